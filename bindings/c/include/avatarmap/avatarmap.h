@@ -1,0 +1,366 @@
+/*
+ * avatarmap C API: MediaPipe landmarks -> proxy pose of the 55 VRM 1.0 humanoid bones.
+ *
+ * C99, usable from C, C++ and any FFI (ctypes, cffi, P/Invoke, ...).
+ *
+ * Conventions
+ *   - Every function returns an avm_status, a plain value or nothing; no function throws,
+ *     aborts or calls exit(). A NULL pointer where an object is required gives
+ *     AVM_ERROR_INVALID_ARGUMENT, never a crash.
+ *   - Handles are typed and opaque (avm_solver). A handle is created by avm_solver_create(),
+ *     owned by the caller and freed by avm_solver_destroy(); destroying NULL does nothing.
+ *   - The library never hands out memory the caller must free. Strings it returns are either
+ *     static (valid for the life of the process) or owned by a handle (valid until the next
+ *     call on that handle or its destruction) as stated on each function.
+ *   - Threads: a handle must be used from one thread at a time (calls on one handle must not
+ *     overlap); different handles are fully independent and may be used from different
+ *     threads at once. Functions without a handle are thread-safe.
+ *   - Quaternions cross this boundary as {x, y, z, w}. Rotations are local (relative to the
+ *     parent bone) in VRM 1.0 normalised space: identity = VRM T-pose, Y up, the avatar faces
+ *     +Z, the avatar's left is +X. Positions are metres; times are seconds.
+ *   - Evolution: structs whose layout may grow start with `uint32_t struct_size`; new
+ *     behaviour comes as new fields at the end of such structs or as new `_v2` functions.
+ */
+#ifndef AVATARMAP_AVATARMAP_H
+#define AVATARMAP_AVATARMAP_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(_WIN32) || defined(__CYGWIN__)
+#if defined(AVATARMAP_C_BUILDING)
+#define AVATARMAP_C_API __declspec(dllexport)
+#else
+#define AVATARMAP_C_API __declspec(dllimport)
+#endif
+#elif defined(AVATARMAP_C_BUILDING) && (defined(__GNUC__) || defined(__clang__))
+#define AVATARMAP_C_API __attribute__((visibility("default")))
+#else
+#define AVATARMAP_C_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- version ------------------------------------------------------------------------- */
+
+/* Version of this header. avm_version() gives the version of the library actually loaded;
+ * they differ only when a program runs against another build of the shared library. */
+#define AVM_VERSION_MAJOR 0
+#define AVM_VERSION_MINOR 1
+#define AVM_VERSION_PATCH 0
+#define AVM_VERSION_STRING "0.1.0"
+/* Single number for compile-time comparisons: MAJOR * 10000 + MINOR * 100 + PATCH. */
+#define AVM_VERSION_NUMBER (AVM_VERSION_MAJOR * 10000 + AVM_VERSION_MINOR * 100 + AVM_VERSION_PATCH)
+
+/* Writes the loaded library's version into each non-NULL argument (NULL ones are skipped).
+ * Thread-safe; cannot fail. */
+AVATARMAP_C_API void avm_version(int* out_major, int* out_minor, int* out_patch);
+
+/* The loaded library's version as "MAJOR.MINOR.PATCH". Static string; thread-safe. */
+AVATARMAP_C_API const char* avm_version_string(void);
+
+/* ---- status -------------------------------------------------------------------------- */
+
+typedef enum avm_status {
+  AVM_OK = 0,
+  AVM_ERROR_INVALID_ARGUMENT, /* NULL pointer, bad count, option out of range, ... */
+  AVM_ERROR_IO,               /* a file could not be opened, written or renamed */
+  AVM_ERROR_PARSE,            /* a file's content is malformed */
+  AVM_ERROR_END_OF_FILE,      /* no more data (not a failure of the caller) */
+  AVM_ERROR_UNSUPPORTED,      /* the feature is not available in this build */
+  AVM_ERROR_OUT_OF_MEMORY,    /* an allocation failed */
+  AVM_ERROR_INTERNAL          /* a bug in avatarmap: please report it with last_error */
+} avm_status;
+
+/* Short English description of a status ("ok", "invalid argument", ...); "unknown status"
+ * for values outside the enum. Static string; thread-safe. */
+AVATARMAP_C_API const char* avm_status_string(avm_status status);
+
+/* ---- skeleton vocabulary ------------------------------------------------------------- */
+
+#define AVM_BONE_COUNT 55
+#define AVM_EXPRESSION_COUNT 16
+
+/* Bones in the order of avm_pose's arrays: every parent comes before its children. */
+typedef enum avm_bone {
+  AVM_BONE_HIPS = 0,
+  AVM_BONE_SPINE,
+  AVM_BONE_CHEST,
+  AVM_BONE_UPPER_CHEST,
+  AVM_BONE_NECK,
+  AVM_BONE_HEAD,
+  AVM_BONE_LEFT_EYE,
+  AVM_BONE_RIGHT_EYE,
+  AVM_BONE_JAW,
+  AVM_BONE_LEFT_UPPER_LEG,
+  AVM_BONE_LEFT_LOWER_LEG,
+  AVM_BONE_LEFT_FOOT,
+  AVM_BONE_LEFT_TOES,
+  AVM_BONE_RIGHT_UPPER_LEG,
+  AVM_BONE_RIGHT_LOWER_LEG,
+  AVM_BONE_RIGHT_FOOT,
+  AVM_BONE_RIGHT_TOES,
+  AVM_BONE_LEFT_SHOULDER,
+  AVM_BONE_LEFT_UPPER_ARM,
+  AVM_BONE_LEFT_LOWER_ARM,
+  AVM_BONE_LEFT_HAND,
+  AVM_BONE_RIGHT_SHOULDER,
+  AVM_BONE_RIGHT_UPPER_ARM,
+  AVM_BONE_RIGHT_LOWER_ARM,
+  AVM_BONE_RIGHT_HAND,
+  AVM_BONE_LEFT_THUMB_METACARPAL,
+  AVM_BONE_LEFT_THUMB_PROXIMAL,
+  AVM_BONE_LEFT_THUMB_DISTAL,
+  AVM_BONE_LEFT_INDEX_PROXIMAL,
+  AVM_BONE_LEFT_INDEX_INTERMEDIATE,
+  AVM_BONE_LEFT_INDEX_DISTAL,
+  AVM_BONE_LEFT_MIDDLE_PROXIMAL,
+  AVM_BONE_LEFT_MIDDLE_INTERMEDIATE,
+  AVM_BONE_LEFT_MIDDLE_DISTAL,
+  AVM_BONE_LEFT_RING_PROXIMAL,
+  AVM_BONE_LEFT_RING_INTERMEDIATE,
+  AVM_BONE_LEFT_RING_DISTAL,
+  AVM_BONE_LEFT_LITTLE_PROXIMAL,
+  AVM_BONE_LEFT_LITTLE_INTERMEDIATE,
+  AVM_BONE_LEFT_LITTLE_DISTAL,
+  AVM_BONE_RIGHT_THUMB_METACARPAL,
+  AVM_BONE_RIGHT_THUMB_PROXIMAL,
+  AVM_BONE_RIGHT_THUMB_DISTAL,
+  AVM_BONE_RIGHT_INDEX_PROXIMAL,
+  AVM_BONE_RIGHT_INDEX_INTERMEDIATE,
+  AVM_BONE_RIGHT_INDEX_DISTAL,
+  AVM_BONE_RIGHT_MIDDLE_PROXIMAL,
+  AVM_BONE_RIGHT_MIDDLE_INTERMEDIATE,
+  AVM_BONE_RIGHT_MIDDLE_DISTAL,
+  AVM_BONE_RIGHT_RING_PROXIMAL,
+  AVM_BONE_RIGHT_RING_INTERMEDIATE,
+  AVM_BONE_RIGHT_RING_DISTAL,
+  AVM_BONE_RIGHT_LITTLE_PROXIMAL,
+  AVM_BONE_RIGHT_LITTLE_INTERMEDIATE,
+  AVM_BONE_RIGHT_LITTLE_DISTAL
+} avm_bone;
+
+/* Expressions in the order of avm_pose's expressions array (VRM 1.0 preset names plus four
+ * custom brow expressions). "Left" is the person's and the avatar's left. */
+typedef enum avm_expression {
+  AVM_EXPRESSION_BLINK = 0,
+  AVM_EXPRESSION_BLINK_LEFT,
+  AVM_EXPRESSION_BLINK_RIGHT,
+  AVM_EXPRESSION_AA,
+  AVM_EXPRESSION_IH,
+  AVM_EXPRESSION_OU,
+  AVM_EXPRESSION_EE,
+  AVM_EXPRESSION_OH,
+  AVM_EXPRESSION_LOOK_UP,
+  AVM_EXPRESSION_LOOK_DOWN,
+  AVM_EXPRESSION_LOOK_LEFT,
+  AVM_EXPRESSION_LOOK_RIGHT,
+  AVM_EXPRESSION_BROW_UP_LEFT,
+  AVM_EXPRESSION_BROW_UP_RIGHT,
+  AVM_EXPRESSION_BROW_DOWN_LEFT,
+  AVM_EXPRESSION_BROW_DOWN_RIGHT
+} avm_expression;
+
+/* VRM 1.0 name of a bone ("hips", "leftUpperArm", ...); NULL when `bone` is outside
+ * [0, AVM_BONE_COUNT). Static string; thread-safe. */
+AVATARMAP_C_API const char* avm_bone_name(int bone);
+
+/* Parent of a bone; -1 for hips (the root) and for `bone` outside [0, AVM_BONE_COUNT).
+ * Thread-safe. */
+AVATARMAP_C_API int avm_bone_parent(int bone);
+
+/* Bone index from its exact, case-sensitive VRM 1.0 name; -1 when unknown or `name` is NULL.
+ * Thread-safe. */
+AVATARMAP_C_API int avm_bone_from_name(const char* name);
+
+/* Name of an expression as written in *.pose.jsonl ("blink", "blinkLeft", "aa", ...); NULL
+ * when `expression` is outside [0, AVM_EXPRESSION_COUNT). Static string; thread-safe. */
+AVATARMAP_C_API const char* avm_expression_name(int expression);
+
+/* Expression index from its exact name; -1 when unknown or `name` is NULL. Thread-safe. */
+AVATARMAP_C_API int avm_expression_from_name(const char* name);
+
+/* ---- input: one frame of landmarks --------------------------------------------------- */
+
+#define AVM_POSE_LANDMARK_COUNT 33
+#define AVM_HAND_LANDMARK_COUNT 21
+#define AVM_FACE_LANDMARK_COUNT 468      /* face mesh */
+#define AVM_FACE_IRIS_LANDMARK_COUNT 478 /* face mesh with iris refinement */
+
+/* One MediaPipe landmark. Image points: x, y normalised to [0, 1] of the image width and
+ * height (y down), z relative depth. World points: metres, x toward image right, y down,
+ * z away from the camera. visibility and presence are in [0, 1]; give 1 for both on hand and
+ * face points (a landmark whose min(visibility, presence) is low is treated as not seen).
+ * Non-finite values (NaN, inf) are accepted and mean "not seen". */
+typedef struct avm_landmark {
+  float x;
+  float y;
+  float z;
+  float visibility;
+  float presence;
+} avm_landmark;
+
+/* One captured frame. Each pointer is either NULL (the part was not seen) or points to the
+ * stated number of landmarks; "left"/"right" are the person's anatomical sides. The arrays
+ * are only read during the call that receives the frame; they are not retained. */
+typedef struct avm_frame {
+  double t;                             /* capture time, seconds; must be finite */
+  const avm_landmark* pose;             /* AVM_POSE_LANDMARK_COUNT image points */
+  const avm_landmark* pose_world;       /* AVM_POSE_LANDMARK_COUNT world points */
+  const avm_landmark* left_hand;        /* AVM_HAND_LANDMARK_COUNT image points */
+  const avm_landmark* left_hand_world;  /* AVM_HAND_LANDMARK_COUNT world points */
+  const avm_landmark* right_hand;       /* AVM_HAND_LANDMARK_COUNT image points */
+  const avm_landmark* right_hand_world; /* AVM_HAND_LANDMARK_COUNT world points */
+  const avm_landmark* face;             /* face_count image points */
+  int32_t face_count; /* AVM_FACE_LANDMARK_COUNT or AVM_FACE_IRIS_LANDMARK_COUNT when face
+                         is not NULL; ignored when face is NULL */
+} avm_frame;
+
+/* ---- output: one proxy pose ---------------------------------------------------------- */
+
+typedef struct avm_pose {
+  double t;                           /* seconds: the frame's capture time, or the sampled time */
+  float hips_position[3];             /* metres, VRM space: Y = hips height above the soles */
+  float rotations[AVM_BONE_COUNT][4]; /* local rotation {x, y, z, w}, unit length */
+  float confidence[AVM_BONE_COUNT];   /* 0 = not observed .. 1 = observed */
+  float expressions[AVM_EXPRESSION_COUNT]; /* weights 0 .. 1, see avm_expression */
+} avm_pose;
+
+/* ---- solver options ------------------------------------------------------------------ */
+
+/* Options of a solver. Always initialise with avm_solver_options_init() and then change
+ * fields: it sets struct_size, which lets a library built with more fields than the caller
+ * knows fill the rest with defaults, and lets this library read only the fields it knows
+ * from a caller compiled against a newer header. Booleans are int32_t, 0 or non-zero.
+ * Ranges are checked by avm_solver_create() / avm_solve_file(). */
+typedef struct avm_solver_options {
+  uint32_t struct_size; /* sizeof(avm_solver_options) as the caller knows it */
+
+  /* -- solver (see include/avatarmap/solve/solver_options.hpp) -- */
+  int32_t mirror;      /* swap left and right and flip X (mirrored webcam preview); 0 */
+  float image_width;   /* pixels; 0 = unknown (square pixels assumed); give both or neither */
+  float image_height;  /* pixels; 0 */
+  int32_t solve_body;  /* hips, spine, shoulders, arms, legs, feet; 1 */
+  int32_t solve_hands; /* wrists' orientation and fingers; 1 */
+  int32_t solve_face;  /* neck, head, eyes, expressions; 1 */
+  int32_t solve_hips_translation;  /* hips_position X/Y/Z from the image (else rest); 1 */
+  float confidence_lost_below;     /* a bone is lost below this confidence; 0.3 */
+  float confidence_found_above;    /* ... and found again above this; 0.5 (>= lost_below) */
+  float confidence_hold_seconds;   /* a lost bone holds its last rotation this long; 0.5 */
+  float confidence_ease_seconds;   /* ... then eases to rest over this long; 1.0 */
+  float confidence_regain_seconds; /* a found bone blends in over this long; 0.15 */
+  float hips_lean_share;           /* [0, 1] share of the torso lean given to the hips; 0.5 */
+  float forearm_twist_share;       /* [0, 1] share of wrist twist moved to the forearm; 0.6 */
+  float horizontal_fov_degrees;    /* camera's horizontal field of view, (1, 179); 60 */
+  float rest_hips_height;          /* metres, (0, 10), used while legs were never seen; 0.95 */
+
+  /* -- One Euro filter applied to each solved pose (avm_solver_push, avm_solve_file);
+   *    defaults from include/avatarmap/time/pose_filter.hpp. Cutoffs in Hz, finite, > 0;
+   *    betas finite, >= 0 (rotation: seconds per radian, position: seconds per metre,
+   *    expressions: seconds per unit weight). -- */
+  int32_t filter_rotations;    /* filter the bone rotations; 1 */
+  float rotation_min_cutoff;   /* 1.5 */
+  float rotation_beta;         /* 0.5 */
+  float rotation_d_cutoff;     /* cutoff of the speed estimate; 1.0 */
+  int32_t filter_position;     /* filter hips_position; 1 */
+  float position_min_cutoff;   /* 1.0 */
+  float position_beta;         /* 2.0 */
+  float position_d_cutoff;     /* 1.0 */
+  int32_t filter_expressions;  /* filter the expression weights; 1 */
+  float expression_min_cutoff; /* 3.0 */
+  float expression_beta;       /* 1.0 */
+  float expression_d_cutoff;   /* 1.0 */
+
+  /* -- resampler (avm_solver_sample) -- */
+  float max_extrapolation_seconds; /* finite, >= 0: how far past the newest frame sample()
+                                      extrapolates before holding still; 0.1 */
+} avm_solver_options;
+
+/* Fills `options` with the defaults and sets options->struct_size. Returns
+ * AVM_ERROR_INVALID_ARGUMENT when `options` is NULL. Thread-safe. */
+AVATARMAP_C_API avm_status avm_solver_options_init(avm_solver_options* options);
+
+/* ---- solver -------------------------------------------------------------------------- */
+
+/* A solver: landmark frames in capture order -> solved, filtered poses, plus a resampler
+ * for render times. Opaque; created by avm_solver_create(). */
+typedef struct avm_solver avm_solver;
+
+/* Creates a solver. `options` NULL means the defaults; it is only read during the call.
+ * On success *out_solver is a new handle owned by the caller (free it with
+ * avm_solver_destroy()).
+ * Failures (*out_solver is set to NULL whenever out_solver is not NULL):
+ *   AVM_ERROR_INVALID_ARGUMENT: out_solver is NULL, options->struct_size is too small to
+ *     hold any field (not initialised with avm_solver_options_init()), or a field is out of
+ *     range;
+ *   AVM_ERROR_OUT_OF_MEMORY; AVM_ERROR_INTERNAL.
+ * The message of the last failure is given by avm_last_create_error(). Thread-safe. */
+AVATARMAP_C_API avm_status avm_solver_create(const avm_solver_options* options,
+                                             avm_solver** out_solver);
+
+/* Message of the calling thread's last failed avm_solver_create() (or avm_solve_file()
+ * option check), naming the field and its allowed range; "" when the last such call
+ * succeeded or none was made. The string belongs to the library and is valid until the
+ * calling thread's next avm_solver_create() or avm_solve_file(). Thread-safe (per thread). */
+AVATARMAP_C_API const char* avm_last_create_error(void);
+
+/* Frees a solver and everything it owns, including its last_error string. NULL does
+ * nothing. The handle must not be in use by another thread. */
+AVATARMAP_C_API void avm_solver_destroy(avm_solver* solver);
+
+/* Forgets every frame pushed so far (solver state, filters, resampler history); options are
+ * kept. Returns AVM_ERROR_INVALID_ARGUMENT when `solver` is NULL. */
+AVATARMAP_C_API avm_status avm_solver_reset(avm_solver* solver);
+
+/* Solves one frame, filters the result (if enabled in the options) and adds it to the
+ * resampler's history. Frames must come in capture order; a frame whose t is earlier than the
+ * previous frame's resets the solver first (as avm_solver_reset()). The frame and its arrays
+ * are only read during the call. Allocates nothing.
+ * Failures (the solver's state is unchanged):
+ *   AVM_ERROR_INVALID_ARGUMENT: solver or frame NULL, t not finite, face not NULL with
+ *     face_count other than 468 or 478;
+ *   AVM_ERROR_INTERNAL. avm_solver_last_error() says which. */
+AVATARMAP_C_API avm_status avm_solver_push(avm_solver* solver, const avm_frame* frame);
+
+/* Copies the latest solved and filtered pose into *out_pose (owned by the caller). Before
+ * the first push (or after a reset) it is the rest pose (T-pose, default hips height,
+ * t = 0).
+ * Failures: AVM_ERROR_INVALID_ARGUMENT when solver or out_pose is NULL. */
+AVATARMAP_C_API avm_status avm_solver_get_pose(const avm_solver* solver, avm_pose* out_pose);
+
+/* Writes the pose at render time t (seconds, on the frames' clock) into *out_pose:
+ * interpolated between the two pushed poses around t (rotations by shortest-path slerp),
+ * held at the first pose before it, and extrapolated at most max_extrapolation_seconds past
+ * the newest. Before the first push it is the rest pose. out_pose->t = t. Allocates nothing.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT when solver or out_pose is NULL or t is not finite;
+ *   AVM_ERROR_INTERNAL. */
+AVATARMAP_C_API avm_status avm_solver_sample(avm_solver* solver, double t, avm_pose* out_pose);
+
+/* Message of the last failed call on `solver` ("" after a successful call, or when `solver`
+ * is NULL). The string is owned by the solver and valid until the next call on it or its
+ * destruction. */
+AVATARMAP_C_API const char* avm_solver_last_error(const avm_solver* solver);
+
+/* ---- files --------------------------------------------------------------------------- */
+
+/* Solves a whole *.landmarks.jsonl file into a *.pose.jsonl file (REFERENCE §3): every frame
+ * is solved and filtered as by avm_solver_push(); no resampling. The image size of the
+ * landmark file's header is used when options give none. The output is written atomically:
+ * a temporary file beside `out_pose` is renamed over it only when everything succeeded, so
+ * on failure an existing `out_pose` is untouched. `options` NULL means the defaults.
+ * When `err` is not NULL and err_size > 0, a NUL-terminated message (truncated to fit) is
+ * written there: "" on success, else what failed and where ("FILE:LINE: ...").
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (a path NULL, bad options), AVM_ERROR_IO (cannot
+ *   open, write or rename), AVM_ERROR_PARSE (a malformed line: the first one stops the
+ *   run), AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL. Thread-safe (separate files). */
+AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* out_pose,
+                                          const avm_solver_options* options, char* err,
+                                          size_t err_size);
+
+#ifdef __cplusplus
+} /* extern "C" */
+#endif
+
+#endif /* AVATARMAP_AVATARMAP_H */

@@ -1,0 +1,546 @@
+// The C API (bindings/c/include/avatarmap/avatarmap.h) over the C++ core. Rules kept here:
+// no exception leaves an avm_* function (each body is wrapped by guarded()); quaternions are
+// copied component by component through store_xyzw (never memcpy'd); the per-frame calls
+// (push, get_pose, sample) allocate nothing on success.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <new>
+#include <string>
+#include <string_view>
+
+#include "avatarmap/avatarmap.h"
+#include "avatarmap/core/rotation.hpp"
+#include "avatarmap/io/landmark_file.hpp"
+#include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/skeleton/bone.hpp"
+#include "avatarmap/skeleton/expression.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+#include "avatarmap/solve/frame_solver.hpp"
+#include "avatarmap/solve/solver_options.hpp"
+#include "avatarmap/time/pose_filter.hpp"
+#include "avatarmap/time/pose_resampler.hpp"
+#include "avatarmap/version.hpp"
+
+namespace am = avatarmap;
+
+static_assert(AVM_VERSION_MAJOR == AVATARMAP_VERSION_MAJOR &&
+                  AVM_VERSION_MINOR == AVATARMAP_VERSION_MINOR &&
+                  AVM_VERSION_PATCH == AVATARMAP_VERSION_PATCH,
+              "avatarmap.h and avatarmap/version.hpp disagree on the version");
+static_assert(AVM_BONE_COUNT == am::k_bone_count, "bone count");
+static_assert(AVM_EXPRESSION_COUNT == am::k_expression_count, "expression count");
+static_assert(AVM_POSE_LANDMARK_COUNT == am::k_pose_landmark_count, "pose landmark count");
+static_assert(AVM_HAND_LANDMARK_COUNT == am::k_hand_landmark_count, "hand landmark count");
+static_assert(AVM_FACE_LANDMARK_COUNT == am::k_face_mesh_count, "face landmark count");
+static_assert(AVM_FACE_IRIS_LANDMARK_COUNT == am::k_face_mesh_iris_count, "face+iris count");
+static_assert(AVM_BONE_RIGHT_LITTLE_DISTAL == am::idx(am::bone::right_little_distal) &&
+                  AVM_BONE_LEFT_HAND == am::idx(am::bone::left_hand) &&
+                  AVM_BONE_RIGHT_TOES == am::idx(am::bone::right_toes) &&
+                  AVM_BONE_JAW == am::idx(am::bone::jaw),
+              "avm_bone must follow avatarmap::bone");
+static_assert(AVM_EXPRESSION_BROW_DOWN_RIGHT == am::idx(am::expression::brow_down_right) &&
+                  AVM_EXPRESSION_LOOK_UP == am::idx(am::expression::look_up),
+              "avm_expression must follow avatarmap::expression");
+// The prefix copy in read_options() relies on every field being 4 bytes wide.
+static_assert(sizeof(avm_solver_options) % 4 == 0 && alignof(avm_solver_options) == 4,
+              "avm_solver_options must hold only 4-byte fields");
+
+// Which parts of a pose are filtered (pose_filter itself filters all or nothing).
+struct filter_channels {
+  bool rotations = true;
+  bool position = true;
+  bool expressions = true;
+};
+
+// The handle. Everything a frame needs is preallocated here.
+struct avm_solver {
+  am::frame_solver solver;
+  am::pose_filter filter;
+  am::pose_resampler resampler;
+  filter_channels channels;
+  am::landmark_frame frame;  // scratch: the C frame converted
+  am::proxy_pose raw;        // scratch: solved, before filtering
+  am::proxy_pose latest;     // solved and filtered
+  am::proxy_pose sampled;    // scratch for sample()
+  mutable std::string last_error;
+
+  avm_solver(const am::solver_options& s, const am::pose_filter_options& f,
+             const am::pose_resampler_options& r)
+      : solver(s), filter(f), resampler(r) {}
+};
+
+namespace {
+
+constexpr std::size_t k_error_capacity = 512;
+// avm_last_create_error(): a fixed buffer so that reporting cannot itself fail to allocate.
+thread_local char t_create_error[k_error_capacity] = "";
+
+void copy_message(char* dst, std::size_t size, const char* msg) {
+  if (dst == nullptr || size == 0) return;
+  if (msg == nullptr) msg = "";
+  std::size_t n = std::strlen(msg);
+  if (n >= size) n = size - 1;
+  std::memcpy(dst, msg, n);
+  dst[n] = '\0';
+}
+
+void set_create_error(const char* msg) { copy_message(t_create_error, k_error_capacity, msg); }
+
+// Sets the handle's message; a failure to allocate it leaves a truncated or empty message
+// rather than turning the real error into another one.
+void set_error(const avm_solver* s, const char* msg) noexcept {
+  if (s == nullptr) return;
+  try {
+    s->last_error.assign(msg);
+  } catch (...) {
+    s->last_error.clear();
+  }
+}
+
+avm_status fail(const avm_solver* s, avm_status code, const char* msg) noexcept {
+  set_error(s, msg);
+  return code;
+}
+
+// Runs `body` (returning avm_status) with every exception mapped to a status; the message
+// goes to the handle `s` when there is one.
+template <class Body>
+avm_status guarded(const avm_solver* s, Body&& body) noexcept {
+  try {
+    return body();
+  } catch (const std::bad_alloc&) {
+    return fail(s, AVM_ERROR_OUT_OF_MEMORY, "out of memory");
+  } catch (const std::exception& e) {
+    return fail(s, AVM_ERROR_INTERNAL, e.what());
+  } catch (...) {
+    return fail(s, AVM_ERROR_INTERNAL, "unknown internal error");
+  }
+}
+
+avm_solver_options default_options() {
+  avm_solver_options o;
+  std::memset(&o, 0, sizeof o);
+  o.struct_size = sizeof o;
+  const am::solver_options s{};
+  o.mirror = s.mirror ? 1 : 0;
+  o.image_width = s.image_width;
+  o.image_height = s.image_height;
+  o.solve_body = s.parts.body ? 1 : 0;
+  o.solve_hands = s.parts.hands ? 1 : 0;
+  o.solve_face = s.parts.face ? 1 : 0;
+  o.solve_hips_translation = s.parts.hips_translation ? 1 : 0;
+  o.confidence_lost_below = s.confidence.lost_below;
+  o.confidence_found_above = s.confidence.found_above;
+  o.confidence_hold_seconds = s.confidence.hold_seconds;
+  o.confidence_ease_seconds = s.confidence.ease_seconds;
+  o.confidence_regain_seconds = s.confidence.regain_seconds;
+  o.hips_lean_share = s.hips_lean_share;
+  o.forearm_twist_share = s.forearm_twist_share;
+  o.horizontal_fov_degrees = s.horizontal_fov_degrees;
+  o.rest_hips_height = s.rest_hips_height;
+  const am::pose_filter_options f{};
+  o.filter_rotations = f.enabled ? 1 : 0;
+  o.rotation_min_cutoff = f.rotation.min_cutoff;
+  o.rotation_beta = f.rotation.beta;
+  o.rotation_d_cutoff = f.rotation.d_cutoff;
+  o.filter_position = f.enabled ? 1 : 0;
+  o.position_min_cutoff = f.position.min_cutoff;
+  o.position_beta = f.position.beta;
+  o.position_d_cutoff = f.position.d_cutoff;
+  o.filter_expressions = f.enabled ? 1 : 0;
+  o.expression_min_cutoff = f.expression.min_cutoff;
+  o.expression_beta = f.expression.beta;
+  o.expression_d_cutoff = f.expression.d_cutoff;
+  const am::pose_resampler_options r{};
+  o.max_extrapolation_seconds = static_cast<float>(r.max_extrapolation_seconds);
+  return o;
+}
+
+// Options as the core wants them, after the checks the core does not do itself.
+struct core_options {
+  am::solver_options solver;
+  am::pose_filter_options filter;
+  am::pose_resampler_options resampler;
+  filter_channels channels;
+};
+
+// Larger than any plausible future avm_solver_options: a bigger struct_size is taken as an
+// uninitialised struct rather than a newer caller.
+constexpr std::uint32_t k_max_struct_size = 4096;
+
+// Reads caller options (NULL = defaults) into `out`; on failure writes a message naming the
+// field and its range into `msg` and returns false.
+bool read_options(const avm_solver_options* in, core_options& out, std::string& msg) {
+  avm_solver_options o = default_options();
+  if (in != nullptr) {
+    const std::uint32_t size = in->struct_size;
+    if (size < offsetof(avm_solver_options, mirror) + sizeof(std::int32_t) ||
+        size > k_max_struct_size) {
+      msg = "avm_solver_options.struct_size is " + std::to_string(size) +
+            ": initialise the options with avm_solver_options_init()";
+      return false;
+    }
+    // Known prefix of a newer caller's struct; defaults for fields an older caller lacks.
+    // Whole fields only (all are 4 bytes wide).
+    std::size_t n = std::min<std::size_t>(size, sizeof o) / 4 * 4;
+    std::memcpy(&o, in, n);
+    o.struct_size = sizeof o;
+  }
+  auto& s = out.solver;
+  s.mirror = o.mirror != 0;
+  s.image_width = o.image_width;
+  s.image_height = o.image_height;
+  s.parts.body = o.solve_body != 0;
+  s.parts.hands = o.solve_hands != 0;
+  s.parts.face = o.solve_face != 0;
+  s.parts.hips_translation = o.solve_hips_translation != 0;
+  s.confidence.lost_below = o.confidence_lost_below;
+  s.confidence.found_above = o.confidence_found_above;
+  s.confidence.hold_seconds = o.confidence_hold_seconds;
+  s.confidence.ease_seconds = o.confidence_ease_seconds;
+  s.confidence.regain_seconds = o.confidence_regain_seconds;
+  s.hips_lean_share = o.hips_lean_share;
+  s.forearm_twist_share = o.forearm_twist_share;
+  s.horizontal_fov_degrees = o.horizontal_fov_degrees;
+  s.rest_hips_height = o.rest_hips_height;
+  am::status st = s.validate();
+  if (!st) {
+    msg = "avm_solver_options: " + st.message();
+    return false;
+  }
+
+  struct param_check {
+    const char* name;
+    float min_cutoff, beta, d_cutoff;
+  };
+  const param_check checks[] = {
+      {"rotation", o.rotation_min_cutoff, o.rotation_beta, o.rotation_d_cutoff},
+      {"position", o.position_min_cutoff, o.position_beta, o.position_d_cutoff},
+      {"expression", o.expression_min_cutoff, o.expression_beta, o.expression_d_cutoff}};
+  for (const param_check& c : checks) {
+    if (!(std::isfinite(c.min_cutoff) && c.min_cutoff > 0.f)) {
+      msg = std::string("avm_solver_options.") + c.name + "_min_cutoff must be finite and > 0";
+      return false;
+    }
+    if (!(std::isfinite(c.beta) && c.beta >= 0.f)) {
+      msg = std::string("avm_solver_options.") + c.name + "_beta must be finite and >= 0";
+      return false;
+    }
+    if (!(std::isfinite(c.d_cutoff) && c.d_cutoff > 0.f)) {
+      msg = std::string("avm_solver_options.") + c.name + "_d_cutoff must be finite and > 0";
+      return false;
+    }
+  }
+  if (!(std::isfinite(o.max_extrapolation_seconds) && o.max_extrapolation_seconds >= 0.f)) {
+    msg = "avm_solver_options.max_extrapolation_seconds must be finite and >= 0";
+    return false;
+  }
+  out.filter.rotation = {o.rotation_min_cutoff, o.rotation_beta, o.rotation_d_cutoff};
+  out.filter.position = {o.position_min_cutoff, o.position_beta, o.position_d_cutoff};
+  out.filter.expression = {o.expression_min_cutoff, o.expression_beta, o.expression_d_cutoff};
+  out.channels.rotations = o.filter_rotations != 0;
+  out.channels.position = o.filter_position != 0;
+  out.channels.expressions = o.filter_expressions != 0;
+  out.filter.enabled = out.channels.rotations || out.channels.position || out.channels.expressions;
+  out.resampler.max_extrapolation_seconds = o.max_extrapolation_seconds;
+  return true;
+}
+
+// Checks a C frame; on failure returns a static message.
+const char* check_frame(const avm_frame& f) {
+  if (!std::isfinite(f.t)) return "avm_frame.t must be finite";
+  if (f.face != nullptr && f.face_count != AVM_FACE_LANDMARK_COUNT &&
+      f.face_count != AVM_FACE_IRIS_LANDMARK_COUNT)
+    return "avm_frame.face_count must be 468 or 478 when face is not NULL";
+  return nullptr;
+}
+
+void copy_part(am::landmark_frame& dst, am::frame_part part, const avm_landmark* src, int n,
+               am::landmark* out) {
+  dst.set(part, src != nullptr);
+  if (src == nullptr) return;
+  for (int i = 0; i < n; ++i) {
+    out[i].x = src[i].x;
+    out[i].y = src[i].y;
+    out[i].z = src[i].z;
+    out[i].visibility = src[i].visibility;
+    out[i].presence = src[i].presence;
+  }
+}
+
+void convert_frame(const avm_frame& f, am::landmark_frame& out) {
+  out.clear();
+  out.t = f.t;
+  using fp = am::frame_part;
+  copy_part(out, fp::pose, f.pose, AVM_POSE_LANDMARK_COUNT, out.pose.data());
+  copy_part(out, fp::pose_world, f.pose_world, AVM_POSE_LANDMARK_COUNT, out.pose_world.data());
+  copy_part(out, fp::left_hand, f.left_hand, AVM_HAND_LANDMARK_COUNT, out.left_hand.data());
+  copy_part(out, fp::left_hand_world, f.left_hand_world, AVM_HAND_LANDMARK_COUNT,
+            out.left_hand_world.data());
+  copy_part(out, fp::right_hand, f.right_hand, AVM_HAND_LANDMARK_COUNT, out.right_hand.data());
+  copy_part(out, fp::right_hand_world, f.right_hand_world, AVM_HAND_LANDMARK_COUNT,
+            out.right_hand_world.data());
+  copy_part(out, fp::face, f.face, f.face != nullptr ? f.face_count : 0, out.face.data());
+  out.face_count = f.face != nullptr ? f.face_count : 0;
+}
+
+// Filters `raw` into `out`; channels whose filtering is off are taken unfiltered.
+void filter_pose(am::pose_filter& filter, const filter_channels& c, const am::proxy_pose& raw,
+                 am::proxy_pose& out) {
+  filter.apply(raw, out);
+  if (!c.rotations) out.rotations = raw.rotations;
+  if (!c.position) out.hips_position = raw.hips_position;
+  if (!c.expressions) out.expressions = raw.expressions;
+}
+
+void to_c_pose(const am::proxy_pose& p, avm_pose& out) {
+  out.t = p.t;
+  out.hips_position[0] = p.hips_position.x;
+  out.hips_position[1] = p.hips_position.y;
+  out.hips_position[2] = p.hips_position.z;
+  for (int b = 0; b < AVM_BONE_COUNT; ++b) {
+    am::store_xyzw(p.rotations[b], out.rotations[b]);
+    out.confidence[b] = p.confidence[b];
+  }
+  for (int e = 0; e < AVM_EXPRESSION_COUNT; ++e) out.expressions[e] = p.expressions[e];
+}
+
+}  // namespace
+
+extern "C" {
+
+AVATARMAP_C_API void avm_version(int* out_major, int* out_minor, int* out_patch) {
+  if (out_major != nullptr) *out_major = AVATARMAP_VERSION_MAJOR;
+  if (out_minor != nullptr) *out_minor = AVATARMAP_VERSION_MINOR;
+  if (out_patch != nullptr) *out_patch = AVATARMAP_VERSION_PATCH;
+}
+
+AVATARMAP_C_API const char* avm_version_string(void) { return AVATARMAP_VERSION_STRING; }
+
+AVATARMAP_C_API const char* avm_status_string(avm_status status) {
+  switch (status) {
+    case AVM_OK:
+      return "ok";
+    case AVM_ERROR_INVALID_ARGUMENT:
+      return "invalid argument";
+    case AVM_ERROR_IO:
+      return "input/output error";
+    case AVM_ERROR_PARSE:
+      return "parse error";
+    case AVM_ERROR_END_OF_FILE:
+      return "end of file";
+    case AVM_ERROR_UNSUPPORTED:
+      return "unsupported";
+    case AVM_ERROR_OUT_OF_MEMORY:
+      return "out of memory";
+    case AVM_ERROR_INTERNAL:
+      return "internal error";
+  }
+  return "unknown status";
+}
+
+AVATARMAP_C_API const char* avm_bone_name(int bone) {
+  if (bone < 0 || bone >= AVM_BONE_COUNT) return nullptr;
+  // The names are string_views over string literals: NUL-terminated.
+  return am::bone_name(static_cast<am::bone>(bone)).data();
+}
+
+AVATARMAP_C_API int avm_bone_parent(int bone) {
+  if (bone < 0 || bone >= AVM_BONE_COUNT) return -1;
+  return am::bone_parent(bone);
+}
+
+AVATARMAP_C_API int avm_bone_from_name(const char* name) {
+  if (name == nullptr) return -1;
+  auto b = am::bone_from_name(std::string_view(name));
+  return b ? am::idx(*b) : -1;
+}
+
+AVATARMAP_C_API const char* avm_expression_name(int expression) {
+  if (expression < 0 || expression >= AVM_EXPRESSION_COUNT) return nullptr;
+  return am::expression_name(static_cast<am::expression>(expression)).data();
+}
+
+AVATARMAP_C_API int avm_expression_from_name(const char* name) {
+  if (name == nullptr) return -1;
+  auto e = am::expression_from_name(std::string_view(name));
+  return e ? am::idx(*e) : -1;
+}
+
+AVATARMAP_C_API avm_status avm_solver_options_init(avm_solver_options* options) {
+  if (options == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  return guarded(nullptr, [&] {
+    *options = default_options();
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API const char* avm_last_create_error(void) { return t_create_error; }
+
+AVATARMAP_C_API avm_status avm_solver_create(const avm_solver_options* options,
+                                             avm_solver** out_solver) {
+  set_create_error("");
+  if (out_solver == nullptr) {
+    set_create_error("avm_solver_create: out_solver is NULL");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  *out_solver = nullptr;
+  try {
+    core_options o;
+    std::string msg;
+    if (!read_options(options, o, msg)) {
+      set_create_error(msg.c_str());
+      return AVM_ERROR_INVALID_ARGUMENT;
+    }
+    auto* s = new avm_solver(o.solver, o.filter, o.resampler);
+    s->channels = o.channels;
+    s->latest.set_rest();
+    s->last_error.reserve(128);
+    *out_solver = s;
+    return AVM_OK;
+  } catch (const std::bad_alloc&) {
+    set_create_error("avm_solver_create: out of memory");
+    return AVM_ERROR_OUT_OF_MEMORY;
+  } catch (const std::exception& e) {
+    set_create_error(e.what());
+    return AVM_ERROR_INTERNAL;
+  } catch (...) {
+    set_create_error("avm_solver_create: unknown internal error");
+    return AVM_ERROR_INTERNAL;
+  }
+}
+
+AVATARMAP_C_API void avm_solver_destroy(avm_solver* solver) { delete solver; }
+
+AVATARMAP_C_API avm_status avm_solver_reset(avm_solver* solver) {
+  if (solver == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  solver->last_error.clear();
+  return guarded(solver, [&] {
+    solver->solver.reset();
+    solver->filter.reset();
+    solver->resampler.reset();
+    solver->latest.set_rest();
+    solver->latest.t = 0.0;
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_solver_push(avm_solver* solver, const avm_frame* frame) {
+  if (solver == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  solver->last_error.clear();
+  if (frame == nullptr)
+    return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_push: frame is NULL");
+  if (const char* bad = check_frame(*frame)) return fail(solver, AVM_ERROR_INVALID_ARGUMENT, bad);
+  return guarded(solver, [&] {
+    convert_frame(*frame, solver->frame);
+    solver->solver.solve(solver->frame, solver->raw);
+    filter_pose(solver->filter, solver->channels, solver->raw, solver->latest);
+    solver->latest.t = frame->t;
+    if (!solver->resampler.push(solver->latest))
+      return fail(solver, AVM_ERROR_INTERNAL, "avm_solver_push: the resampler refused the pose");
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_solver_get_pose(const avm_solver* solver, avm_pose* out_pose) {
+  if (solver == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  solver->last_error.clear();
+  if (out_pose == nullptr)
+    return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_get_pose: out_pose is NULL");
+  to_c_pose(solver->latest, *out_pose);
+  return AVM_OK;
+}
+
+AVATARMAP_C_API avm_status avm_solver_sample(avm_solver* solver, double t, avm_pose* out_pose) {
+  if (solver == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  solver->last_error.clear();
+  if (out_pose == nullptr)
+    return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_sample: out_pose is NULL");
+  if (!std::isfinite(t))
+    return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_sample: t must be finite");
+  return guarded(solver, [&] {
+    if (!solver->resampler.sample(t, solver->sampled)) {
+      solver->sampled.set_rest();  // nothing pushed yet
+      solver->sampled.t = t;
+    }
+    to_c_pose(solver->sampled, *out_pose);
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API const char* avm_solver_last_error(const avm_solver* solver) {
+  if (solver == nullptr) return "";
+  return solver->last_error.c_str();
+}
+
+AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* out_pose,
+                                          const avm_solver_options* options, char* err,
+                                          size_t err_size) {
+  copy_message(err, err_size, "");
+  set_create_error("");
+  auto report = [&](avm_status code, const char* msg) {
+    copy_message(err, err_size, msg);
+    return code;
+  };
+  if (in_landmarks == nullptr || out_pose == nullptr)
+    return report(AVM_ERROR_INVALID_ARGUMENT, "avm_solve_file: a path is NULL");
+  try {
+    core_options o;
+    std::string msg;
+    if (!read_options(options, o, msg)) {
+      set_create_error(msg.c_str());
+      return report(AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
+    }
+    am::landmark_reader reader;
+    am::status st = reader.open(in_landmarks);
+    if (!st) return report(AVM_ERROR_IO, st.message().c_str());
+    const am::landmark_file_header& lh = reader.header();
+    if (o.solver.image_width == 0.f && o.solver.image_height == 0.f && lh.image_width > 0 &&
+        lh.image_height > 0) {
+      o.solver.image_width = static_cast<float>(lh.image_width);
+      o.solver.image_height = static_cast<float>(lh.image_height);
+    }
+    am::pose_writer writer;
+    am::pose_file_header ph;
+    ph.present = true;
+    ph.fps = lh.fps;
+    st = writer.open(out_pose, ph);
+    if (!st) return report(AVM_ERROR_IO, st.message().c_str());
+
+    // Large scratch objects live on the heap, not on a caller's possibly small stack.
+    struct scratch {
+      am::landmark_frame frame;
+      am::proxy_pose raw, filtered;
+    };
+    auto work = std::make_unique<scratch>();
+    auto solver = std::make_unique<am::frame_solver>(o.solver);
+    auto filter = std::make_unique<am::pose_filter>(o.filter);
+    for (;;) {
+      am::read_result r = reader.next(work->frame);
+      if (r == am::read_result::end) break;
+      if (r == am::read_result::error) return report(AVM_ERROR_PARSE, reader.error().c_str());
+      solver->solve(work->frame, work->raw);
+      filter_pose(*filter, o.channels, work->raw, work->filtered);
+      work->filtered.t = work->frame.t;
+      st = writer.write(work->filtered);
+      if (!st) return report(AVM_ERROR_IO, st.message().c_str());
+    }
+    st = writer.commit();
+    if (!st) return report(AVM_ERROR_IO, st.message().c_str());
+    return AVM_OK;
+  } catch (const std::bad_alloc&) {
+    return report(AVM_ERROR_OUT_OF_MEMORY, "avm_solve_file: out of memory");
+  } catch (const std::exception& e) {
+    return report(AVM_ERROR_INTERNAL, e.what());
+  } catch (...) {
+    return report(AVM_ERROR_INTERNAL, "avm_solve_file: unknown internal error");
+  }
+}
+
+}  // extern "C"

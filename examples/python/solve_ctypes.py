@@ -1,0 +1,310 @@
+#!/usr/bin/env python3
+"""Drive the avatarmap C API from Python with ctypes only (no numpy, no build step).
+
+Usage:
+    solve_ctypes.py [--library PATH] [--mirror] [FILE.landmarks.jsonl]
+
+The shared library is taken from --library, else from the environment variable
+AVATARMAP_C_LIBRARY, else from the system search path (libavatarmap_c). Without a landmark
+file, a built-in synthetic T-pose is solved. Prints the hips rotation {x, y, z, w} of every
+frame, then a summary. Exits with status 1 on any avm error, 2 on bad usage.
+"""
+
+import argparse
+import ctypes
+import ctypes.util
+import json
+import math
+import os
+import sys
+
+AVM_BONE_COUNT = 55
+AVM_EXPRESSION_COUNT = 16
+AVM_POSE_LANDMARK_COUNT = 33
+AVM_HAND_LANDMARK_COUNT = 21
+AVM_FACE_COUNTS = (468, 478)
+AVM_OK = 0
+
+
+# ---- mirrors of the C structs (bindings/c/include/avatarmap/avatarmap.h) -----------------
+
+
+class AvmLandmark(ctypes.Structure):
+    _fields_ = [(name, ctypes.c_float) for name in ("x", "y", "z", "visibility", "presence")]
+
+
+_LandmarkPtr = ctypes.POINTER(AvmLandmark)
+
+
+class AvmFrame(ctypes.Structure):
+    _fields_ = [
+        ("t", ctypes.c_double),
+        ("pose", _LandmarkPtr),
+        ("pose_world", _LandmarkPtr),
+        ("left_hand", _LandmarkPtr),
+        ("left_hand_world", _LandmarkPtr),
+        ("right_hand", _LandmarkPtr),
+        ("right_hand_world", _LandmarkPtr),
+        ("face", _LandmarkPtr),
+        ("face_count", ctypes.c_int32),
+    ]
+
+
+class AvmPose(ctypes.Structure):
+    _fields_ = [
+        ("t", ctypes.c_double),
+        ("hips_position", ctypes.c_float * 3),
+        ("rotations", (ctypes.c_float * 4) * AVM_BONE_COUNT),  # {x, y, z, w}
+        ("confidence", ctypes.c_float * AVM_BONE_COUNT),
+        ("expressions", ctypes.c_float * AVM_EXPRESSION_COUNT),
+    ]
+
+
+_I, _F = ctypes.c_int32, ctypes.c_float
+
+
+class AvmSolverOptions(ctypes.Structure):
+    # Field order must match the header exactly; new fields are only ever appended there.
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("mirror", _I), ("image_width", _F), ("image_height", _F),
+        ("solve_body", _I), ("solve_hands", _I), ("solve_face", _I),
+        ("solve_hips_translation", _I),
+        ("confidence_lost_below", _F), ("confidence_found_above", _F),
+        ("confidence_hold_seconds", _F), ("confidence_ease_seconds", _F),
+        ("confidence_regain_seconds", _F),
+        ("hips_lean_share", _F), ("forearm_twist_share", _F),
+        ("horizontal_fov_degrees", _F), ("rest_hips_height", _F),
+        ("filter_rotations", _I), ("rotation_min_cutoff", _F), ("rotation_beta", _F),
+        ("rotation_d_cutoff", _F),
+        ("filter_position", _I), ("position_min_cutoff", _F), ("position_beta", _F),
+        ("position_d_cutoff", _F),
+        ("filter_expressions", _I), ("expression_min_cutoff", _F), ("expression_beta", _F),
+        ("expression_d_cutoff", _F),
+        ("max_extrapolation_seconds", _F),
+    ]
+
+
+class AvmError(RuntimeError):
+    pass
+
+
+def load_library(path):
+    if not path:
+        path = os.environ.get("AVATARMAP_C_LIBRARY") or ctypes.util.find_library("avatarmap_c")
+    if not path:
+        raise AvmError("no library: pass --library PATH or set AVATARMAP_C_LIBRARY")
+    lib = ctypes.CDLL(path)
+    c_int_p = ctypes.POINTER(ctypes.c_int)
+    solver_p = ctypes.c_void_p  # opaque avm_solver*
+    sigs = {
+        "avm_version": (None, [c_int_p, c_int_p, c_int_p]),
+        "avm_version_string": (ctypes.c_char_p, []),
+        "avm_status_string": (ctypes.c_char_p, [ctypes.c_int]),
+        "avm_bone_name": (ctypes.c_char_p, [ctypes.c_int]),
+        "avm_bone_from_name": (ctypes.c_int, [ctypes.c_char_p]),
+        "avm_solver_options_init": (ctypes.c_int, [ctypes.POINTER(AvmSolverOptions)]),
+        "avm_solver_create": (ctypes.c_int, [ctypes.POINTER(AvmSolverOptions),
+                                             ctypes.POINTER(solver_p)]),
+        "avm_last_create_error": (ctypes.c_char_p, []),
+        "avm_solver_destroy": (None, [solver_p]),
+        "avm_solver_push": (ctypes.c_int, [solver_p, ctypes.POINTER(AvmFrame)]),
+        "avm_solver_get_pose": (ctypes.c_int, [solver_p, ctypes.POINTER(AvmPose)]),
+        "avm_solver_sample": (ctypes.c_int, [solver_p, ctypes.c_double,
+                                             ctypes.POINTER(AvmPose)]),
+        "avm_solver_last_error": (ctypes.c_char_p, [solver_p]),
+    }
+    for name, (restype, argtypes) in sigs.items():
+        fn = getattr(lib, name)
+        fn.restype = restype
+        fn.argtypes = argtypes
+    return lib
+
+
+class Solver:
+    """Owns one avm_solver handle; raises AvmError on any non-OK status."""
+
+    def __init__(self, lib, options):
+        self.lib = lib
+        self.handle = ctypes.c_void_p()
+        st = lib.avm_solver_create(ctypes.byref(options), ctypes.byref(self.handle))
+        if st != AVM_OK:
+            raise AvmError("avm_solver_create: %s: %s" % (
+                self._status(st), lib.avm_last_create_error().decode()))
+
+    def _status(self, st):
+        return self.lib.avm_status_string(st).decode()
+
+    def _check(self, st, what):
+        if st != AVM_OK:
+            msg = self.lib.avm_solver_last_error(self.handle).decode()
+            raise AvmError("%s: %s: %s" % (what, self._status(st), msg))
+
+    def push(self, frame):
+        self._check(self.lib.avm_solver_push(self.handle, ctypes.byref(frame)), "push")
+
+    def pose(self):
+        out = AvmPose()
+        self._check(self.lib.avm_solver_get_pose(self.handle, ctypes.byref(out)), "get_pose")
+        return out
+
+    def sample(self, t):
+        out = AvmPose()
+        self._check(self.lib.avm_solver_sample(self.handle, t, ctypes.byref(out)), "sample")
+        return out
+
+    def close(self):
+        if self.handle:
+            self.lib.avm_solver_destroy(self.handle)
+            self.handle = ctypes.c_void_p()
+
+
+# ---- frames -------------------------------------------------------------------------------
+
+# A person facing a non-mirrored camera in a T-pose, MediaPipe world coordinates (metres,
+# origin at the hip midpoint, x toward image right, y down, z away from the camera).
+T_POSE_WORLD = [
+    (0.0, -0.62, -0.10), (0.015, -0.65, -0.08), (0.03, -0.65, -0.08), (0.045, -0.65, -0.07),
+    (-0.015, -0.65, -0.08), (-0.03, -0.65, -0.08), (-0.045, -0.65, -0.07),
+    (0.075, -0.63, 0.0), (-0.075, -0.63, 0.0), (0.025, -0.57, -0.09), (-0.025, -0.57, -0.09),
+    (0.18, -0.50, 0.0), (-0.18, -0.50, 0.0), (0.45, -0.50, 0.0), (-0.45, -0.50, 0.0),
+    (0.70, -0.50, 0.0), (-0.70, -0.50, 0.0), (0.78, -0.50, 0.03), (-0.78, -0.50, 0.03),
+    (0.80, -0.50, -0.02), (-0.80, -0.50, -0.02), (0.75, -0.50, -0.05), (-0.75, -0.50, -0.05),
+    (0.10, 0.0, 0.0), (-0.10, 0.0, 0.0), (0.10, 0.45, 0.0), (-0.10, 0.45, 0.0),
+    (0.10, 0.88, 0.0), (-0.10, 0.88, 0.0), (0.10, 0.92, 0.05), (-0.10, 0.92, 0.05),
+    (0.10, 0.95, -0.12), (-0.10, 0.95, -0.12),
+]
+
+
+def synthetic_frames(count=10, fps=30.0):
+    """The T-pose, turning slowly about the vertical axis (a frame dict per sample)."""
+    frames = []
+    for i in range(count):
+        yaw = 0.03 * i
+        c, s = math.cos(yaw), math.sin(yaw)
+        world = [[c * x + s * z, y, -s * x + c * z, 0.99, 0.99] for x, y, z in T_POSE_WORLD]
+        image = [[0.5 + 0.4 * p[0], 0.5 + 0.4 * p[1], 0.4 * p[2], 0.99, 0.99] for p in world]
+        frames.append({"t": i / fps, "pose": image, "pose_world": world})
+    return frames
+
+
+def read_landmark_file(path):
+    """(header dict or None, iterator of frame dicts) of a *.landmarks.jsonl file."""
+    header = None
+    frames = []
+    with open(path, "r", encoding="utf-8") as f:
+        for number, line in enumerate(f, 1):
+            line = line.strip()
+            if not line:
+                continue
+            try:
+                obj = json.loads(line)
+            except json.JSONDecodeError as e:
+                raise AvmError("%s:%d: %s" % (path, number, e))
+            if number == 1 and obj.get("format") == "avatarmap.landmarks":
+                header = obj
+                continue
+            frames.append(obj)
+    return header, frames
+
+
+PARTS = (("pose", AVM_POSE_LANDMARK_COUNT), ("pose_world", AVM_POSE_LANDMARK_COUNT),
+         ("left_hand", AVM_HAND_LANDMARK_COUNT), ("left_hand_world", AVM_HAND_LANDMARK_COUNT),
+         ("right_hand", AVM_HAND_LANDMARK_COUNT), ("right_hand_world", AVM_HAND_LANDMARK_COUNT),
+         ("face", None))
+
+
+def _num(v):
+    return float("nan") if v is None else float(v)
+
+
+def to_avm_frame(obj):
+    """An AvmFrame plus the arrays it points to (keep both alive while the frame is used)."""
+    frame = AvmFrame()
+    frame.t = float(obj["t"])
+    keep = []
+    for key, count in PARTS:
+        points = obj.get(key)
+        if points is None:
+            continue  # absent part: NULL pointer
+        n = len(points)
+        if count is not None and n != count:
+            raise AvmError("frame t=%s: %s has %d points, expected %d" % (frame.t, key, n, count))
+        if count is None and n not in AVM_FACE_COUNTS:
+            raise AvmError("frame t=%s: face has %d points, expected 468 or 478" % (frame.t, n))
+        array = (AvmLandmark * n)()
+        for i, p in enumerate(points):
+            vals = [_num(v) for v in p] + [1.0] * (5 - len(p))  # hand/face: [x, y, z]
+            array[i] = AvmLandmark(*vals[:5])
+        keep.append(array)
+        setattr(frame, key, ctypes.cast(array, _LandmarkPtr))
+        if key == "face":
+            frame.face_count = n
+    return frame, keep
+
+
+def angle_deg(q):
+    w = min(1.0, abs(q[3]))
+    return math.degrees(2.0 * math.acos(w))
+
+
+def main(argv):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("landmarks", nargs="?", help="*.landmarks.jsonl (default: synthetic)")
+    parser.add_argument("--library", help="path of libavatarmap_c (or AVATARMAP_C_LIBRARY)")
+    parser.add_argument("--mirror", action="store_true", help="mirrored (selfie) input")
+    args = parser.parse_args(argv)
+
+    try:
+        lib = load_library(args.library)
+    except (OSError, AvmError) as e:
+        print("error: cannot load the avatarmap C library: %s" % e, file=sys.stderr)
+        return 1
+    major, minor, patch = ctypes.c_int(), ctypes.c_int(), ctypes.c_int()
+    lib.avm_version(ctypes.byref(major), ctypes.byref(minor), ctypes.byref(patch))
+    print("avatarmap %s (%d.%d.%d)" % (lib.avm_version_string().decode(), major.value,
+                                       minor.value, patch.value))
+
+    solver = None
+    try:
+        options = AvmSolverOptions()
+        if lib.avm_solver_options_init(ctypes.byref(options)) != AVM_OK:
+            raise AvmError("avm_solver_options_init failed")
+        options.struct_size = ctypes.sizeof(AvmSolverOptions)  # what this script knows
+        options.mirror = 1 if args.mirror else 0
+        if args.landmarks:
+            header, frames = read_landmark_file(args.landmarks)
+            if header and header.get("image_size"):
+                options.image_width, options.image_height = map(float, header["image_size"])
+        else:
+            frames = synthetic_frames()
+        solver = Solver(lib, options)
+        hips = lib.avm_bone_from_name(b"hips")
+        max_angle, last_t = 0.0, None
+        for obj in frames:
+            frame, _keep = to_avm_frame(obj)
+            solver.push(frame)
+            pose = solver.pose()
+            q = list(pose.rotations[hips])
+            if not all(math.isfinite(v) for v in q):
+                raise AvmError("non-finite hips rotation at t=%g" % pose.t)
+            max_angle = max(max_angle, angle_deg(q))
+            print("t=%8.4f hips [x y z w] = [% .4f % .4f % .4f % .4f]  position = [% .3f % .3f % .3f]"
+                  % (pose.t, q[0], q[1], q[2], q[3], *pose.hips_position))
+            if last_t is not None:  # a render time between the last two captures
+                mid = solver.sample(0.5 * (last_t + pose.t))
+                if not all(math.isfinite(v) for v in mid.rotations[hips]):
+                    raise AvmError("non-finite sampled hips rotation at t=%g" % mid.t)
+            last_t = pose.t
+        print("summary: %d frame(s), largest hips rotation %.2f deg" % (len(frames), max_angle))
+        return 0
+    except (AvmError, OSError, ValueError, KeyError, TypeError) as e:
+        print("error: %s" % e, file=sys.stderr)
+        return 1
+    finally:
+        if solver is not None:
+            solver.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,73 @@
+// The pluggable landmark estimator: an image in, a landmark frame out. Backends are listed
+// in one table (estimator_backends()); "replay" (recorded landmarks) is always built, so
+// everything downstream is testable without models. The ONNX backend arrives with capture.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "avatarmap/core/status.hpp"
+#include "avatarmap/landmarks/landmark_frame.hpp"
+
+namespace avatarmap {
+
+enum class pixel_format : std::uint8_t { rgb8, bgr8, rgba8, bgra8, gray8 };
+
+/// A view of pixels owned by the caller, valid for the duration of the call. Rows are
+/// `stride_bytes` apart (>= width * bytes per pixel). May be empty (data == nullptr) for
+/// backends that need no pixels (replay).
+struct image_view {
+  const std::uint8_t* data = nullptr;
+  int width = 0;
+  int height = 0;
+  int stride_bytes = 0;
+  pixel_format format = pixel_format::rgb8;
+};
+
+/// Arguments of one estimate() call; a struct so that fields can be added compatibly.
+struct estimate_args {
+  image_view image{};
+  double t = 0.0;  // capture time, seconds
+  bool body = true;
+  bool hands = true;
+  bool face = true;
+};
+
+/// Options given when a backend is created; a struct for the same reason.
+struct estimator_options {
+  std::string source;  // replay: the *.landmarks.jsonl path; onnx: the models folder
+  int threads = 1;
+};
+
+class estimator {
+ public:
+  virtual ~estimator() = default;
+  /// Estimates the landmarks of the frame in `args` into `out` (cleared first). A frame with
+  /// no person is not an error: `out` then has no parts. Errors (a broken file, end of a
+  /// replay) are reported in the status.
+  virtual status estimate(const estimate_args& args, landmark_frame& out) = 0;
+  /// Backend name as listed in estimator_backends().
+  virtual std::string_view name() const = 0;
+};
+
+/// One row of the backend table.
+struct estimator_backend {
+  std::string_view name;
+  std::string_view description;
+  status (*create)(const estimator_options& options, std::unique_ptr<estimator>& out);
+};
+
+/// All backends compiled into this build. The returned span-like pair stays valid forever.
+struct estimator_backend_list {
+  const estimator_backend* items;
+  int count;
+};
+estimator_backend_list estimator_backends();
+
+/// Creates the backend called `name`; the error lists the available names when unknown.
+status create_estimator(std::string_view name, const estimator_options& options,
+                        std::unique_ptr<estimator>& out);
+
+}  // namespace avatarmap

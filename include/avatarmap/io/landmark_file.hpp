@@ -1,0 +1,73 @@
+// Streaming reader and writer of *.landmarks.jsonl (REFERENCE §3, docs/file-formats.md).
+// Constant memory on any file size: one line is held at a time. Errors name the file and
+// line. Writes are atomic: a temporary file beside the target is renamed over it by
+// commit(); a writer destroyed without commit() leaves any existing target untouched.
+#pragma once
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "avatarmap/core/status.hpp"
+#include "avatarmap/landmarks/landmark_frame.hpp"
+
+namespace avatarmap {
+
+/// The optional first line {"format":"avatarmap.landmarks","version":1,...}.
+struct landmark_file_header {
+  bool present = false;  // false when the file has no header line
+  int version = 1;
+  int image_width = 0;  // 0 = not given
+  int image_height = 0;
+  double fps = 0.0;  // 0 = not given
+};
+
+enum class read_result { frame, end, error };
+
+class landmark_reader {
+ public:
+  landmark_reader();
+  ~landmark_reader();
+  landmark_reader(const landmark_reader&) = delete;
+  landmark_reader& operator=(const landmark_reader&) = delete;
+
+  /// Opens `path` ("-" = standard input) and reads the header line if there is one.
+  status open(const std::string& path);
+  /// Reads from a memory buffer (not copied: it must outlive the reader). For tests/fuzzing.
+  status open_memory(const char* data, std::size_t size, const std::string& name = "<memory>");
+
+  const landmark_file_header& header() const;
+
+  /// Reads the next frame into `out` (all parts cleared first). On error, error() says what
+  /// and where ("FILE:LINE: ..."); the reader stays usable: the next call goes on with the
+  /// following line, so a caller may skip bad lines. Blank lines are skipped.
+  read_result next(landmark_frame& out);
+  const std::string& error() const;
+  /// 1-based number of the line last read.
+  long line() const;
+
+ private:
+  struct impl;
+  std::unique_ptr<impl> impl_;
+};
+
+class landmark_writer {
+ public:
+  landmark_writer();
+  ~landmark_writer();
+  landmark_writer(const landmark_writer&) = delete;
+  landmark_writer& operator=(const landmark_writer&) = delete;
+
+  /// Starts writing to a temporary file beside `path` ("-" = standard output, not atomic).
+  status open(const std::string& path, const landmark_file_header& header);
+  /// Writes one frame (only the parts it has). Non-finite numbers are written as null.
+  status write(const landmark_frame& frame);
+  /// Flushes and renames the temporary file over `path`.
+  status commit();
+
+ private:
+  struct impl;
+  std::unique_ptr<impl> impl_;
+};
+
+}  // namespace avatarmap

@@ -1,0 +1,66 @@
+// Streaming reader and writer of *.pose.jsonl (REFERENCE §3, docs/file-formats.md).
+// Quaternions are written [x, y, z, w]; bones are VRM 1.0 names; bones at identity may be
+// omitted when reading (missing bones mean identity). Same error and atomicity rules as
+// landmark_file.hpp.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "avatarmap/core/status.hpp"
+#include "avatarmap/io/landmark_file.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+
+namespace avatarmap {
+
+struct pose_file_header {
+  bool present = false;
+  int version = 1;
+  double fps = 0.0;  // 0 = not given (irregular times)
+};
+
+class pose_reader {
+ public:
+  pose_reader();
+  ~pose_reader();
+  pose_reader(const pose_reader&) = delete;
+  pose_reader& operator=(const pose_reader&) = delete;
+
+  status open(const std::string& path);
+  status open_memory(const char* data, std::size_t size, const std::string& name = "<memory>");
+  const pose_file_header& header() const;
+  /// Reads the next pose (reset to rest first). Unknown bone or expression names are an
+  /// error naming them; quaternions are normalised; a zero or non-finite quaternion is an
+  /// error.
+  read_result next(proxy_pose& out);
+  const std::string& error() const;
+  long line() const;
+
+ private:
+  struct impl;
+  std::unique_ptr<impl> impl_;
+};
+
+struct pose_write_options {
+  bool write_confidence = false;  // adds "confidence": {bone: c} per frame
+  bool skip_identity = false;     // omit bones whose rotation is exactly identity
+};
+
+class pose_writer {
+ public:
+  pose_writer();
+  ~pose_writer();
+  pose_writer(const pose_writer&) = delete;
+  pose_writer& operator=(const pose_writer&) = delete;
+
+  status open(const std::string& path, const pose_file_header& header,
+              const pose_write_options& options = {});
+  status write(const proxy_pose& pose);
+  status commit();
+
+ private:
+  struct impl;
+  std::unique_ptr<impl> impl_;
+};
+
+}  // namespace avatarmap

@@ -1,0 +1,53 @@
+// A pose of the proxy skeleton in VRM 1.0 normalised space: a local rotation per bone
+// (relative to its parent; identity = VRM T-pose), the hips position in metres, expression
+// weights and a per-bone confidence. Fixed-size: never allocates.
+#pragma once
+
+#include <array>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "avatarmap/skeleton/bone.hpp"
+#include "avatarmap/skeleton/expression.hpp"
+
+namespace avatarmap {
+
+/// Default hips height (metres above the soles) used when the legs were never seen.
+inline constexpr float k_default_hips_height = 0.95f;
+
+struct proxy_pose {
+  double t = 0.0;  // seconds
+  /// Hips joint in VRM space, metres: Y above the floor (soles at 0); X and Z from the
+  /// solver's origin (see solver docs).
+  glm::vec3 hips_position{0.f, k_default_hips_height, 0.f};
+  std::array<glm::quat, k_bone_count> rotations;       // local, {w,x,y,z} in GLM's storage
+  std::array<float, k_bone_count> confidence{};        // 0 = not observed .. 1 = observed
+  std::array<float, k_expression_count> expressions{};  // 0 .. 1
+
+  proxy_pose() { set_rest(); }
+
+  /// T-pose: identity rotations, default hips height, zero expressions and confidence.
+  void set_rest() {
+    hips_position = glm::vec3(0.f, k_default_hips_height, 0.f);
+    rotations.fill(glm::quat(1.f, 0.f, 0.f, 0.f));
+    confidence.fill(0.f);
+    expressions.fill(0.f);
+  }
+
+  glm::quat& operator[](bone b) { return rotations[idx(b)]; }
+  const glm::quat& operator[](bone b) const { return rotations[idx(b)]; }
+  float& operator[](expression e) { return expressions[idx(e)]; }
+  float operator[](expression e) const { return expressions[idx(e)]; }
+};
+
+/// World (model-space) rotations of every bone from a pose's local rotations.
+inline void compute_world_rotations(const proxy_pose& pose,
+                                    std::array<glm::quat, k_bone_count>& out_world) {
+  for (int b = 0; b < k_bone_count; ++b) {
+    int p = bone_parent(b);
+    out_world[b] = p == k_no_parent ? pose.rotations[b] : out_world[p] * pose.rotations[b];
+  }
+}
+
+}  // namespace avatarmap

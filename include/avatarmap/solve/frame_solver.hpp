@@ -1,0 +1,91 @@
+// Landmarks -> proxy pose: body, hands, face, confidence gating, hips translation.
+// The solver keeps per-bone state between frames (hysteresis, last good rotation, the
+// translation origin); frames must be fed in capture order. solve() allocates nothing.
+#pragma once
+
+#include <array>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+#include "avatarmap/solve/solver_options.hpp"
+
+namespace avatarmap {
+
+/// One bone's measurement before confidence gating: a world rotation in VRM space and its
+/// confidence (0 = not measured this frame).
+struct bone_measurement {
+  glm::quat world{1.f, 0.f, 0.f, 0.f};
+  float confidence = 0.f;
+};
+
+/// What the solver measured in one frame, before gating (exposed for tests and tools).
+struct frame_measurement {
+  std::array<bone_measurement, k_bone_count> bones{};
+  bool hips_height_valid = false;
+  float hips_height = 0.f;  // metres above the lowest foot point
+  bool hips_ground_valid = false;
+  glm::vec2 hips_ground{0.f};  // X, Z in metres from the camera axis / depth
+  std::array<float, k_expression_count> expressions{};
+  bool expressions_valid = false;
+};
+
+class frame_solver {
+ public:
+  /// Options must satisfy options.validate(); invalid options are replaced by defaults
+  /// (check validate() first to report the error).
+  explicit frame_solver(const solver_options& options = {});
+
+  /// Solves one frame into `out` (out.t = in.t). Input is never modified. Frames with a time
+  /// earlier than the previous one reset the solver's state first. Non-finite landmarks are
+  /// treated as not seen.
+  void solve(const landmark_frame& in, proxy_pose& out);
+
+  /// Measurement only (no gating, no state change): for tests and diagnostics.
+  void measure(const landmark_frame& in, frame_measurement& out) const;
+
+  /// Forgets all state (as if newly constructed with the same options).
+  void reset();
+
+  const solver_options& options() const { return options_; }
+
+ private:
+  struct bone_state {
+    bool tracked = false;
+    bool ever_tracked = false;
+    double lost_at = 0.0;
+    double found_at = -1e9;
+    glm::quat last_good{1.f, 0.f, 0.f, 0.f};
+    glm::quat output{1.f, 0.f, 0.f, 0.f};
+    glm::quat regain_from{1.f, 0.f, 0.f, 0.f};
+  };
+  struct scalar_state {
+    bool tracked = false;
+    bool ever_tracked = false;
+    double lost_at = 0.0;
+    double found_at = -1e9;
+  };
+
+  float gate(scalar_state& s, float confidence, double t) const;
+
+  solver_options options_;
+  std::array<bone_state, k_bone_count> bones_{};
+  std::array<glm::quat, k_bone_count> prev_world_{};
+  scalar_state hips_height_state_{};
+  scalar_state ground_state_{};
+  scalar_state face_state_{};
+  float hips_height_ = 0.f;
+  float hips_height_held_ = 0.f;
+  glm::vec2 ground_{0.f};
+  glm::vec2 ground_origin_{0.f};
+  bool have_origin_ = false;
+  std::array<float, k_expression_count> expressions_held_{};
+  double last_t_ = 0.0;
+  bool started_ = false;
+  bool have_prev_world_ = false;
+  mutable frame_measurement scratch_{};
+};
+
+}  // namespace avatarmap

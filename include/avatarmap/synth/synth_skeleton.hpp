@@ -1,0 +1,71 @@
+// The synthetic ground truth's rest skeleton and its forward kinematics. The skeleton is the
+// independent reference of every solver accuracy test: a proxy_pose (local rotations in VRM
+// normalised space + hips_position) is turned into joint positions here, then into landmarks
+// by landmark_synth (landmark_synth.hpp).
+//
+// Space: VRM (metres, Y up, the avatar faces +Z, avatar's left = +X); rest = VRM T-pose.
+// For every bone, offsets[primary child] == lengths[bone] * bone_rest_direction(bone), so a
+// bone's rest direction (REFERENCE §3) is exactly the direction from its joint to its
+// primary child's joint (leaves: to their tip). Everything here is allocation-free.
+#pragma once
+
+#include <array>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "avatarmap/skeleton/bone.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+
+namespace avatarmap {
+
+/// Height of the reference person the proportion table is written for (metres).
+inline constexpr float k_synth_reference_height = 1.70f;
+
+/// Rest skeleton of a synthetic person. Build with make_synth_skeleton(); the fields are
+/// plain data so that tests can inspect (or deliberately break) them.
+struct synth_skeleton {
+  float height = k_synth_reference_height;  // metres, top of the head above the soles
+  float scale = 1.f;                        // height / k_synth_reference_height
+  /// Rest offset of each bone's joint from its parent's joint (VRM, metres). hips: zero.
+  std::array<glm::vec3, k_bone_count> offsets{};
+  /// Length of each bone along bone_rest_direction(): to its primary child's joint, or to its
+  /// tip for leaves (head, eyes, jaw, distal finger bones, toes). Metres, > 0.
+  std::array<float, k_bone_count> lengths{};
+  /// Heel point in the foot's frame (rest VRM axes, metres from the foot joint), both feet.
+  glm::vec3 heel_offset{0.f, -0.07f, -0.06f};
+};
+
+/// Rest skeleton of a person `height` metres tall (every length of the 1.70 m table scaled
+/// by height / 1.70). `height` must be positive and finite (asserted); 1.70 by default.
+synth_skeleton make_synth_skeleton(float height = k_synth_reference_height);
+
+/// Forward kinematics of one pose: world rotations, joint positions and bone tips (VRM space,
+/// metres). joints[hips] = pose.hips_position; joints[b] = joints[parent] +
+/// world[parent] * offsets[b]; tips[b] = joints[b] + world[b] * (lengths[b] * rest_dir(b)).
+struct synth_fk {
+  std::array<glm::quat, k_bone_count> world{};
+  std::array<glm::vec3, k_bone_count> joints{};
+  std::array<glm::vec3, k_bone_count> tips{};
+  glm::vec3 heels[2]{};  // [0] left, [1] right: foot joint + foot world * heel_offset
+};
+
+/// Fills `out` for `pose` (rotations need not be normalised: they are used as given, so pass
+/// unit quaternions).
+void compute_synth_fk(const synth_skeleton& skeleton, const proxy_pose& pose, synth_fk& out);
+
+/// Joint positions only (VRM, metres), as in synth_fk::joints.
+void joint_world_positions(const synth_skeleton& skeleton, const proxy_pose& pose,
+                           std::array<glm::vec3, k_bone_count>& out_joints);
+
+/// Height of the hips joint above the soles in the rest pose (metres); the sole is the lowest
+/// of the heel and toe-tip points.
+float standing_hips_height(const synth_skeleton& skeleton);
+
+/// Y (VRM, metres) of the lowest heel or toe-tip point of `pose`.
+float lowest_foot_point(const synth_skeleton& skeleton, const proxy_pose& pose);
+
+/// Moves pose.hips_position.y so that the lowest heel or toe-tip point lies at Y = 0.
+void ground_pose(const synth_skeleton& skeleton, proxy_pose& pose);
+
+}  // namespace avatarmap

@@ -1,0 +1,79 @@
+// The table of estimator backends and the replay backend.
+#include "avatarmap/capture/estimator.hpp"
+
+#include "avatarmap/capture/replay_estimator.hpp"
+
+namespace avatarmap {
+
+status replay_estimator::open(const std::string& path, std::unique_ptr<replay_estimator>& out) {
+  out.reset();
+  std::unique_ptr<replay_estimator> r(new replay_estimator());
+  status s = r->reader_.open(path);
+  if (!s.ok()) return s;
+  out = std::move(r);
+  return {};
+}
+
+status replay_estimator::estimate(const estimate_args& args, landmark_frame& out) {
+  if (finished_) return status::error("end of recording");
+  for (;;) {
+    read_result r = reader_.next(out);
+    if (r == read_result::end) {
+      finished_ = true;
+      out.clear();
+      return status::error("end of recording");
+    }
+    if (r == read_result::error) return status::error(reader_.error());
+    break;
+  }
+  if (!args.body) {
+    out.set(frame_part::pose, false);
+    out.set(frame_part::pose_world, false);
+  }
+  if (!args.hands) {
+    out.set(frame_part::left_hand, false);
+    out.set(frame_part::left_hand_world, false);
+    out.set(frame_part::right_hand, false);
+    out.set(frame_part::right_hand_world, false);
+  }
+  if (!args.face) {
+    out.set(frame_part::face, false);
+    out.face_count = 0;
+  }
+  return {};
+}
+
+namespace {
+status create_replay(const estimator_options& options, std::unique_ptr<estimator>& out) {
+  std::unique_ptr<replay_estimator> r;
+  if (options.source.empty())
+    return status::error("replay backend: give the recording (*.landmarks.jsonl) as the source");
+  status s = replay_estimator::open(options.source, r);
+  if (s.ok()) out = std::move(r);
+  return s;
+}
+
+constexpr estimator_backend k_backends[] = {
+    {"replay", "plays a recorded *.landmarks.jsonl file (always built)", &create_replay},
+};
+}  // namespace
+
+estimator_backend_list estimator_backends() {
+  return {k_backends, static_cast<int>(sizeof(k_backends) / sizeof(k_backends[0]))};
+}
+
+status create_estimator(std::string_view name, const estimator_options& options,
+                        std::unique_ptr<estimator>& out) {
+  out.reset();
+  estimator_backend_list list = estimator_backends();
+  std::string names;
+  for (int i = 0; i < list.count; ++i) {
+    if (list.items[i].name == name) return list.items[i].create(options, out);
+    if (!names.empty()) names += ", ";
+    names += list.items[i].name;
+  }
+  return status::error("unknown estimator backend '" + std::string(name) + "' (available: " +
+                       names + ")");
+}
+
+}  // namespace avatarmap

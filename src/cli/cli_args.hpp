@@ -1,0 +1,88 @@
+// A small command-line argument scanner for the avatarmap tool: flags, "--name value" and
+// "--name=value" options, positionals. Errors are messages for the user, never exceptions.
+#pragma once
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace avatarmap::cli {
+
+class args {
+ public:
+  args(int argc, char** argv, int first) {
+    for (int i = first; i < argc; ++i) items_.emplace_back(argv[i]);
+  }
+
+  /// Removes "--name" and returns true when present.
+  bool flag(const std::string& name) {
+    for (size_t i = 0; i < items_.size(); ++i) {
+      if (items_[i] == name) {
+        items_.erase(items_.begin() + static_cast<long>(i));
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /// Removes "--name VALUE" / "--name=VALUE" (or "-s VALUE" for the short alias) and stores the
+  /// value. Returns false when absent; sets error() when the value is missing.
+  bool value(const std::string& name, std::string& out, const std::string& alias = "") {
+    for (size_t i = 0; i < items_.size(); ++i) {
+      const std::string& it = items_[i];
+      if (it == name || (!alias.empty() && it == alias)) {
+        if (i + 1 >= items_.size()) {
+          error_ = "option " + it + " needs a value";
+          items_.erase(items_.begin() + static_cast<long>(i));
+          return false;
+        }
+        out = items_[i + 1];
+        items_.erase(items_.begin() + static_cast<long>(i), items_.begin() + static_cast<long>(i) + 2);
+        return true;
+      }
+      if (it.rfind(name + "=", 0) == 0) {
+        out = it.substr(name.size() + 1);
+        items_.erase(items_.begin() + static_cast<long>(i));
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /// Like value() but parses a finite number; sets error() when it is not one.
+  bool number(const std::string& name, double& out) {
+    std::string s;
+    if (!value(name, s)) return false;
+    char* end = nullptr;
+    double v = std::strtod(s.c_str(), &end);
+    if (s.empty() || *end != '\0' || !(v == v) || v > 1e300 || v < -1e300) {
+      error_ = "option " + name + " needs a number, got '" + s + "'";
+      return false;
+    }
+    out = v;
+    return true;
+  }
+
+  /// What is left after the options were taken; unknown "-x" options are reported by
+  /// check_no_options().
+  const std::vector<std::string>& rest() const { return items_; }
+
+  /// Fails with a message when an unrecognised option is left.
+  bool check_no_options() {
+    for (const std::string& it : items_) {
+      if (it.size() > 1 && it[0] == '-') {
+        error_ = "unknown option " + it + " (see --help)";
+        return false;
+      }
+    }
+    return true;
+  }
+
+  const std::string& error() const { return error_; }
+
+ private:
+  std::vector<std::string> items_;
+  std::string error_;
+};
+
+}  // namespace avatarmap::cli

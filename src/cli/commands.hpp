@@ -1,0 +1,13 @@
+// The avatarmap tool's commands. Each returns the process exit status: 0 success,
+// 1 failure while working (I/O, bad data), 2 wrong usage.
+#pragma once
+
+namespace avatarmap::cli {
+
+int run_solve(int argc, char** argv);
+int run_synth(int argc, char** argv);
+int run_demo(int argc, char** argv);
+int run_import_tfjs(int argc, char** argv);
+int run_backends(int argc, char** argv);
+
+}  // namespace avatarmap::cli

@@ -1,0 +1,54 @@
+// avatarmap: the command-line tool. See `avatarmap --help` and docs/cli.md.
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include <unistd.h>
+
+#include "avatarmap/version.hpp"
+#include "cli/commands.hpp"
+
+namespace {
+
+const char* k_usage =
+    "avatarmap " AVATARMAP_VERSION_STRING
+    " - monocular landmarks to expressive avatar animation\n"
+    "\n"
+    "Usage:\n"
+    "  avatarmap solve IN.landmarks.jsonl -o OUT.pose.jsonl [options]\n"
+    "      Landmarks -> proxy pose (VRM 1.0 bones, hips position, expressions).\n"
+    "  avatarmap synth -o OUT.landmarks.jsonl [--seconds S] [--fps F] [--noise MM] [--seed N]\n"
+    "      Writes a synthetic recording of a scripted motion (ground truth known).\n"
+    "  avatarmap demo [--keep DIR]\n"
+    "      Synthesises a recording, solves it and prints the summary (no input needed).\n"
+    "  avatarmap import-tfjs IMAGE.json WORLD.json --size WxH --fps F -o OUT.landmarks.jsonl\n"
+    "      Converts tfjs-models' reference pose landmarks (pixels + world) to our format.\n"
+    "  avatarmap backends\n"
+    "      Lists the landmark estimator backends in this build.\n"
+    "  avatarmap --version | --help | COMMAND --help\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fputs(k_usage, stderr);
+    return 2;
+  }
+  std::string cmd = argv[1];
+  if (cmd == "--help" || cmd == "-h" || cmd == "help") {
+    std::fputs(k_usage, stdout);
+    return 0;
+  }
+  if (cmd == "--version") {
+    std::printf("avatarmap %s\n", AVATARMAP_VERSION_STRING);
+    return 0;
+  }
+  if (cmd == "solve") return avatarmap::cli::run_solve(argc, argv);
+  if (cmd == "synth") return avatarmap::cli::run_synth(argc, argv);
+  if (cmd == "demo") return avatarmap::cli::run_demo(argc, argv);
+  if (cmd == "import-tfjs") return avatarmap::cli::run_import_tfjs(argc, argv);
+  if (cmd == "backends") return avatarmap::cli::run_backends(argc, argv);
+  std::fprintf(stderr, "avatarmap: unknown command '%s'\n\n%s", cmd.c_str(), k_usage);
+  return 2;
+}

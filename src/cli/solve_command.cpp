@@ -1,0 +1,148 @@
+// `avatarmap solve`: *.landmarks.jsonl -> *.pose.jsonl.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <unistd.h>
+
+#include "avatarmap/io/landmark_file.hpp"
+#include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/solve/frame_solver.hpp"
+#include "avatarmap/time/pose_filter.hpp"
+#include "avatarmap/time/pose_resampler.hpp"
+#include "cli/cli_args.hpp"
+#include "cli/commands.hpp"
+#include "cli/solve_job.hpp"
+
+namespace avatarmap::cli {
+namespace {
+
+const char* k_solve_help =
+    "Usage: avatarmap solve IN.landmarks.jsonl -o OUT.pose.jsonl [options]\n"
+    "\n"
+    "Turns a landmark recording into proxy poses: VRM 1.0 bone rotations {x,y,z,w}, the hips\n"
+    "position in metres and expression weights, one JSON line per frame (docs/file-formats.md).\n"
+    "IN may be '-' for standard input, OUT '-' for standard output. OUT is written atomically.\n"
+    "\n"
+    "Options:\n"
+    "  -o, --output PATH      where to write the poses (required)\n"
+    "  --mirror               mirror the performer (for mirrored webcam recordings)\n"
+    "  --image-size WxH       image size in pixels (default: the file's header; without one,\n"
+    "                         square pixels are assumed and a warning is printed)\n"
+    "  --filter euro|none     One Euro filter on rotations, position and expressions\n"
+    "                         (default: euro)\n"
+    "  --min-cutoff HZ        One Euro cutoff at rest for rotations (default 1.5)\n"
+    "  --beta B               One Euro speed coefficient for rotations (default 0.5)\n"
+    "  --fps N                resample the output at N frames per second (slerp between\n"
+    "                         capture frames); default: one pose per input frame\n"
+    "  --parts LIST           comma list of body,hands,face,root (default: all)\n"
+    "  --fov DEG              camera's horizontal field of view for root motion (default 60)\n"
+    "  --skip-bad-lines       report malformed lines and go on (default: stop at the first)\n"
+    "  --confidence           also write per-bone confidence\n"
+    "  --progress / --quiet   force / silence the progress line (default: when stderr is a\n"
+    "                         terminal)\n";
+
+bool parse_size(const std::string& s, float& w, float& h) {
+  int a = 0, b = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(s.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') ||
+      a <= 0 || b <= 0 || a > 100000 || b > 100000)
+    return false;
+  w = static_cast<float>(a);
+  h = static_cast<float>(b);
+  return true;
+}
+
+}  // namespace
+
+int run_solve(int argc, char** argv) {
+  args a(argc, argv, 2);
+  if (a.flag("--help") || a.flag("-h")) {
+    std::fputs(k_solve_help, stdout);
+    return 0;
+  }
+  solve_job job;
+  std::string value;
+  a.value("--output", job.output, "-o");
+  job.options.mirror = a.flag("--mirror");
+  job.skip_bad_lines = a.flag("--skip-bad-lines");
+  job.write_confidence = a.flag("--confidence");
+  if (a.flag("--progress")) job.progress = progress_mode::on;
+  if (a.flag("--quiet")) job.progress = progress_mode::off;
+  if (a.value("--image-size", value)) {
+    if (!parse_size(value, job.image_width, job.image_height)) {
+      std::fprintf(stderr, "avatarmap solve: --image-size wants WxH in pixels, e.g. 1280x720\n");
+      return 2;
+    }
+  }
+  if (a.value("--filter", value)) {
+    if (value == "none") {
+      job.filter.enabled = false;
+    } else if (value != "euro") {
+      std::fprintf(stderr, "avatarmap solve: --filter is euro or none, got '%s'\n", value.c_str());
+      return 2;
+    }
+  }
+  double num = 0.0;
+  if (a.number("--min-cutoff", num)) job.filter.rotation.min_cutoff = static_cast<float>(num);
+  if (a.number("--beta", num)) job.filter.rotation.beta = static_cast<float>(num);
+  if (a.number("--fps", num)) job.output_fps = num;
+  if (a.number("--fov", num)) job.options.horizontal_fov_degrees = static_cast<float>(num);
+  if (a.value("--parts", value)) {
+    solve_parts p{false, false, false, false};
+    size_t start = 0;
+    while (start <= value.size()) {
+      size_t end = value.find(',', start);
+      std::string part = value.substr(start, end == std::string::npos ? std::string::npos : end - start);
+      if (part == "body") p.body = true;
+      else if (part == "hands") p.hands = true;
+      else if (part == "face") p.face = true;
+      else if (part == "root") p.hips_translation = true;
+      else {
+        std::fprintf(stderr, "avatarmap solve: unknown part '%s' in --parts (body,hands,face,root)\n",
+                     part.c_str());
+        return 2;
+      }
+      if (end == std::string::npos) break;
+      start = end + 1;
+    }
+    job.options.parts = p;
+  }
+  if (!a.error().empty() || !a.check_no_options()) {
+    std::fprintf(stderr, "avatarmap solve: %s\n", a.error().c_str());
+    return 2;
+  }
+  if (a.rest().size() != 1) {
+    std::fprintf(stderr, "avatarmap solve: give exactly one input file (see --help)\n");
+    return 2;
+  }
+  job.input = a.rest()[0];
+  if (job.output.empty()) {
+    std::fprintf(stderr, "avatarmap solve: give the output file with -o OUT.pose.jsonl\n");
+    return 2;
+  }
+  if (job.output_fps != 0.0 && !(job.output_fps > 0.0 && job.output_fps <= 1000.0)) {
+    std::fprintf(stderr, "avatarmap solve: --fps must be in (0, 1000]\n");
+    return 2;
+  }
+  if (!(job.filter.rotation.min_cutoff > 0.f) || !(job.filter.rotation.beta >= 0.f)) {
+    std::fprintf(stderr, "avatarmap solve: --min-cutoff must be > 0 and --beta >= 0\n");
+    return 2;
+  }
+  status st = job.options.validate();
+  if (!st.ok()) {
+    std::fprintf(stderr, "avatarmap solve: %s\n", st.message().c_str());
+    return 2;
+  }
+  solve_summary summary;
+  st = run_solve_job(job, summary);
+  if (!st.ok()) {
+    std::fprintf(stderr, "avatarmap solve: %s\n", st.message().c_str());
+    return 1;
+  }
+  print_summary(job, summary, stderr);
+  return 0;
+}
+
+}  // namespace avatarmap::cli

@@ -1,0 +1,49 @@
+// The solve pipeline shared by `solve` and `demo`: read landmarks, solve, filter, resample,
+// write poses, with progress and a summary.
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+#include "avatarmap/core/status.hpp"
+#include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/solve/solver_options.hpp"
+#include "avatarmap/time/pose_filter.hpp"
+
+namespace avatarmap::cli {
+
+enum class progress_mode { automatic, on, off };
+
+struct solve_job {
+  std::string input;
+  std::string output;
+  solver_options options{};
+  float image_width = 0.f;  // 0 = from the file's header
+  float image_height = 0.f;
+  pose_filter_options filter{};
+  double output_fps = 0.0;  // 0 = one pose per input frame
+  bool skip_bad_lines = false;
+  bool write_confidence = false;
+  progress_mode progress = progress_mode::automatic;
+};
+
+struct solve_summary {
+  long frames = 0;
+  long poses_written = 0;
+  long bad_lines = 0;
+  long part_frames[k_frame_part_count] = {};
+  long face_iris_frames = 0;
+  double t_first = 0.0;
+  double t_last = 0.0;
+  double seconds = 0.0;
+  float image_width = 0.f;
+  float image_height = 0.f;
+  bool image_size_assumed = false;
+  float hips_height_min = 0.f;
+  float hips_height_max = 0.f;
+};
+
+status run_solve_job(const solve_job& job, solve_summary& out);
+void print_summary(const solve_job& job, const solve_summary& s, std::FILE* to);
+
+}  // namespace avatarmap::cli

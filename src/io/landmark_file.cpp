@@ -1,0 +1,429 @@
+// *.landmarks.jsonl reader and writer. The frame parser is a hand-written scanner
+// (io/json_scan.hpp) with std::from_chars numbers; see docs/file-formats.md for the rules.
+#include "avatarmap/io/landmark_file.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <string_view>
+
+#include "io/json_scan.hpp"
+#include "io/jsonl_reader_core.hpp"
+#include "io/text_output.hpp"
+
+namespace avatarmap {
+
+using io_detail::json_cursor;
+using io_detail::line_status;
+
+namespace {
+
+constexpr std::string_view k_landmark_format = "avatarmap.landmarks";
+constexpr int k_supported_version = 1;
+
+// Part from its JSON key, or -1.
+int part_from_key(std::string_view key) {
+  switch (key.size()) {
+    case 4:
+      if (key == "pose") return static_cast<int>(frame_part::pose);
+      if (key == "face") return static_cast<int>(frame_part::face);
+      break;
+    case 9:
+      if (key == "left_hand") return static_cast<int>(frame_part::left_hand);
+      break;
+    case 10:
+      if (key == "pose_world") return static_cast<int>(frame_part::pose_world);
+      if (key == "right_hand") return static_cast<int>(frame_part::right_hand);
+      break;
+    case 15:
+      if (key == "left_hand_world") return static_cast<int>(frame_part::left_hand_world);
+      break;
+    case 16:
+      if (key == "right_hand_world") return static_cast<int>(frame_part::right_hand_world);
+      break;
+    default:
+      break;
+  }
+  return -1;
+}
+
+// Points of part `p` (const or not) and their capacity.
+template <class Frame>
+auto part_storage(Frame& f, frame_part p, int& out_capacity) -> decltype(f.pose.data()) {
+  switch (p) {
+    case frame_part::pose:
+      out_capacity = k_pose_landmark_count;
+      return f.pose.data();
+    case frame_part::pose_world:
+      out_capacity = k_pose_landmark_count;
+      return f.pose_world.data();
+    case frame_part::left_hand:
+      out_capacity = k_hand_landmark_count;
+      return f.left_hand.data();
+    case frame_part::left_hand_world:
+      out_capacity = k_hand_landmark_count;
+      return f.left_hand_world.data();
+    case frame_part::right_hand:
+      out_capacity = k_hand_landmark_count;
+      return f.right_hand.data();
+    case frame_part::right_hand_world:
+      out_capacity = k_hand_landmark_count;
+      return f.right_hand_world.data();
+    case frame_part::face:
+      out_capacity = k_face_mesh_iris_count;
+      return f.face.data();
+  }
+  out_capacity = 0;
+  return nullptr;
+}
+
+// Prefixes a cursor error with where in the frame it happened.
+struct frame_context {
+  std::string_view key;
+  int point = -1;
+};
+
+// Reads one point [x, y, z (, visibility (, presence))] into `out`.
+bool parse_point(json_cursor& c, landmark& out) {
+  if (!c.eat('['))
+    return c.fail_expected("'[' starting a point [x, y, z, visibility, presence]");
+  float v[5];
+  int n = 0;
+  if (!c.eat(']')) {
+    for (;;) {
+      if (n == 5)
+        return c.fail("more than 5 values (expected 3 to 5: x, y, z, visibility, presence)");
+      if (!c.parse_float(v[n])) return false;
+      ++n;
+      if (c.eat(',')) continue;
+      if (c.eat(']')) break;
+      return c.fail_expected("',' or ']' in a point");
+    }
+  }
+  if (n < 3) {
+    return c.fail(std::to_string(n) +
+                  " values (expected 3 to 5: x, y, z, visibility, presence)");
+  }
+  out.x = v[0];
+  out.y = v[1];
+  out.z = v[2];
+  out.visibility = n > 3 ? v[3] : 1.f;
+  out.presence = n > 4 ? v[4] : 1.f;
+  return true;
+}
+
+bool parse_points(json_cursor& c, landmark* storage, int capacity, frame_context& ctx,
+                  int& out_count) {
+  out_count = 0;
+  ctx.point = -1;
+  if (!c.eat('[')) return c.fail_expected("'[' starting an array of points");
+  if (c.eat(']')) return true;
+  landmark overflow;
+  for (;;) {
+    ctx.point = out_count;
+    if (!parse_point(c, out_count < capacity ? storage[out_count] : overflow)) return false;
+    ++out_count;
+    if (c.eat(',')) continue;
+    if (c.eat(']')) break;
+    return c.fail_expected("',' or ']' after a point");
+  }
+  ctx.point = -1;
+  return true;
+}
+
+std::string context_message(const frame_context& ctx, const std::string& error) {
+  if (ctx.key.empty()) return error;
+  std::string m = "in \"";
+  m += ctx.key;
+  m += '"';
+  if (ctx.point >= 0) {
+    m += " point ";
+    m += std::to_string(ctx.point);
+  }
+  m += ": ";
+  m += error;
+  return m;
+}
+
+}  // namespace
+
+// ---- reader --------------------------------------------------------------------------------
+
+struct landmark_reader::impl {
+  io_detail::jsonl_reader_core core;
+  landmark_file_header header;
+  long frame_index = 0;  // frame lines seen (good or bad), for t = index / fps
+  std::string scratch;
+
+  status parse_header(std::string_view line) {
+    json_cursor c(line.data(), line.data() + line.size());
+    bool format_ok = false;
+    std::string problem;
+    bool ok = io_detail::for_each_member(c, scratch, [&](std::string_view key) {
+      if (key == "format") {
+        std::string_view v;
+        std::string s2;
+        if (!c.parse_string(v, s2)) return false;
+        if (v != k_landmark_format) {
+          problem = "wrong format \"" + std::string(v) + "\" (expected \"" +
+                    std::string(k_landmark_format) + "\")";
+          return false;
+        }
+        format_ok = true;
+        return true;
+      }
+      if (key == "version") {
+        double v = 0;
+        if (!c.parse_double(v) || !(v >= 1) || v != std::floor(v)) {
+          problem = "\"version\" must be a positive integer (expected 1)";
+          return false;
+        }
+        if (v > k_supported_version) {
+          problem = "version " + std::to_string(static_cast<long long>(std::min(v, 1e18))) +
+                    " is newer than this reader supports (expected 1); update avatarmap";
+          return false;
+        }
+        header.version = static_cast<int>(v);
+        return true;
+      }
+      if (key == "image_size") {
+        double w = 0, h = 0;
+        if (!c.eat('[') || !c.parse_double(w) || !c.eat(',') || !c.parse_double(h) ||
+            !c.eat(']') || !(w >= 1 && w <= 1e6 && h >= 1 && h <= 1e6) || w != std::floor(w) ||
+            h != std::floor(h)) {
+          problem = "\"image_size\" must be [width, height] in pixels (positive integers)";
+          return false;
+        }
+        header.image_width = static_cast<int>(w);
+        header.image_height = static_cast<int>(h);
+        return true;
+      }
+      if (key == "fps") {
+        double f = 0;
+        bool was_null = false;
+        if (!c.parse_double(f, &was_null) || was_null || !(f >= 0) || !std::isfinite(f)) {
+          problem = "\"fps\" must be a number >= 0 (0 = not given)";
+          return false;
+        }
+        header.fps = f;
+        return true;
+      }
+      return c.skip_value();
+    });
+    if (ok) {
+      c.skip_ws();
+      if (!c.at_end()) ok = c.fail("unexpected text after the header object (expected end of line)");
+    }
+    if (!ok) {
+      return core.error_status("bad header line: " + (problem.empty() ? c.error : problem));
+    }
+    if (!format_ok) return core.error_status("bad header line (expected \"format\")");
+    header.present = true;
+    return {};
+  }
+
+  status after_open(const status& s, std::string_view header_line, bool has_header) {
+    if (!s) return s;
+    if (has_header) return parse_header(header_line);
+    return {};
+  }
+
+  read_result parse_frame(std::string_view line, landmark_frame& out) {
+    out.clear();
+    long index = frame_index++;
+    json_cursor c(line.data(), line.data() + line.size());
+    frame_context ctx;
+    bool has_t = false;
+    bool ok = [&]() {
+      if (!c.eat('{')) return c.fail_expected("'{' (each line must be one JSON object: a frame)");
+      if (c.eat('}')) return true;
+      for (;;) {
+        std::string_view key;
+        if (!c.parse_string(key, scratch)) return false;
+        if (!c.eat(':')) return c.fail_expected("':'");
+        int part = part_from_key(key);
+        if (part >= 0) {
+          ctx.key = frame_part_key(static_cast<frame_part>(part));
+          auto fp = static_cast<frame_part>(part);
+          if (c.eat_null()) {
+            out.set(fp, false);  // null part = not seen, like an absent key
+          } else {
+            int capacity = 0;
+            landmark* storage = part_storage(out, fp, capacity);
+            int count = 0;
+            if (!parse_points(c, storage, capacity, ctx, count)) return false;
+            if (fp == frame_part::face) {
+              if (count != k_face_mesh_count && count != k_face_mesh_iris_count)
+                return c.fail("has " + std::to_string(count) + " points (expected 468 or 478)");
+              out.face_count = count;
+            } else if (count != capacity) {
+              return c.fail("has " + std::to_string(count) + " points (expected " +
+                            std::to_string(capacity) + ")");
+            }
+            out.set(fp, true);
+          }
+          ctx.key = {};
+        } else if (key == "t") {
+          ctx.key = "t";
+          bool was_null = false;
+          if (!c.parse_double(out.t, &was_null)) return false;
+          if (!std::isfinite(out.t)) return c.fail("not a finite number (expected seconds)");
+          has_t = true;
+          ctx.key = {};
+        } else if (key == "format" || key == "version") {
+          return c.fail("header key \"" + std::string(key) +
+                        "\" in a frame (a header is only allowed as the first line)");
+        } else {
+          if (!c.skip_value()) return false;
+        }
+        if (c.eat(',')) continue;
+        if (c.eat('}')) return true;
+        return c.fail_expected("',' or '}' after a member of the frame");
+      }
+    }();
+    if (ok) {
+      c.skip_ws();
+      if (!c.at_end()) ok = c.fail("unexpected text after the frame object (expected end of line)");
+    }
+    if (ok && !has_t) {
+      if (header.fps > 0) {
+        out.t = static_cast<double>(index) / header.fps;
+      } else {
+        core.set_error("missing \"t\" (expected the frame time in seconds; it may only be "
+                       "omitted when the header gives \"fps\")");
+        out.clear();
+        return read_result::error;
+      }
+    }
+    if (!ok) {
+      core.set_error(context_message(ctx, c.error));
+      out.clear();
+      return read_result::error;
+    }
+    return read_result::frame;
+  }
+};
+
+landmark_reader::landmark_reader() : impl_(std::make_unique<impl>()) {}
+landmark_reader::~landmark_reader() = default;
+
+status landmark_reader::open(const std::string& path) {
+  impl_ = std::make_unique<impl>();
+  std::string_view header_line;
+  bool has_header = false;
+  status s = impl_->core.open_file(path, header_line, has_header);
+  return impl_->after_open(s, header_line, has_header);
+}
+
+status landmark_reader::open_memory(const char* data, std::size_t size, const std::string& name) {
+  impl_ = std::make_unique<impl>();
+  std::string_view header_line;
+  bool has_header = false;
+  status s = impl_->core.open_memory(data, size, name, header_line, has_header);
+  return impl_->after_open(s, header_line, has_header);
+}
+
+const landmark_file_header& landmark_reader::header() const { return impl_->header; }
+
+read_result landmark_reader::next(landmark_frame& out) {
+  std::string_view line;
+  switch (impl_->core.next_line(line)) {
+    case line_status::end:
+      out.clear();
+      return read_result::end;
+    case line_status::error:
+      out.clear();
+      return read_result::error;
+    case line_status::line:
+      break;
+  }
+  return impl_->parse_frame(line, out);
+}
+
+const std::string& landmark_reader::error() const { return impl_->core.error(); }
+long landmark_reader::line() const { return impl_->core.line(); }
+
+// ---- writer --------------------------------------------------------------------------------
+
+struct landmark_writer::impl {
+  io_detail::text_output out;
+
+  bool put_points(const landmark* pts, int count, bool always_five) {
+    for (int i = 0; i < count; ++i) {
+      if (!out.reserve(5 * 32 + 8)) return false;
+      const landmark& p = pts[i];
+      out.put(i == 0 ? "[[" : ",[");
+      out.put_number(p.x);
+      out.put(',');
+      out.put_number(p.y);
+      out.put(',');
+      out.put_number(p.z);
+      // Hand and face points are [x, y, z]; visibility/presence are written only when they
+      // differ from the implied 1 so that reading back gives the same frame.
+      if (always_five || p.visibility != 1.f || p.presence != 1.f) {
+        out.put(',');
+        out.put_number(p.visibility);
+        out.put(',');
+        out.put_number(p.presence);
+      }
+      out.put(']');
+    }
+    if (!out.reserve(4)) return false;
+    out.put(count == 0 ? "[]" : "]");
+    return true;
+  }
+};
+
+landmark_writer::landmark_writer() : impl_(std::make_unique<impl>()) {}
+landmark_writer::~landmark_writer() = default;
+
+status landmark_writer::open(const std::string& path, const landmark_file_header& header) {
+  status s = impl_->out.open(path);
+  if (!s) return s;
+  auto& o = impl_->out;
+  o.reserve(256);
+  o.put("{\"format\":\"avatarmap.landmarks\",\"version\":1");
+  if (header.image_width > 0 && header.image_height > 0) {
+    o.put(",\"image_size\":[");
+    o.put_number(header.image_width);
+    o.put(',');
+    o.put_number(header.image_height);
+    o.put(']');
+  }
+  if (header.fps > 0 && std::isfinite(header.fps)) {
+    o.put(",\"fps\":");
+    o.put_number(header.fps);
+  }
+  o.put("}\n");
+  return {};
+}
+
+status landmark_writer::write(const landmark_frame& frame) {
+  auto& o = impl_->out;
+  if (!o.is_open()) return status::error(o.path() + ": write() on a writer that is not open");
+  if (!o.reserve(64)) return status::error(o.error());
+  o.put("{\"t\":");
+  o.put_number(frame.t);
+  for (int p = 0; p < k_frame_part_count; ++p) {
+    auto fp = static_cast<frame_part>(p);
+    if (!frame.has(fp)) continue;
+    int capacity = 0;
+    const landmark* pts = part_storage(frame, fp, capacity);
+    int count = capacity;
+    if (fp == frame_part::face) {
+      count = frame.face_count == k_face_mesh_count ? k_face_mesh_count : k_face_mesh_iris_count;
+    }
+    if (!o.reserve(32)) return status::error(o.error());
+    o.put(",\"");
+    o.put(frame_part_key(fp));
+    o.put("\":");
+    bool five = fp == frame_part::pose || fp == frame_part::pose_world;
+    if (!impl_->put_points(pts, count, five)) return status::error(o.error());
+  }
+  if (!o.reserve(2)) return status::error(o.error());
+  o.put("}\n");
+  return {};
+}
+
+status landmark_writer::commit() { return impl_->out.commit(); }
+
+}  // namespace avatarmap

@@ -1,0 +1,81 @@
+// Internal: buffered, atomic text output for the *.jsonl writers. Data goes to a temporary
+// file `PATH.tmp.XXXXXX` beside the target (so the rename stays on one file system);
+// commit() flushes, fsyncs and renames it over PATH. Destroying an uncommitted output
+// removes the temporary file and leaves PATH untouched. "-" writes to standard output
+// (not atomic; commit() only flushes). Numbers are written with std::to_chars (shortest
+// text that reads back to the same value); non-finite numbers are written as null.
+#pragma once
+
+#include <charconv>
+#include <cmath>
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "avatarmap/core/status.hpp"
+
+namespace avatarmap::io_detail {
+
+class text_output {
+ public:
+  text_output() = default;
+  ~text_output();
+  text_output(const text_output&) = delete;
+  text_output& operator=(const text_output&) = delete;
+
+  status open(const std::string& path);
+  bool is_open() const { return fd_ >= 0; }
+  const std::string& path() const { return path_; }
+
+  /// Makes sure `n` bytes fit in the buffer (flushing first if needed); false on a write
+  /// error (then error() says why). `n` must be at most k_reserve_max.
+  static constexpr std::size_t k_reserve_max = 4096;
+  bool reserve(std::size_t n) {
+    if (pos_ + n <= buf_.size()) return true;
+    return flush();
+  }
+  /// Unchecked appends: call reserve() first.
+  void put(char c) { buf_[pos_++] = c; }
+  void put(std::string_view s) {
+    std::char_traits<char>::copy(buf_.data() + pos_, s.data(), s.size());
+    pos_ += s.size();
+  }
+  void put_number(float v) {
+    if (!std::isfinite(v)) return put("null");
+    pos_ = static_cast<std::size_t>(
+        std::to_chars(buf_.data() + pos_, buf_.data() + buf_.size(), v).ptr - buf_.data());
+  }
+  void put_number(double v) {
+    if (!std::isfinite(v)) return put("null");
+    pos_ = static_cast<std::size_t>(
+        std::to_chars(buf_.data() + pos_, buf_.data() + buf_.size(), v).ptr - buf_.data());
+  }
+  void put_number(int v) {
+    pos_ = static_cast<std::size_t>(
+        std::to_chars(buf_.data() + pos_, buf_.data() + buf_.size(), v).ptr - buf_.data());
+  }
+  /// Appends any length (checked).
+  bool write(std::string_view s);
+
+  /// Writes the buffer out; false on error.
+  bool flush();
+  /// Flush, fsync, rename over the target. After it, the output is closed.
+  status commit();
+  /// Last write error ("PATH: write failed: ...").
+  const std::string& error() const { return error_; }
+
+ private:
+  void discard();
+
+  int fd_ = -1;
+  bool is_stdout_ = false;
+  bool failed_ = false;
+  std::string path_;
+  std::string temp_path_;
+  std::string error_;
+  std::vector<char> buf_;
+  std::size_t pos_ = 0;
+};
+
+}  // namespace avatarmap::io_detail

@@ -1,0 +1,88 @@
+#include "avatarmap/io/tfjs_import.hpp"
+
+#include <fstream>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "avatarmap/io/landmark_file.hpp"
+
+namespace avatarmap {
+
+namespace {
+
+status load_json(const std::string& path, nlohmann::json& out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return status::error(path + ": cannot open for reading");
+  out = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (out.is_discarded()) return status::error(path + ": not valid JSON");
+  if (!out.is_array())
+    return status::error(path + ": expected a JSON array of frames (tfjs-models test format)");
+  return {};
+}
+
+// Reads 33 points of 3 numbers from frame `i` of `doc`.
+status read_frame(const nlohmann::json& doc, std::size_t i, const std::string& path,
+                  double (*out)[3]) {
+  const nlohmann::json& f = doc[i];
+  if (!f.is_array() || f.size() != static_cast<std::size_t>(k_pose_landmark_count))
+    return status::error(path + ": frame " + std::to_string(i) +
+                         ": expected an array of 33 points");
+  for (int k = 0; k < k_pose_landmark_count; ++k) {
+    const nlohmann::json& p = f[static_cast<std::size_t>(k)];
+    if (!p.is_array() || p.size() < 3)
+      return status::error(path + ": frame " + std::to_string(i) + " point " +
+                           std::to_string(k) + ": expected [x, y, z]");
+    for (int c = 0; c < 3; ++c) {
+      const nlohmann::json& v = p[static_cast<std::size_t>(c)];
+      out[k][c] = v.is_number() ? v.get<double>() : std::numeric_limits<double>::quiet_NaN();
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+status import_tfjs_pose(const std::string& image_json, const std::string& world_json,
+                        int image_width, int image_height, double fps,
+                        const std::string& out_landmarks_path) {
+  if (image_width <= 0 || image_height <= 0)
+    return status::error("import_tfjs_pose: image_width and image_height must be > 0");
+  if (!(fps > 0)) return status::error("import_tfjs_pose: fps must be > 0");
+  nlohmann::json image, world;
+  if (status s = load_json(image_json, image); !s) return s;
+  if (status s = load_json(world_json, world); !s) return s;
+  if (image.size() != world.size())
+    return status::error(image_json + " has " + std::to_string(image.size()) + " frames but " +
+                         world_json + " has " + std::to_string(world.size()) +
+                         " (expected the same number)");
+
+  landmark_file_header header;
+  header.present = true;
+  header.image_width = image_width;
+  header.image_height = image_height;
+  header.fps = fps;
+  landmark_writer writer;
+  if (status s = writer.open(out_landmarks_path, header); !s) return s;
+  landmark_frame frame;
+  double img[k_pose_landmark_count][3], wld[k_pose_landmark_count][3];
+  const double w = image_width, h = image_height;
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    if (status s = read_frame(image, i, image_json, img); !s) return s;
+    if (status s = read_frame(world, i, world_json, wld); !s) return s;
+    frame.clear();
+    frame.t = static_cast<double>(i) / fps;
+    for (int k = 0; k < k_pose_landmark_count; ++k) {
+      frame.pose[k] = landmark{static_cast<float>(img[k][0] / w), static_cast<float>(img[k][1] / h),
+                               static_cast<float>(img[k][2] / w), 1.f, 1.f};
+      frame.pose_world[k] = landmark{static_cast<float>(wld[k][0]), static_cast<float>(wld[k][1]),
+                                     static_cast<float>(wld[k][2]), 1.f, 1.f};
+    }
+    frame.set(frame_part::pose, true);
+    frame.set(frame_part::pose_world, true);
+    if (status s = writer.write(frame); !s) return s;
+  }
+  return writer.commit();
+}
+
+}  // namespace avatarmap

@@ -1,0 +1,729 @@
+// Landmarks -> proxy pose. See include/avatarmap/solve/frame_solver.hpp and docs/solver.md.
+#include "avatarmap/solve/frame_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "avatarmap/core/rotation.hpp"
+#include "avatarmap/core/spaces.hpp"
+#include "solve/solve_geometry.hpp"
+
+namespace avatarmap {
+namespace {
+
+using namespace solve_detail;
+
+// ---- input preparation --------------------------------------------------------------------
+
+float landmark_confidence(const landmark& l) {
+  if (!std::isfinite(l.x) || !std::isfinite(l.y) || !std::isfinite(l.z)) return 0.f;
+  float v = std::isfinite(l.visibility) ? l.visibility : 0.f;
+  float p = std::isfinite(l.presence) ? l.presence : 0.f;
+  return glm::clamp(std::min(v, p), 0.f, 1.f);
+}
+
+// Pose points in VRM space after mirroring: metres when from pose_world, else VRM pixels.
+struct body_points {
+  std::array<glm::vec3, k_pose_landmark_count> p;
+  std::array<float, k_pose_landmark_count> c;
+  bool valid = false;
+  bool metric = false;
+};
+
+struct hand_points {
+  std::array<glm::vec3, k_hand_landmark_count> p;
+  float c = 0.f;  // 1 when every point is finite, else 0
+};
+
+// The face mesh points the solver reads, in VRM pixels, sides after mirroring
+// (index 0 = avatar's left).
+struct eye_points {
+  glm::vec3 outer, inner, upper[3], lower[3], iris, brow;
+  bool has_iris = false;
+};
+struct face_points {
+  bool valid = false;
+  glm::vec3 forehead, chin, cheek[2], mouth[2], lip_upper, lip_lower;
+  eye_points eye[2];
+};
+
+struct prepared_frame {
+  body_points body;
+  hand_points hand[2];  // 0 = avatar's left
+  face_points face;
+  float width = 1.f, height = 1.f;
+};
+
+glm::vec3 to_vec(const landmark& l) { return glm::vec3(l.x, l.y, l.z); }
+
+void prepare_body(const landmark_frame& in, const solver_options& o, prepared_frame& f) {
+  body_points& b = f.body;
+  b.valid = false;
+  const bool world = in.has(frame_part::pose_world);
+  if (!world && !in.has(frame_part::pose)) return;
+  const auto& src = world ? in.pose_world : in.pose;
+  for (int i = 0; i < k_pose_landmark_count; ++i) {
+    int s = o.mirror ? pose_mirror_index(i) : i;
+    const landmark& l = src[s];
+    float c = landmark_confidence(l);
+    glm::vec3 v = world ? world_to_vrm(to_vec(l)) : image_to_vrm_pixels(to_vec(l), f.width, f.height);
+    if (!is_finite(v)) {
+      v = glm::vec3(0.f);
+      c = 0.f;
+    }
+    if (o.mirror) v = mirror_x(v);
+    b.p[i] = v;
+    b.c[i] = c;
+  }
+  b.valid = true;
+  b.metric = world;
+}
+
+void prepare_hand(const landmark_frame& in, const solver_options& o, int side, prepared_frame& f) {
+  // side 0 = avatar's left. Without mirroring that is the person's left hand.
+  bool person_left = (side == 0) != o.mirror;
+  frame_part world_part = person_left ? frame_part::left_hand_world : frame_part::right_hand_world;
+  frame_part image_part = person_left ? frame_part::left_hand : frame_part::right_hand;
+  hand_points& h = f.hand[side];
+  h.c = 0.f;
+  const bool world = in.has(world_part);
+  if (!world && !in.has(image_part)) return;
+  const auto& src = world ? (person_left ? in.left_hand_world : in.right_hand_world)
+                          : (person_left ? in.left_hand : in.right_hand);
+  float c = 1.f;
+  for (int i = 0; i < k_hand_landmark_count; ++i) {
+    glm::vec3 v = world ? world_to_vrm(to_vec(src[i]))
+                        : image_to_vrm_pixels(to_vec(src[i]), f.width, f.height);
+    if (!is_finite(v)) {
+      c = 0.f;
+      v = glm::vec3(0.f);
+    }
+    if (o.mirror) v = mirror_x(v);
+    h.p[i] = v;
+  }
+  h.c = c;
+}
+
+void prepare_face(const landmark_frame& in, const solver_options& o, prepared_frame& f) {
+  face_points& fp = f.face;
+  fp.valid = false;
+  if (!in.has(frame_part::face) ||
+      (in.face_count != k_face_mesh_count && in.face_count != k_face_mesh_iris_count))
+    return;
+  bool ok = true;
+  auto get = [&](int i) {
+    glm::vec3 v = image_to_vrm_pixels(to_vec(in.face[i]), f.width, f.height);
+    if (!is_finite(v)) {
+      ok = false;
+      return glm::vec3(0.f);
+    }
+    return o.mirror ? mirror_x(v) : v;
+  };
+  namespace fi = face_index;
+  const int l = o.mirror ? 1 : 0;  // slot of the person's left side
+  const int r = 1 - l;
+  fp.forehead = get(fi::forehead);
+  fp.chin = get(fi::chin);
+  fp.cheek[l] = get(fi::left_cheek);
+  fp.cheek[r] = get(fi::right_cheek);
+  fp.mouth[l] = get(fi::mouth_left);
+  fp.mouth[r] = get(fi::mouth_right);
+  fp.lip_upper = get(fi::upper_lip_inner);
+  fp.lip_lower = get(fi::lower_lip_inner);
+  eye_points& el = fp.eye[l];
+  eye_points& er = fp.eye[r];
+  el.outer = get(fi::left_eye_outer);
+  el.inner = get(fi::left_eye_inner);
+  er.outer = get(fi::right_eye_outer);
+  er.inner = get(fi::right_eye_inner);
+  for (int k = 0; k < 3; ++k) {
+    el.upper[k] = get(fi::left_eye_upper[k]);
+    el.lower[k] = get(fi::left_eye_lower[k]);
+    er.upper[k] = get(fi::right_eye_upper[k]);
+    er.lower[k] = get(fi::right_eye_lower[k]);
+  }
+  el.brow = get(fi::left_brow);
+  er.brow = get(fi::right_brow);
+  el.has_iris = er.has_iris = false;
+  if (in.face_count == k_face_mesh_iris_count) {
+    bool before = ok;
+    el.iris = get(fi::left_iris);
+    er.iris = get(fi::right_iris);
+    el.has_iris = er.has_iris = ok;
+    ok = before;  // a broken iris loses gaze only
+  }
+  fp.valid = ok;
+}
+
+// ---- body ---------------------------------------------------------------------------------
+
+float min_conf(const body_points& b, std::initializer_list<int> ids) {
+  float c = 1.f;
+  for (int i : ids) c = std::min(c, b.c[i]);
+  return c;
+}
+
+void set(frame_measurement& m, bone b, const glm::quat& world, float c) {
+  m.bones[idx(b)].world = world;
+  m.bones[idx(b)].confidence = c;
+}
+
+// Arm of the avatar's left side, in (possibly mirrored) canonical space.
+// `twist_reference` sets the twist of a straight arm (no bend plane): the upper arm's world
+// rotation of the previous frame (temporal coherence), or the shoulder's on the first frame.
+void measure_arm(const glm::vec3& sh, const glm::vec3& el, const glm::vec3& wr,
+                 const glm::quat& twist_reference, glm::quat& out_upper, glm::quat& out_lower) {
+  glm::vec3 d1 = el - sh;
+  glm::vec3 d2 = wr - el;
+  // The elbow is a hinge: the forearm leaves the upper arm toward the upper arm's local +Z.
+  out_upper = aim_with_bend(twist_reference, k_x, k_z, d1, d2, glm::vec3(0.f));
+  out_lower = out_upper * swing_local(out_upper, k_x, d2);
+}
+
+// Leg of the avatar's left side: hip, knee, ankle, heel, toe tip (foot index).
+void measure_leg(const glm::vec3& hip, const glm::vec3& knee, const glm::vec3& ankle,
+                 const glm::vec3& heel, const glm::vec3& toe, bool foot_ok,
+                 const glm::quat& hips_world, glm::quat& out_upper, glm::quat& out_lower,
+                 glm::quat& out_foot) {
+  glm::vec3 d1 = knee - hip;
+  glm::vec3 d2 = ankle - knee;
+  // The knee flexes backward: the shin leaves the thigh toward the thigh's local -Z. For a
+  // straight leg the knee points where the foot points.
+  glm::vec3 forward = foot_ok ? (toe - heel) : glm::vec3(0.f);
+  out_upper = aim_with_bend(hips_world, -k_y, -k_z, d1, d2, -forward);
+  out_lower = out_upper * swing_local(out_upper, -k_y, d2);
+  if (foot_ok) {
+    constexpr glm::vec3 k_foot_rest(0.f, -0.44721360f, 0.89442719f);
+    glm::vec3 dir = toe - ankle;
+    // Heel, ankle and toe span the foot's sagittal plane; its normal is the foot's +X.
+    glm::vec3 lateral = -glm::cross(toe - heel, ankle - heel);
+    out_foot = frame_from_two_vectors(k_foot_rest, k_x, dir, lateral);
+  } else {
+    out_foot = out_lower;
+  }
+}
+
+// Wrist orientation of the avatar's left hand from the 21 hand points: +X along wrist ->
+// middle knuckle, +Z toward the index side (palm faces -Y at rest).
+glm::quat hand_world_from_points(const hand_points& h) {
+  return frame_from_two_vectors(k_x, k_z, h.p[idx(hand_landmark::middle_mcp)] - h.p[0],
+                                h.p[idx(hand_landmark::index_mcp)] -
+                                    h.p[idx(hand_landmark::pinky_mcp)]);
+}
+
+// Thumb rest frame: X along the thumb's rest direction (1, 0, 1)/sqrt2, Y up.
+const glm::quat k_thumb_frame = axis_angle(k_y, -0.25f * k_pi);
+
+// Finger bones of the avatar's left hand (world rotations), given the hand's world rotation.
+void measure_fingers(const hand_points& h, const glm::quat& hand_w, float c, bool left,
+                     frame_measurement& m) {
+  auto emit = [&](int offset, const glm::quat& w) {
+    int first = left ? idx(bone::left_thumb_metacarpal) : idx(bone::right_thumb_metacarpal);
+    bone b = static_cast<bone>(first + offset);
+    set(m, b, left ? w : mirror_x(w), c);
+  };
+  // Thumb: CMC 1, MCP 2, IP 3, tip 4. The metacarpal's twist (opposition) comes from the plane
+  // the thumb bends in; its later joints are hinges in that plane.
+  {
+    const glm::vec3 d = h.p[2] - h.p[1];
+    const glm::vec3 bend_to = h.p[4] - h.p[2];
+    glm::quat rest_frame = hand_w * k_thumb_frame;
+    glm::quat g = aim_with_bend(rest_frame, k_x, -k_y, d, bend_to, glm::vec3(0.f));
+    glm::quat inv_f = glm::inverse(k_thumb_frame);
+    emit(0, g * inv_f);
+    glm::quat hinge1 = finger_hinge(glm::inverse(g) * (h.p[3] - h.p[2]));
+    glm::quat g2 = g * hinge1;
+    emit(1, g2 * inv_f);
+    glm::quat hinge2 = finger_hinge(glm::inverse(g2) * (h.p[4] - h.p[3]));
+    emit(2, g2 * hinge2 * inv_f);
+  }
+  const glm::quat inv_hand = glm::inverse(hand_w);
+  for (int finger = 1; finger < 5; ++finger) {
+    int j = finger_base_landmark(finger);
+    glm::vec3 v = normalize_or(inv_hand * (h.p[j + 1] - h.p[j]), k_x);
+    // Proximal: spread about local Y, then flexion about the hand's lateral axis (Z).
+    float spread = std::asin(glm::clamp(-v.z, -1.f, 1.f));
+    float flex = std::atan2(-v.y, v.x);
+    glm::quat prox = hand_w * axis_angle(k_z, -flex) * axis_angle(k_y, spread);
+    emit(3 * finger, prox);
+    glm::quat mid = prox * finger_hinge(glm::inverse(prox) * (h.p[j + 2] - h.p[j + 1]));
+    emit(3 * finger + 1, mid);
+    glm::quat dist = mid * finger_hinge(glm::inverse(mid) * (h.p[j + 3] - h.p[j + 2]));
+    emit(3 * finger + 2, dist);
+  }
+}
+
+hand_points mirrored(const hand_points& h) {
+  hand_points r = h;
+  for (auto& p : r.p) p = mirror_x(p);
+  return r;
+}
+
+// `prev_world`: the previous frame's output world rotations, or null on the first frame.
+void measure_body(const prepared_frame& f, const solver_options& o,
+                  const std::array<glm::quat, k_bone_count>* prev_world, frame_measurement& m) {
+  const body_points& b = f.body;
+  if (!b.valid || !o.parts.body) return;
+  using pl = pose_landmark;
+  const glm::vec3 hip_l = b.p[idx(pl::left_hip)], hip_r = b.p[idx(pl::right_hip)];
+  const glm::vec3 sh_l = b.p[idx(pl::left_shoulder)], sh_r = b.p[idx(pl::right_shoulder)];
+  const glm::vec3 hip_mid = 0.5f * (hip_l + hip_r);
+  const glm::vec3 up = 0.5f * (sh_l + sh_r) - hip_mid;
+  const float c_torso = min_conf(b, {idx(pl::left_hip), idx(pl::right_hip),
+                                     idx(pl::left_shoulder), idx(pl::right_shoulder)});
+  // Hips: yaw and roll from the hip line; a share of the torso's lean about the hip line.
+  const glm::quat upright = frame_from_two_vectors(k_x, k_y, hip_l - hip_r, k_y);
+  const glm::quat leaning = frame_from_two_vectors(k_x, k_y, hip_l - hip_r, up);
+  const glm::quat hips_w = slerp_shortest(upright, leaning, o.hips_lean_share);
+  // Spine chain: the rest of the way to the shoulder line's frame, split evenly.
+  const glm::quat shoulders_w = frame_from_two_vectors(k_x, k_y, sh_l - sh_r, up);
+  const glm::quat third = quat_fraction(glm::inverse(hips_w) * shoulders_w, 1.f / 3.f);
+  const glm::quat spine_w = hips_w * third;
+  const glm::quat chest_w = spine_w * third;
+  const glm::quat upper_chest_w = chest_w * third;
+  set(m, bone::hips, hips_w, c_torso);
+  set(m, bone::spine, spine_w, c_torso);
+  set(m, bone::chest, chest_w, c_torso);
+  set(m, bone::upper_chest, upper_chest_w, c_torso);
+  // Clavicles are not observable from BlazePose's points: they follow the upper chest.
+  set(m, bone::left_shoulder, upper_chest_w, c_torso);
+  set(m, bone::right_shoulder, upper_chest_w, c_torso);
+
+  for (int side = 0; side < 2; ++side) {
+    const bool left = side == 0;
+    auto P = [&](pl l_id, pl r_id) {
+      glm::vec3 v = b.p[idx(left ? l_id : r_id)];
+      return left ? v : mirror_x(v);
+    };
+    auto C = [&](std::initializer_list<pl> ids_l, std::initializer_list<pl> ids_r) {
+      float c = 1.f;
+      for (pl i : (left ? ids_l : ids_r)) c = std::min(c, b.c[idx(i)]);
+      return c;
+    };
+    auto out = [&](const glm::quat& q) { return left ? q : mirror_x(q); };
+    const glm::quat uc = left ? upper_chest_w : mirror_x(upper_chest_w);
+    const glm::quat hw = left ? hips_w : mirror_x(hips_w);
+
+    glm::quat ua, la;
+    glm::quat twist_ref = uc;
+    if (prev_world) {
+      const glm::quat& p = (*prev_world)[idx(left ? bone::left_upper_arm : bone::right_upper_arm)];
+      twist_ref = left ? p : mirror_x(p);
+    }
+    measure_arm(P(pl::left_shoulder, pl::right_shoulder), P(pl::left_elbow, pl::right_elbow),
+                P(pl::left_wrist, pl::right_wrist), twist_ref, ua, la);
+    float c_ua = C({pl::left_shoulder, pl::left_elbow}, {pl::right_shoulder, pl::right_elbow});
+    float c_la = C({pl::left_elbow, pl::left_wrist}, {pl::right_elbow, pl::right_wrist});
+    set(m, left ? bone::left_upper_arm : bone::right_upper_arm, out(ua), c_ua);
+    set(m, left ? bone::left_lower_arm : bone::right_lower_arm, out(la), c_la);
+    // Coarse wrist orientation from the pose's pinky, index and wrist points; replaced by
+    // the hand landmarks when those are present.
+    if (o.parts.hands) {
+      glm::vec3 wr = P(pl::left_wrist, pl::right_wrist);
+      glm::vec3 pk = P(pl::left_pinky, pl::right_pinky);
+      glm::vec3 ix = P(pl::left_index, pl::right_index);
+      glm::quat hand = frame_from_two_vectors(k_x, k_z, 0.5f * (pk + ix) - wr, ix - pk);
+      float c_h = C({pl::left_wrist, pl::left_pinky, pl::left_index},
+                    {pl::right_wrist, pl::right_pinky, pl::right_index});
+      set(m, left ? bone::left_hand : bone::right_hand, out(hand), 0.999f * c_h);
+    }
+
+    glm::quat ul, ll, foot;
+    const float c_foot = C({pl::left_ankle, pl::left_heel, pl::left_foot_index},
+                           {pl::right_ankle, pl::right_heel, pl::right_foot_index});
+    measure_leg(P(pl::left_hip, pl::right_hip), P(pl::left_knee, pl::right_knee),
+                P(pl::left_ankle, pl::right_ankle), P(pl::left_heel, pl::right_heel),
+                P(pl::left_foot_index, pl::right_foot_index), c_foot > o.confidence.lost_below,
+                hw, ul, ll, foot);
+    set(m, left ? bone::left_upper_leg : bone::right_upper_leg, out(ul),
+        C({pl::left_hip, pl::left_knee}, {pl::right_hip, pl::right_knee}));
+    set(m, left ? bone::left_lower_leg : bone::right_lower_leg, out(ll),
+        C({pl::left_knee, pl::left_ankle}, {pl::right_knee, pl::right_ankle}));
+    set(m, left ? bone::left_foot : bone::right_foot, out(foot), c_foot);
+    set(m, left ? bone::left_toes : bone::right_toes, out(foot), c_foot);
+  }
+}
+
+// Hips height above the floor (lowest foot point) from metric points, and the hips' ground
+// position from the image (weak-perspective scale -> depth).
+void measure_hips_position(const landmark_frame& in, const prepared_frame& f,
+                           const solver_options& o, frame_measurement& m) {
+  const body_points& b = f.body;
+  if (!b.valid || !o.parts.body || !o.parts.hips_translation) return;
+  using pl = pose_landmark;
+  if (b.metric) {
+    float c = min_conf(b, {idx(pl::left_hip), idx(pl::right_hip), idx(pl::left_knee),
+                           idx(pl::right_knee), idx(pl::left_ankle), idx(pl::right_ankle),
+                           idx(pl::left_heel), idx(pl::right_heel), idx(pl::left_foot_index),
+                           idx(pl::right_foot_index)});
+    if (c > o.confidence.lost_below) {
+      float floor_y = b.p[idx(pl::left_ankle)].y;
+      for (int i = idx(pl::left_ankle); i <= idx(pl::right_foot_index); ++i)
+        floor_y = std::min(floor_y, b.p[i].y);
+      glm::vec3 hip_mid = 0.5f * (b.p[idx(pl::left_hip)] + b.p[idx(pl::right_hip)]);
+      m.hips_height = hip_mid.y - floor_y;
+      m.hips_height_valid = std::isfinite(m.hips_height);
+    }
+  }
+  if (!in.has(frame_part::pose) || !in.has(frame_part::pose_world)) return;
+  // Least-squares fit image_px = s * world_xy + t over confident torso and leg points. The
+  // world origin is the hip midpoint, so t is the hip midpoint's pixel position.
+  static constexpr int k_ids[] = {11, 12, 23, 24, 25, 26, 27, 28};
+  glm::vec2 mw(0.f), mi(0.f);
+  int n = 0;
+  for (int i : k_ids) {
+    const landmark& w = in.pose_world[i];
+    const landmark& p = in.pose[i];
+    if (std::min(landmark_confidence(w), landmark_confidence(p)) < o.confidence.found_above)
+      continue;
+    mw += glm::vec2(w.x, w.y);
+    mi += glm::vec2(p.x * f.width, p.y * f.height);
+    ++n;
+  }
+  if (n < 4) return;
+  mw /= float(n);
+  mi /= float(n);
+  float num = 0.f, den = 0.f;
+  for (int i : k_ids) {
+    const landmark& w = in.pose_world[i];
+    const landmark& p = in.pose[i];
+    if (std::min(landmark_confidence(w), landmark_confidence(p)) < o.confidence.found_above)
+      continue;
+    glm::vec2 dw = glm::vec2(w.x, w.y) - mw;
+    glm::vec2 di = glm::vec2(p.x * f.width, p.y * f.height) - mi;
+    num += glm::dot(dw, di);
+    den += glm::dot(dw, dw);
+  }
+  if (!(den > 1e-6f) || !(num > 0.f)) return;
+  const float s = num / den;             // pixels per metre
+  const glm::vec2 t = mi - s * mw;       // hip midpoint in pixels
+  const float focal = 0.5f * f.width / std::tan(0.5f * o.horizontal_fov_degrees * k_deg);
+  const float depth = focal / s;
+  float x = (t.x - 0.5f * f.width) / focal * depth;
+  if (o.mirror) x = -x;
+  m.hips_ground = glm::vec2(x, -depth);
+  m.hips_ground_valid = is_finite(glm::vec3(m.hips_ground, 0.f));
+}
+
+// ---- hands --------------------------------------------------------------------------------
+
+void measure_hands(const prepared_frame& f, const solver_options& o, frame_measurement& m) {
+  if (!o.parts.hands) return;
+  for (int side = 0; side < 2; ++side) {
+    const hand_points& h = f.hand[side];
+    if (h.c <= 0.f) continue;
+    const bool left = side == 0;
+    hand_points hc = left ? h : mirrored(h);
+    glm::quat hand_w = hand_world_from_points(hc);
+    set(m, left ? bone::left_hand : bone::right_hand, left ? hand_w : mirror_x(hand_w), h.c);
+    measure_fingers(hc, hand_w, h.c, left, m);
+  }
+}
+
+// ---- face ---------------------------------------------------------------------------------
+
+// Blink thresholds on the eye's opening ratio (mean lid gap / corner distance).
+constexpr float k_eye_open_ratio = 0.18f;
+constexpr float k_eye_closed_ratio = 0.05f;
+// Iris: rest position along the corner line (from the inner corner) and above it, and the
+// eyeball radius, all as fractions of the eye's width.
+constexpr float k_iris_rest_u = 0.55f;
+constexpr float k_iris_rest_v = 0.06f;
+constexpr float k_eyeball_radius = 0.4f;
+// Mouth: neutral width as a fraction of the cheek-to-cheek width.
+constexpr float k_mouth_neutral_width = 0.05f / 0.14f;
+// Brow height above the upper lid, as a fraction of the eye's width: rest, up, down range.
+constexpr float k_brow_rest = 0.4f;
+constexpr float k_brow_up_range = 0.267f;
+constexpr float k_brow_down_range = 0.167f;
+
+struct viseme_prototype {
+  expression e;
+  float open;   // inner-lip gap / mouth width
+  float width;  // mouth width / neutral width
+};
+constexpr viseme_prototype k_visemes[] = {{expression::aa, 0.60f, 1.00f},
+                                          {expression::ih, 0.20f, 1.10f},
+                                          {expression::ou, 0.25f, 0.72f},
+                                          {expression::ee, 0.25f, 1.22f},
+                                          {expression::oh, 0.45f, 0.80f}};
+
+void measure_face(const prepared_frame& f, const solver_options& o, const glm::quat& upper_chest_w,
+                  frame_measurement& m) {
+  if (!o.parts.face) return;
+  const face_points& fp = f.face;
+  glm::quat head_w;
+  float c_head = 0.f;
+  if (fp.valid) {
+    glm::vec3 lateral = (fp.eye[0].outer - fp.eye[1].outer) + (fp.cheek[0] - fp.cheek[1]);
+    head_w = frame_from_two_vectors(k_x, k_y, lateral, fp.forehead - fp.chin);
+    c_head = 1.f;
+  } else if (f.body.valid) {
+    const body_points& b = f.body;
+    using pl = pose_landmark;
+    glm::vec3 lateral = b.p[idx(pl::left_ear)] - b.p[idx(pl::right_ear)];
+    glm::vec3 up = 0.5f * (b.p[idx(pl::left_eye)] + b.p[idx(pl::right_eye)]) -
+                   0.5f * (b.p[idx(pl::mouth_left)] + b.p[idx(pl::mouth_right)]);
+    head_w = frame_from_two_vectors(k_x, k_y, lateral, up);
+    c_head = min_conf(b, {idx(pl::left_ear), idx(pl::right_ear), idx(pl::left_eye),
+                          idx(pl::right_eye), idx(pl::mouth_left), idx(pl::mouth_right)});
+  }
+  if (c_head > 0.f) {
+    const glm::quat& base = upper_chest_w;
+    glm::quat neck_w = base * quat_fraction(glm::inverse(base) * head_w, 0.5f);
+    set(m, bone::neck, neck_w, c_head);
+    set(m, bone::head, head_w, c_head);
+  }
+  if (!fp.valid) return;
+
+  // Expressions. Distances are 3-D in pixel units, so they hold for any aspect ratio and for
+  // moderate head turns.
+  auto& ex = m.expressions;
+  ex.fill(0.f);
+  const glm::vec3 head_up = head_w * k_y;
+  float closure[2];
+  float yaw_sum = 0.f, pitch_sum = 0.f;
+  int gaze_n = 0;
+  for (int s = 0; s < 2; ++s) {
+    const eye_points& e = fp.eye[s];
+    glm::vec3 across = e.outer - e.inner;
+    float width = glm::length(across);
+    if (!(width > 1e-9f)) {
+      closure[s] = 0.f;
+      continue;
+    }
+    float gap = 0.f;
+    for (int k = 0; k < 3; ++k) gap += glm::length(e.upper[k] - e.lower[k]);
+    float ratio = gap / (3.f * width);
+    closure[s] = glm::clamp((k_eye_open_ratio - ratio) / (k_eye_open_ratio - k_eye_closed_ratio),
+                            0.f, 1.f);
+    glm::vec3 ax = across / width;
+    glm::vec3 up_dir = normalize_or(orth(head_up, ax), k_y);
+    // Brows: height of the brow above the middle of the upper lid.
+    float brow = glm::dot(e.brow - e.upper[1], up_dir) / width;
+    ex[idx(s == 0 ? expression::brow_up_left : expression::brow_up_right)] =
+        glm::clamp((brow - k_brow_rest) / k_brow_up_range, 0.f, 1.f);
+    ex[idx(s == 0 ? expression::brow_down_left : expression::brow_down_right)] =
+        glm::clamp((k_brow_rest - brow) / k_brow_down_range, 0.f, 1.f);
+    if (e.has_iris && closure[s] < 0.7f) {
+      float u = glm::dot(e.iris - e.inner, ax) / width;
+      float v = glm::dot(e.iris - 0.5f * (e.inner + e.outer), up_dir) / width;
+      // The left eye's outer corner is on the avatar's left (+X): moving toward it is a
+      // positive yaw. For the right eye the corner line points the other way.
+      float sy = (u - k_iris_rest_u) / k_eyeball_radius * (s == 0 ? 1.f : -1.f);
+      float sp = (v - k_iris_rest_v) / k_eyeball_radius;
+      yaw_sum += std::asin(glm::clamp(sy, -1.f, 1.f));
+      pitch_sum += std::asin(glm::clamp(sp, -1.f, 1.f));
+      ++gaze_n;
+    }
+  }
+  const float both = std::min(closure[0], closure[1]);
+  ex[idx(expression::blink)] = both;
+  ex[idx(expression::blink_left)] = closure[0] - both;
+  ex[idx(expression::blink_right)] = closure[1] - both;
+  if (gaze_n > 0) {
+    float yaw = glm::clamp(yaw_sum / float(gaze_n), -35.f * k_deg, 35.f * k_deg);
+    float pitch = glm::clamp(pitch_sum / float(gaze_n), -25.f * k_deg, 25.f * k_deg);
+    // Eye bones: yaw about Y (toward +X), then pitch up (a negative turn about X).
+    glm::quat eye_local = axis_angle(k_y, yaw) * axis_angle(k_x, -pitch);
+    set(m, bone::left_eye, head_w * eye_local, 1.f);
+    set(m, bone::right_eye, head_w * eye_local, 1.f);
+    ex[idx(expression::look_left)] = glm::clamp(yaw / (25.f * k_deg), 0.f, 1.f);
+    ex[idx(expression::look_right)] = glm::clamp(-yaw / (25.f * k_deg), 0.f, 1.f);
+    ex[idx(expression::look_up)] = glm::clamp(pitch / (20.f * k_deg), 0.f, 1.f);
+    ex[idx(expression::look_down)] = glm::clamp(-pitch / (20.f * k_deg), 0.f, 1.f);
+  }
+  // Mouth: a point in (openness, width) space, softly assigned to the nearest vowel shape.
+  const float mouth_w = glm::length(fp.mouth[0] - fp.mouth[1]);
+  const float face_w = glm::length(fp.cheek[0] - fp.cheek[1]);
+  if (mouth_w > 1e-9f && face_w > 1e-9f) {
+    float open = glm::length(fp.lip_upper - fp.lip_lower) / mouth_w;
+    float width = (mouth_w / face_w) / k_mouth_neutral_width;
+    auto kernel = [&](float po, float pw) {
+      float dox = (open - po) / 0.6f, dwx = (width - pw) / 0.5f;
+      return std::exp(-(dox * dox + dwx * dwx) / (0.15f * 0.15f));
+    };
+    float total = kernel(0.f, 1.f);  // closed, neutral mouth
+    float k[5];
+    for (int i = 0; i < 5; ++i) total += (k[i] = kernel(k_visemes[i].open, k_visemes[i].width));
+    if (total > 0.f)
+      for (int i = 0; i < 5; ++i) ex[idx(k_visemes[i].e)] = glm::clamp(k[i] / total, 0.f, 1.f);
+  }
+  m.expressions_valid = true;
+}
+
+float smooth01(float x) {
+  x = glm::clamp(x, 0.f, 1.f);
+  return x * x * (3.f - 2.f * x);
+}
+
+}  // namespace
+
+// ---- frame_solver -------------------------------------------------------------------------
+
+frame_solver::frame_solver(const solver_options& options)
+    : options_(options.validate().ok() ? options : solver_options{}) {
+  reset();
+}
+
+void frame_solver::reset() {
+  for (auto& b : bones_) b = bone_state{};
+  prev_world_.fill(identity_quat());
+  hips_height_state_ = scalar_state{};
+  ground_state_ = scalar_state{};
+  face_state_ = scalar_state{};
+  hips_height_ = hips_height_held_ = options_.rest_hips_height;
+  ground_ = ground_origin_ = glm::vec2(0.f);
+  have_origin_ = false;
+  expressions_held_.fill(0.f);
+  last_t_ = 0.0;
+  started_ = false;
+  have_prev_world_ = false;
+}
+
+void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const {
+  for (auto& b : m.bones) b = bone_measurement{};
+  m.hips_height_valid = m.hips_ground_valid = m.expressions_valid = false;
+  m.expressions.fill(0.f);
+  prepared_frame f;
+  if (options_.image_width > 0.f && options_.image_height > 0.f) {
+    f.width = options_.image_width;
+    f.height = options_.image_height;
+  }
+  prepare_body(in, options_, f);
+  prepare_hand(in, options_, 0, f);
+  prepare_hand(in, options_, 1, f);
+  prepare_face(in, options_, f);
+  measure_body(f, options_, have_prev_world_ ? &prev_world_ : nullptr, m);
+  measure_hips_position(in, f, options_, m);
+  measure_hands(f, options_, m);
+  const bone_measurement& uc = m.bones[idx(bone::upper_chest)];
+  const bool have_uc = uc.confidence > 0.f;
+  measure_face(f, options_, have_uc ? uc.world : prev_world_[idx(bone::upper_chest)], m);
+}
+
+float frame_solver::gate(scalar_state& s, float c, double t) const {
+  // Returns the blend weight of the measurement (1 = use it) and updates hysteresis.
+  const confidence_options& co = options_.confidence;
+  if (s.tracked && (c <= 0.f || c < co.lost_below)) {
+    s.tracked = false;
+    s.lost_at = t;
+  } else if (!s.tracked && c > 0.f && c >= co.found_above) {
+    s.tracked = true;
+    s.found_at = s.ever_tracked ? t : -1e9;
+    s.ever_tracked = true;
+  }
+  return s.tracked ? 1.f : 0.f;
+}
+
+void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
+  const double t = std::isfinite(in.t) ? in.t : last_t_;
+  if (started_ && t < last_t_) reset();
+  started_ = true;
+  last_t_ = t;
+  const confidence_options& co = options_.confidence;
+
+  frame_measurement& m = scratch_;
+  measure(in, m);
+
+  // Local rotations of the measurement, relative to the measured parent when there is one,
+  // else to the parent's last output.
+  std::array<glm::quat, k_bone_count> local;
+  local.fill(identity_quat());
+  for (int b = 0; b < k_bone_count; ++b) {
+    int p = bone_parent(b);
+    if (m.bones[b].confidence <= 0.f) continue;
+    glm::quat parent = p == k_no_parent ? identity_quat()
+                       : m.bones[p].confidence > 0.f ? m.bones[p].world
+                                                     : prev_world_[p];
+    local[b] = glm::normalize(glm::inverse(parent) * m.bones[b].world);
+  }
+  // Move a share of the wrist's twist about the forearm into the lower arm.
+  for (int side = 0; side < 2; ++side) {
+    int la = idx(side == 0 ? bone::left_lower_arm : bone::right_lower_arm);
+    int hd = idx(side == 0 ? bone::left_hand : bone::right_hand);
+    if (m.bones[la].confidence <= 0.f || m.bones[hd].confidence <= 0.f) continue;
+    glm::vec3 axis = bone_rest_direction(static_cast<bone>(hd));
+    glm::quat twist = quat_fraction(swing_twist(local[hd], axis).twist, options_.forearm_twist_share);
+    local[la] = glm::normalize(local[la] * twist);
+    local[hd] = glm::normalize(glm::inverse(twist) * local[hd]);
+  }
+
+  // Confidence gating per bone: hold, ease to rest, blend back in.
+  for (int b = 0; b < k_bone_count; ++b) {
+    bone_state& s = bones_[b];
+    const float c = m.bones[b].confidence;
+    if (s.tracked && (c <= 0.f || c < co.lost_below)) {
+      s.tracked = false;
+      s.lost_at = t;
+    } else if (!s.tracked && c > 0.f && c >= co.found_above) {
+      s.tracked = true;
+      s.regain_from = s.output;
+      s.found_at = s.ever_tracked ? t : -1e30;
+      s.ever_tracked = true;
+    }
+    if (s.tracked) {
+      s.last_good = local[b];
+      float k = co.regain_seconds > 0.f ? float((t - s.found_at) / co.regain_seconds) : 1.f;
+      s.output = k >= 1.f ? local[b] : slerp_shortest(s.regain_from, local[b], smooth01(k));
+      out.confidence[b] = c;
+    } else {
+      double age = t - s.lost_at;
+      if (!s.ever_tracked) {
+        s.output = identity_quat();
+      } else if (age <= co.hold_seconds) {
+        s.output = s.last_good;
+      } else {
+        float e = co.ease_seconds > 0.f ? float((age - co.hold_seconds) / co.ease_seconds) : 1.f;
+        s.output = slerp_shortest(s.last_good, identity_quat(), smooth01(e));
+      }
+      out.confidence[b] = 0.f;
+    }
+    out.rotations[b] = s.output;
+  }
+  compute_world_rotations(out, prev_world_);
+  have_prev_world_ = true;
+
+  // Hips height: hold, then ease to the last standing height (or the rest height).
+  {
+    float w = gate(hips_height_state_, m.hips_height_valid ? 1.f : 0.f, t);
+    if (w > 0.f) {
+      hips_height_ = hips_height_held_ = m.hips_height;
+    } else if (hips_height_state_.ever_tracked) {
+      double age = t - hips_height_state_.lost_at;
+      float e = age <= co.hold_seconds ? 0.f
+                : co.ease_seconds > 0.f ? float((age - co.hold_seconds) / co.ease_seconds)
+                                        : 1.f;
+      hips_height_ = glm::mix(hips_height_held_, options_.rest_hips_height, smooth01(e));
+    }
+    // Ground position: relative to where the person was first seen; held while unseen.
+    float g = gate(ground_state_, m.hips_ground_valid ? 1.f : 0.f, t);
+    if (g > 0.f) {
+      if (!have_origin_) {
+        ground_origin_ = m.hips_ground;
+        have_origin_ = true;
+      }
+      ground_ = m.hips_ground - ground_origin_;
+    }
+    out.hips_position = glm::vec3(ground_.x, hips_height_, ground_.y);
+  }
+  // Expressions: held, then eased to 0.
+  {
+    float w = gate(face_state_, m.expressions_valid ? 1.f : 0.f, t);
+    if (w > 0.f) {
+      expressions_held_ = m.expressions;
+      out.expressions = m.expressions;
+    } else {
+      double age = t - face_state_.lost_at;
+      float e = !face_state_.ever_tracked ? 1.f
+                : age <= co.hold_seconds  ? 0.f
+                : co.ease_seconds > 0.f   ? float((age - co.hold_seconds) / co.ease_seconds)
+                                          : 1.f;
+      float k = 1.f - smooth01(e);
+      for (int i = 0; i < k_expression_count; ++i) out.expressions[i] = expressions_held_[i] * k;
+    }
+  }
+  out.t = t;
+}
+
+}  // namespace avatarmap

@@ -1,0 +1,460 @@
+// Pose -> landmark frame generator of the synthetic ground truth. See
+// include/avatarmap/synth/landmark_synth.hpp for the geometry and the output spaces.
+//
+// Face rules (head frame: VRM axes at rest, metres from the head joint, s = skeleton scale):
+// - eye width w = 0.03 s (outer - inner corner); the corner lines are parallel to X.
+// - lids: closure c = min(1, blink + blinkLeft/Right); each upper-lid point and its lower-lid
+//   partner sit (0.22 (1 - c) + 0.02 c) w apart along the head's up axis, symmetric about
+//   the corner line.
+// - mouth: neutral width 0.05 s; blend_visemes() gives (open, width_scale); width =
+//   0.05 s width_scale, inner-lip gap (13 - 14) = open * width; the upper lip takes a quarter
+//   of the opening, the lower lip three quarters.
+// - brows (105/334 and their neighbours): 0.012 s above the open upper lid's middle point,
+//   + 0.008 s browUp, - 0.005 s browDown (weights clamped to [0, 1]).
+// - irises (478 only): rest centre at inner + 0.55 (outer - inner) + 0.06 w up; gaze moves
+//   it by 0.012 s (sin yaw, -sin pitch) along the head's X / Y axes, where
+//   (pitch, yaw) = euler_from_quat(eye bone local rotation, YXZ): positive yaw turns the gaze
+//   toward +X, positive pitch (right-handed about +X) turns it down, so the iris moves down.
+//   Ring points 469-472 / 474-477 = centre + 0.0058 s * (+X, +Y, -X, -Y).
+// - every other index: a deterministic point on the front half of an ellipsoid on the head.
+#include "avatarmap/synth/landmark_synth.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "avatarmap/core/euler.hpp"
+#include "avatarmap/core/rotation.hpp"
+
+namespace avatarmap {
+
+namespace {
+
+// Head-frame geometry at 1.70 m (metres).
+constexpr float k_eye_y = 0.11f;
+constexpr float k_eye_z = 0.088f;
+constexpr float k_eye_inner_x = 0.016f;
+constexpr float k_eye_width = 0.03f;
+constexpr float k_lid_open = 0.22f;    // lid gap / eye width, open
+constexpr float k_lid_closed = 0.02f;  // closed
+constexpr float k_lid_z = 0.003f;      // lids bulge forward over the eyeball
+constexpr float k_lid_fraction[3] = {0.25f, 0.5f, 0.75f};  // from outer to inner corner
+constexpr float k_mouth_y = 0.045f;
+constexpr float k_mouth_z = k_eye_z;  // mouth corners at the eye corners' depth
+constexpr float k_mouth_width = 0.05f;
+constexpr float k_brow_above_lid = 0.012f;
+constexpr float k_brow_up = 0.008f;
+constexpr float k_brow_down = 0.005f;
+constexpr float k_iris_along = 0.55f;
+constexpr float k_iris_above = 0.06f;  // * eye width
+constexpr float k_iris_gaze = 0.012f;
+constexpr float k_iris_radius = 0.0058f;
+
+// Per eye, right side listed; the left side is its mirror image.
+struct eye_indices {
+  int inner, outer, outer2;  // outer2: a second index at the outer corner
+  int upper[3], lower[3];
+  int brow[5];               // outer -> inner
+  int under[3];              // below the lower lid (outer -> inner)
+  int corner_out, corner_in; // points just outside each corner
+  int iris;                  // centre; ring = iris + 1 .. iris + 4
+};
+constexpr eye_indices k_right_eye{133, 130, 33, {160, 159, 158}, {144, 145, 153},
+                                  {70, 63, 105, 66, 107}, {229, 230, 231}, 35, 244, 468};
+constexpr eye_indices k_left_eye{362, 263, 359, {387, 386, 385}, {373, 374, 380},
+                                 {300, 293, 334, 296, 336}, {449, 450, 451}, 265, 464, 473};
+constexpr float k_brow_fraction[5] = {-0.15f, 0.15f, 0.5f, 0.85f, 1.1f};
+constexpr float k_brow_shape[5] = {0.007f, 0.010f, 0.012f, 0.011f, 0.009f};
+
+// Fixed points: right side (x < 0) or the midline; mirrored pairs below.
+struct fixed_point {
+  int index;
+  int mirror;  // -1 on the midline
+  glm::vec3 p;
+};
+const fixed_point k_fixed[] = {
+    {1, -1, {0.f, 0.075f, 0.115f}},     // nose tip
+    {4, -1, {0.f, 0.080f, 0.113f}},     // nose tip (upper)
+    {2, -1, {0.f, 0.063f, 0.103f}},     // below the nose
+    {6, -1, {0.f, 0.110f, 0.098f}},     // nose bridge
+    {168, -1, {0.f, 0.120f, 0.096f}},   // between the brows
+    {10, -1, {0.f, 0.185f, 0.085f}},    // forehead
+    {152, -1, {0.f, 0.000f, 0.085f}},   // chin
+    {234, 454, {-0.07f, 0.09f, 0.035f}},  // cheeks
+    {21, 251, {-0.065f, 0.145f, 0.04f}},  // temples
+    {172, 397, {-0.055f, 0.025f, 0.03f}}, // jaw angles
+    {127, 356, {-0.072f, 0.105f, 0.02f}}, // beside the eyes
+    {93, 323, {-0.068f, 0.065f, 0.03f}},
+    {132, 361, {-0.062f, 0.045f, 0.03f}},
+    {58, 288, {-0.06f, 0.035f, 0.03f}},
+};
+
+void set_eye_rest(std::array<glm::vec3, k_face_mesh_iris_count>& t, const eye_indices& e,
+                  float side, float s) {
+  const float w = k_eye_width * s;
+  const glm::vec3 inner(side * k_eye_inner_x * s, k_eye_y * s, k_eye_z * s);
+  const glm::vec3 outer = inner + glm::vec3(side * w, 0.f, 0.f);
+  t[e.inner] = inner;
+  t[e.outer] = outer;
+  t[e.outer2] = outer;
+  for (int i = 0; i < 3; ++i) {
+    glm::vec3 on_line = outer + k_lid_fraction[i] * (inner - outer);
+    on_line.z += k_lid_z * s;
+    t[e.upper[i]] = on_line + glm::vec3(0.f, 0.5f * k_lid_open * w, 0.f);
+    t[e.lower[i]] = on_line - glm::vec3(0.f, 0.5f * k_lid_open * w, 0.f);
+    glm::vec3 under = outer + k_lid_fraction[i] * (inner - outer);
+    under.y -= 0.010f * s;
+    t[e.under[i]] = under;
+  }
+  const float lid_top = k_eye_y * s + 0.5f * k_lid_open * w;
+  for (int i = 0; i < 5; ++i) {
+    glm::vec3 b = outer + k_brow_fraction[i] * (inner - outer);
+    b.y = lid_top + k_brow_shape[i] * s;
+    b.z = (k_eye_z + 0.006f) * s;
+    t[e.brow[i]] = b;
+  }
+  t[e.corner_out] = outer + glm::vec3(side * 0.004f * s, -0.002f * s, -0.002f * s);
+  t[e.corner_in] = inner + glm::vec3(-side * 0.003f * s, -0.001f * s, 0.f);
+  const glm::vec3 iris = inner + k_iris_along * (outer - inner) +
+                         glm::vec3(0.f, k_iris_above * w, 0.004f * s);
+  t[e.iris] = iris;
+  const float r = k_iris_radius * s;
+  t[e.iris + 1] = iris + glm::vec3(r, 0.f, 0.f);
+  t[e.iris + 2] = iris + glm::vec3(0.f, r, 0.f);
+  t[e.iris + 3] = iris + glm::vec3(-r, 0.f, 0.f);
+  t[e.iris + 4] = iris + glm::vec3(0.f, -r, 0.f);
+}
+
+// Mouth points for a given width and inner-lip gap (metres).
+void set_mouth(std::array<glm::vec3, k_face_mesh_iris_count>& t, float width, float gap,
+               float s) {
+  const float y = k_mouth_y * s;
+  const float h = 0.5f * width;
+  t[61] = glm::vec3(-h, y, k_mouth_z * s);
+  t[291] = glm::vec3(h, y, k_mouth_z * s);
+  t[78] = glm::vec3(-0.9f * h, y, (k_mouth_z + 0.003f) * s);
+  t[308] = glm::vec3(0.9f * h, y, (k_mouth_z + 0.003f) * s);
+  t[13] = glm::vec3(0.f, y + 0.25f * gap, 0.095f * s);
+  t[14] = glm::vec3(0.f, y - 0.75f * gap, 0.095f * s);
+  t[0] = glm::vec3(0.f, y + 0.008f * s + 0.25f * gap, 0.099f * s);
+  t[17] = glm::vec3(0.f, y - 0.010f * s - 0.75f * gap, 0.097f * s);
+}
+
+void build_template(std::array<glm::vec3, k_face_mesh_iris_count>& t, float s) {
+  // Filler: golden-angle spiral on the front half of an ellipsoid around the head.
+  const glm::vec3 centre(0.f, 0.095f, 0.01f);
+  const glm::vec3 radii(0.075f, 0.11f, 0.09f);
+  constexpr float k_golden = 2.39996323f;
+  for (int i = 0; i < k_face_mesh_iris_count; ++i) {
+    float nz = (static_cast<float>(i) + 0.5f) / static_cast<float>(k_face_mesh_iris_count);
+    float r = std::sqrt(std::max(0.f, 1.f - nz * nz));
+    float phi = k_golden * static_cast<float>(i);
+    glm::vec3 n(r * std::cos(phi), r * std::sin(phi), nz);
+    t[i] = (centre + radii * n) * s;
+  }
+  for (const fixed_point& f : k_fixed) {
+    t[f.index] = f.p * s;
+    if (f.mirror >= 0) t[f.mirror] = mirror_x(f.p) * s;
+  }
+  set_eye_rest(t, k_right_eye, -1.f, s);
+  set_eye_rest(t, k_left_eye, 1.f, s);
+  set_mouth(t, k_mouth_width * s, 0.f, s);
+}
+
+float clamp01(float v) { return std::isfinite(v) ? std::min(1.f, std::max(0.f, v)) : 0.f; }
+
+}  // namespace
+
+glm::vec3 face_template_point(int index, float scale) {
+  assert(index >= 0 && index < k_face_mesh_iris_count);
+  std::array<glm::vec3, k_face_mesh_iris_count> t;
+  build_template(t, scale);
+  return t[std::min(std::max(index, 0), k_face_mesh_iris_count - 1)];
+}
+
+synth_viseme_shape blend_visemes(const proxy_pose& pose) {
+  float w[5];
+  float sum = 0.f;
+  for (int i = 0; i < 5; ++i) {
+    w[i] = clamp01(pose.expressions[idx(expression::aa) + i]);
+    sum += w[i];
+  }
+  float norm = sum > 1.f ? 1.f / sum : 1.f;
+  synth_viseme_shape out{0.f, 0.f};
+  float used = 0.f;
+  for (int i = 0; i < 5; ++i) {
+    float wi = w[i] * norm;
+    out.open += wi * k_synth_visemes[i].open;
+    out.width_scale += wi * k_synth_visemes[i].width_scale;
+    used += wi;
+  }
+  out.width_scale += std::max(0.f, 1.f - used);  // neutral (0, 1)
+  return out;
+}
+
+status synth_options::validate() const {
+  if (!(image_width > 0) || !(image_height > 0))
+    return status::error("synth_options.image_width/image_height must be > 0");
+  if (!(horizontal_fov_degrees > 1.f && horizontal_fov_degrees < 179.f))
+    return status::error("synth_options.horizontal_fov_degrees must be in (1, 179)");
+  if (!std::isfinite(camera_position.x) || !std::isfinite(camera_position.y) ||
+      !std::isfinite(camera_position.z))
+    return status::error("synth_options.camera_position must be finite");
+  if (!(person_height > 0.f) || !std::isfinite(person_height))
+    return status::error("synth_options.person_height must be finite and > 0 metres");
+  auto bad_sigma = [](float v) { return !(v >= 0.f) || !std::isfinite(v); };
+  if (bad_sigma(body_noise_sigma) || bad_sigma(hand_noise_sigma) || bad_sigma(face_noise_sigma))
+    return status::error("synth_options.*_noise_sigma must be finite and >= 0 metres");
+  return {};
+}
+
+landmark_synth::landmark_synth(const synth_options& options)
+    : skeleton_(make_synth_skeleton(options.validate().ok() ? options.person_height
+                                                            : k_synth_reference_height)),
+      options_(options) {
+  init();
+}
+
+landmark_synth::landmark_synth(const synth_skeleton& skeleton, const synth_options& options)
+    : skeleton_(skeleton), options_(options) {
+  init();
+}
+
+void landmark_synth::init() {
+  assert(options_.validate().ok());
+  if (!options_.validate().ok()) {
+    synth_options defaults;
+    defaults.person_height = options_.person_height;
+    options_ = defaults;
+  }
+  camera_ = options_.camera_position;
+  if (options_.camera_y_scales_with_height) camera_.y *= skeleton_.scale;
+  const float half_fov = 0.5f * options_.horizontal_fov_degrees * k_pi / 180.f;
+  focal_ = 0.5f * static_cast<float>(options_.image_width) / std::tan(half_fov);
+  build_template(face_template_, skeleton_.scale);
+  reseed(options_.seed);
+}
+
+void landmark_synth::reseed(std::uint32_t seed) {
+  rng_.seed(seed);
+  normal_.reset();
+}
+
+namespace {
+glm::vec3 project_with(const glm::vec3& camera, float focal, float width, float height,
+                       const glm::vec3& p, float z_ref) {
+  const float xc = p.x - camera.x;
+  const float yc = -(p.y - camera.y);
+  const float zc = std::max(camera.z - p.z, 1e-3f);
+  const float zr = std::max(z_ref, 1e-3f);
+  const float u = 0.5f * width + focal * xc / zc;
+  const float v = 0.5f * height + focal * yc / zc;
+  return glm::vec3(u / width, v / height, (zc - zr) * focal / (zr * width));
+}
+
+void put(landmark& l, const glm::vec3& v) {
+  l.x = v.x;
+  l.y = v.y;
+  l.z = v.z;
+  l.visibility = 1.f;
+  l.presence = 1.f;
+}
+
+glm::vec3 to_mediapipe(const glm::vec3& v) { return glm::vec3(v.x, -v.y, -v.z); }
+
+void swap_expressions(proxy_pose& p, expression a, expression b) {
+  std::swap(p.expressions[idx(a)], p.expressions[idx(b)]);
+}
+}  // namespace
+
+glm::vec3 landmark_synth::project(const glm::vec3& vrm_point, float z_ref) const {
+  return project_with(camera_, focal_, static_cast<float>(options_.image_width),
+                      static_cast<float>(options_.image_height), vrm_point, z_ref);
+}
+
+void landmark_synth::add_noise(glm::vec3* points, int count, float sigma) {
+  if (!(sigma > 0.f)) return;
+  for (int i = 0; i < count; ++i) {
+    points[i].x += sigma * normal_(rng_);
+    points[i].y += sigma * normal_(rng_);
+    points[i].z += sigma * normal_(rng_);
+  }
+}
+
+void landmark_synth::build_face(const proxy_pose& pose) {
+  // Deformed head-frame template into points_.face, then to VRM space.
+  std::array<glm::vec3, k_face_mesh_iris_count>& f = points_.face;
+  f = face_template_;
+  const float s = skeleton_.scale;
+  const float w = k_eye_width * s;
+
+  const float blink = pose[expression::blink];
+  const float closure[2] = {clamp01(blink + pose[expression::blink_right]),
+                            clamp01(blink + pose[expression::blink_left])};
+  const float brow[2] = {
+      k_brow_up * s * clamp01(pose[expression::brow_up_right]) -
+          k_brow_down * s * clamp01(pose[expression::brow_down_right]),
+      k_brow_up * s * clamp01(pose[expression::brow_up_left]) -
+          k_brow_down * s * clamp01(pose[expression::brow_down_left])};
+  const bone eye_bones[2] = {bone::right_eye, bone::left_eye};
+  const eye_indices* eyes[2] = {&k_right_eye, &k_left_eye};
+  for (int side = 0; side < 2; ++side) {
+    const eye_indices& e = *eyes[side];
+    const float c = closure[side];
+    const float half_gap = 0.5f * (k_lid_open * (1.f - c) + k_lid_closed * c) * w;
+    const float line_y = face_template_[e.inner].y;
+    for (int i = 0; i < 3; ++i) {
+      f[e.upper[i]].y = line_y + half_gap;
+      f[e.lower[i]].y = line_y - half_gap;
+    }
+    for (int i = 0; i < 5; ++i) f[e.brow[i]].y += brow[side];
+    glm::quat q = glm::normalize(pose[eye_bones[side]]);
+    glm::vec3 pyr = euler_from_quat(q, euler_order::yxz);  // x = pitch, y = yaw
+    glm::vec3 gaze(k_iris_gaze * s * std::sin(pyr.y), -k_iris_gaze * s * std::sin(pyr.x), 0.f);
+    if (!is_finite(gaze)) gaze = glm::vec3(0.f);
+    for (int i = 0; i < 5; ++i) f[e.iris + i] += gaze;
+  }
+  const synth_viseme_shape m = blend_visemes(pose);
+  const float width = k_mouth_width * s * m.width_scale;
+  set_mouth(f, width, m.open * width, s);
+
+  const glm::quat& head = fk_.world[idx(bone::head)];
+  const glm::vec3& origin = fk_.joints[idx(bone::head)];
+  points_.head_joint = origin;
+  for (glm::vec3& p : f) p = origin + head * p;
+}
+
+void landmark_synth::generate(const proxy_pose& pose, landmark_frame& out) {
+  const proxy_pose* p = &pose;
+  glm::vec3 camera = camera_;
+  if (options_.mirror) {
+    for (int b = 0; b < k_bone_count; ++b) {
+      int m = idx(mirror_bone(static_cast<bone>(b)));
+      mirrored_.rotations[m] = mirror_x(pose.rotations[b]);
+      mirrored_.confidence[m] = pose.confidence[b];
+    }
+    mirrored_.t = pose.t;
+    mirrored_.hips_position = mirror_x(pose.hips_position);
+    mirrored_.expressions = pose.expressions;
+    swap_expressions(mirrored_, expression::blink_left, expression::blink_right);
+    swap_expressions(mirrored_, expression::look_left, expression::look_right);
+    swap_expressions(mirrored_, expression::brow_up_left, expression::brow_up_right);
+    swap_expressions(mirrored_, expression::brow_down_left, expression::brow_down_right);
+    p = &mirrored_;
+    camera.x = -camera.x;
+  }
+  compute_synth_fk(skeleton_, *p, fk_);
+
+  out.clear();
+  out.t = pose.t;
+  const float width = static_cast<float>(options_.image_width);
+  const float height = static_cast<float>(options_.image_height);
+  auto project = [&](const glm::vec3& v, float z_ref) {
+    return project_with(camera, focal_, width, height, v, z_ref);
+  };
+  auto depth = [&](const glm::vec3& v) { return camera.z - v.z; };
+
+  const bool want_pose = options_.pose_image || options_.pose_world;
+  const bool want_face = options_.face != synth_face::none;
+  if (want_pose || want_face) build_face(*p);  // the pose's face points need the mouth
+
+  if (want_pose) {
+    std::array<glm::vec3, k_pose_landmark_count>& P = points_.pose;
+    const auto& J = fk_.joints;
+    const glm::quat& head = fk_.world[idx(bone::head)];
+    const glm::vec3& hj = J[idx(bone::head)];
+    const float s = skeleton_.scale;
+    auto head_point = [&](const glm::vec3& local) { return hj + head * local; };
+    // Face points: nose, eye corners (as the mesh) and centres, ears, mouth corners (live).
+    const glm::vec3 eye_centre(0.5f * (face_template_[k_left_eye.inner].x +
+                                       face_template_[k_left_eye.outer].x),
+                               face_template_[k_left_eye.inner].y,
+                               face_template_[k_left_eye.inner].z);
+    const glm::vec3 ear = glm::vec3(0.075f, 0.10f, -0.005f) * s;
+    P[0] = head_point(face_template_[1]);
+    P[1] = head_point(face_template_[k_left_eye.inner]);
+    P[2] = head_point(eye_centre);
+    P[3] = head_point(face_template_[k_left_eye.outer]);
+    P[4] = head_point(face_template_[k_right_eye.inner]);
+    P[5] = head_point(mirror_x(eye_centre));
+    P[6] = head_point(face_template_[k_right_eye.outer]);
+    P[7] = head_point(ear);
+    P[8] = head_point(mirror_x(ear));
+    P[9] = points_.face[291];
+    P[10] = points_.face[61];
+    const bone body[22] = {
+        bone::left_upper_arm,        bone::right_upper_arm,       bone::left_lower_arm,
+        bone::right_lower_arm,       bone::left_hand,             bone::right_hand,
+        bone::left_little_proximal,  bone::right_little_proximal, bone::left_index_proximal,
+        bone::right_index_proximal,  bone::left_thumb_proximal,   bone::right_thumb_proximal,
+        bone::left_upper_leg,        bone::right_upper_leg,       bone::left_lower_leg,
+        bone::right_lower_leg,       bone::left_foot,             bone::right_foot,
+        bone::left_foot,             bone::right_foot,            bone::left_toes,
+        bone::right_toes};
+    for (int i = 0; i < 18; ++i) P[11 + i] = J[idx(body[i])];
+    P[29] = fk_.heels[0];
+    P[30] = fk_.heels[1];
+    P[31] = fk_.tips[idx(bone::left_toes)];
+    P[32] = fk_.tips[idx(bone::right_toes)];
+    add_noise(P.data(), k_pose_landmark_count, options_.body_noise_sigma);
+
+    const glm::vec3 hip_mid = 0.5f * (P[23] + P[24]);
+    if (options_.pose_image) {
+      const float z_ref = depth(hip_mid);
+      for (int i = 0; i < k_pose_landmark_count; ++i) put(out.pose[i], project(P[i], z_ref));
+      out.set(frame_part::pose, true);
+    }
+    if (options_.pose_world) {
+      const glm::vec3 origin = to_mediapipe(hip_mid);
+      for (int i = 0; i < k_pose_landmark_count; ++i)
+        put(out.pose_world[i], to_mediapipe(P[i]) - origin);
+      out.set(frame_part::pose_world, true);
+    }
+  }
+
+  if (options_.hands_image || options_.hands_world) {
+    for (int side = 0; side < 2; ++side) {
+      std::array<glm::vec3, k_hand_landmark_count>& H =
+          side == 0 ? points_.left_hand : points_.right_hand;
+      const int hand = idx(side == 0 ? bone::left_hand : bone::right_hand);
+      const int first = idx(side == 0 ? bone::left_thumb_metacarpal : bone::right_thumb_metacarpal);
+      H[0] = fk_.joints[hand];
+      for (int finger = 0; finger < 5; ++finger) {
+        const int b = first + 3 * finger;
+        const int l = finger_base_landmark(finger);
+        H[l] = fk_.joints[b];
+        H[l + 1] = fk_.joints[b + 1];
+        H[l + 2] = fk_.joints[b + 2];
+        H[l + 3] = fk_.tips[b + 2];
+      }
+      add_noise(H.data(), k_hand_landmark_count, options_.hand_noise_sigma);
+      std::array<landmark, k_hand_landmark_count>& img = side == 0 ? out.left_hand : out.right_hand;
+      std::array<landmark, k_hand_landmark_count>& wld =
+          side == 0 ? out.left_hand_world : out.right_hand_world;
+      if (options_.hands_image) {
+        const float z_ref = depth(H[0]);
+        for (int i = 0; i < k_hand_landmark_count; ++i) put(img[i], project(H[i], z_ref));
+        out.set(side == 0 ? frame_part::left_hand : frame_part::right_hand, true);
+      }
+      if (options_.hands_world) {
+        const glm::vec3 centre =
+            to_mediapipe((H[0] + H[5] + H[9] + H[13] + H[17]) * 0.2f);
+        for (int i = 0; i < k_hand_landmark_count; ++i)
+          put(wld[i], to_mediapipe(H[i]) - centre);
+        out.set(side == 0 ? frame_part::left_hand_world : frame_part::right_hand_world, true);
+      }
+    }
+  }
+
+  if (want_face) {
+    const int count =
+        options_.face == synth_face::mesh_478 ? k_face_mesh_iris_count : k_face_mesh_count;
+    add_noise(points_.face.data(), count, options_.face_noise_sigma);
+    const float z_ref = depth(points_.head_joint);
+    for (int i = 0; i < count; ++i) put(out.face[i], project(points_.face[i], z_ref));
+    out.face_count = count;
+    out.set(frame_part::face, true);
+  }
+}
+
+}  // namespace avatarmap

@@ -1,0 +1,19 @@
+# Checks that the C API shared library exports the avm_* functions and no avatarmap C++ symbol.
+# Usage: cmake -DLIB=<path to libavatarmap_c.so> -DNM=<nm> -P check_exports.cmake
+execute_process(COMMAND ${NM} -D --defined-only ${LIB} OUTPUT_VARIABLE symbols
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${NM} failed on ${LIB}")
+endif()
+foreach(fn avm_version avm_solver_create avm_solver_push avm_solver_sample avm_solve_file
+           avm_bone_name avm_last_create_error)
+  if(NOT symbols MATCHES " ${fn}\n")
+    message(FATAL_ERROR "${LIB} does not export ${fn}")
+  endif()
+endforeach()
+# Mangled names of the core live in namespace avatarmap: "...9avatarmap...".
+string(REGEX MATCHALL "[^\n]*9avatarmap[^\n]*" leaked "${symbols}")
+if(leaked)
+  string(REPLACE ";" "\n" leaked "${leaked}")
+  message(FATAL_ERROR "${LIB} exports C++ symbols of the core:\n${leaked}")
+endif()
