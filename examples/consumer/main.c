@@ -1,8 +1,7 @@
 /* Consumer of the C API: create a solver, push an empty frame, read the pose. */
+#include <avatarmap/avatarmap.h>
 #include <stdio.h>
 #include <string.h>
-
-#include <avatarmap/avatarmap.h>
 
 int main(void) {
   avm_solver* solver = NULL;
@@ -18,8 +17,7 @@ int main(void) {
   }
   st = avm_solver_create(NULL, &solver);
   if (st != AVM_OK) {
-    fprintf(stderr, "avm_solver_create: %s: %s\n", avm_status_string(st),
-            avm_last_create_error());
+    fprintf(stderr, "avm_solver_create: %s: %s\n", avm_status_string(st), avm_last_create_error());
     return 1;
   }
   memset(&frame, 0, sizeof frame); /* every part NULL: nothing seen */

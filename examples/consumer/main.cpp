@@ -1,10 +1,9 @@
 // Consumer of the C++ library: solve one empty frame (nothing seen) and print the hips.
-#include <cstdio>
-#include <memory>
-
 #include <avatarmap/core/rotation.hpp>
 #include <avatarmap/solve/frame_solver.hpp>
 #include <avatarmap/version.hpp>
+#include <cstdio>
+#include <memory>
 
 int main() {
   namespace am = avatarmap;

@@ -114,8 +114,8 @@ bool json_cursor::parse_special(double& out, bool* was_null, bool as_float) {
     out = -std::numeric_limits<double>::infinity();
     return true;
   }
-  if (p < end && ((*p >= '0' && *p <= '9') || (*p == '-' && p + 1 < end && p[1] >= '0' &&
-                                               p[1] <= '9'))) {
+  if (p < end &&
+      ((*p >= '0' && *p <= '9') || (*p == '-' && p + 1 < end && p[1] >= '0' && p[1] <= '9'))) {
     std::from_chars_result r;
     if (as_float) {
       float f = 0.f;
@@ -206,14 +206,30 @@ bool json_cursor::parse_string(std::string_view& out, std::string& scratch) {
     if (++p >= end) break;
     char e = *p++;
     switch (e) {
-      case '"': scratch += '"'; break;
-      case '\\': scratch += '\\'; break;
-      case '/': scratch += '/'; break;
-      case 'b': scratch += '\b'; break;
-      case 'f': scratch += '\f'; break;
-      case 'n': scratch += '\n'; break;
-      case 'r': scratch += '\r'; break;
-      case 't': scratch += '\t'; break;
+      case '"':
+        scratch += '"';
+        break;
+      case '\\':
+        scratch += '\\';
+        break;
+      case '/':
+        scratch += '/';
+        break;
+      case 'b':
+        scratch += '\b';
+        break;
+      case 'f':
+        scratch += '\f';
+        break;
+      case 'n':
+        scratch += '\n';
+        break;
+      case 'r':
+        scratch += '\r';
+        break;
+      case 't':
+        scratch += '\t';
+        break;
       case 'u': {
         auto read4 = [this](unsigned& v) {
           if (end - p < 4) return false;
@@ -243,7 +259,8 @@ bool json_cursor::parse_string(std::string_view& out, std::string& scratch) {
       }
       default:
         --p;
-        return fail("bad escape in a string (expected one of \\\" \\\\ \\/ \\b \\f \\n \\r \\t \\u)");
+        return fail(
+            "bad escape in a string (expected one of \\\" \\\\ \\/ \\b \\f \\n \\r \\t \\u)");
     }
   }
   return fail("unterminated string (expected '\"' before the end of the line)");

@@ -27,8 +27,7 @@ status jsonl_reader_core::open_file(const std::string& path, std::string_view& o
   return after_open(out_header_line, out_has_header);
 }
 
-status jsonl_reader_core::open_memory(const char* data, std::size_t size,
-                                      const std::string& name,
+status jsonl_reader_core::open_memory(const char* data, std::size_t size, const std::string& name,
                                       std::string_view& out_header_line, bool& out_has_header) {
   name_ = name;
   src_.open_memory(data, size);

@@ -84,8 +84,7 @@ struct frame_context {
 
 // Reads one point [x, y, z (, visibility (, presence))] into `out`.
 bool parse_point(json_cursor& c, landmark& out) {
-  if (!c.eat('['))
-    return c.fail_expected("'[' starting a point [x, y, z, visibility, presence]");
+  if (!c.eat('[')) return c.fail_expected("'[' starting a point [x, y, z, visibility, presence]");
   float v[5];
   int n = 0;
   if (!c.eat(']')) {
@@ -100,8 +99,7 @@ bool parse_point(json_cursor& c, landmark& out) {
     }
   }
   if (n < 3) {
-    return c.fail(std::to_string(n) +
-                  " values (expected 3 to 5: x, y, z, visibility, presence)");
+    return c.fail(std::to_string(n) + " values (expected 3 to 5: x, y, z, visibility, presence)");
   }
   out.x = v[0];
   out.y = v[1];
@@ -187,8 +185,8 @@ struct landmark_reader::impl {
       }
       if (key == "image_size") {
         double w = 0, h = 0;
-        if (!c.eat('[') || !c.parse_double(w) || !c.eat(',') || !c.parse_double(h) ||
-            !c.eat(']') || !(w >= 1 && w <= 1e6 && h >= 1 && h <= 1e6) || w != std::floor(w) ||
+        if (!c.eat('[') || !c.parse_double(w) || !c.eat(',') || !c.parse_double(h) || !c.eat(']') ||
+            !(w >= 1 && w <= 1e6 && h >= 1 && h <= 1e6) || w != std::floor(w) ||
             h != std::floor(h)) {
           problem = "\"image_size\" must be [width, height] in pixels (positive integers)";
           return false;
@@ -211,7 +209,8 @@ struct landmark_reader::impl {
     });
     if (ok) {
       c.skip_ws();
-      if (!c.at_end()) ok = c.fail("unexpected text after the header object (expected end of line)");
+      if (!c.at_end())
+        ok = c.fail("unexpected text after the header object (expected end of line)");
     }
     if (!ok) {
       return core.error_status("bad header line: " + (problem.empty() ? c.error : problem));
@@ -288,8 +287,9 @@ struct landmark_reader::impl {
       if (header.fps > 0) {
         out.t = static_cast<double>(index) / header.fps;
       } else {
-        core.set_error("missing \"t\" (expected the frame time in seconds; it may only be "
-                       "omitted when the header gives \"fps\")");
+        core.set_error(
+            "missing \"t\" (expected the frame time in seconds; it may only be "
+            "omitted when the header gives \"fps\")");
         out.clear();
         return read_result::error;
       }

@@ -35,7 +35,17 @@ bool line_source::open_file(const std::string& path, std::string& out_error) {
   return true;
 }
 
+void line_source::open_stream(std::FILE* file, bool owns) {
+  const line_source_limits& lim = default_line_source_limits();
+  block_size_ = lim.block_size > 0 ? lim.block_size : 1;
+  max_line_ = lim.max_line;
+  file_ = file;
+  owns_file_ = owns;
+  buf_.resize(block_size_);
+}
+
 void line_source::open_memory(const char* data, std::size_t size) {
+  max_line_ = default_line_source_limits().max_line;
   memory_mode_ = true;
   mem_ = data;
   mem_size_ = size;
@@ -70,21 +80,19 @@ line_status line_source::next(std::string_view& out_line, std::string& out_error
     if (mem_pos_ >= mem_size_) return line_status::end;
     const char* b = mem_ + mem_pos_;
     std::size_t left = mem_size_ - mem_pos_;
-    if (first_) {
-      first_ = false;
-      if (left >= 3 && std::memcmp(b, "\xEF\xBB\xBF", 3) == 0) {
-        b += 3;
-        left -= 3;
-        mem_pos_ += 3;
-      }
-    }
     const char* nl = static_cast<const char*>(std::memchr(b, '\n', left));
     std::size_t len = nl ? static_cast<std::size_t>(nl - b) : left;
     mem_pos_ += nl ? len + 1 : len;
     ++line_;
+    bool first = first_;
+    first_ = false;
     if (len > max_line_) {
       out_error = "line longer than " + std::to_string(max_line_) + " bytes (the limit)";
       return line_status::error;
+    }
+    if (first && len >= 3 && std::memcmp(b, "\xEF\xBB\xBF", 3) == 0) {
+      b += 3;
+      len -= 3;
     }
     if (len > 0 && b[len - 1] == '\r') --len;
     out_line = std::string_view(b, len);
@@ -96,15 +104,17 @@ line_status line_source::next(std::string_view& out_line, std::string& out_error
   for (;;) {
     const char* base = buf_.data() + begin_;
     std::size_t avail = end_ - begin_;
-    const char* nl = scanned_ < avail ? static_cast<const char*>(std::memchr(
-                                            base + scanned_, '\n', avail - scanned_))
-                                      : nullptr;
+    const char* nl =
+        scanned_ < avail
+            ? static_cast<const char*>(std::memchr(base + scanned_, '\n', avail - scanned_))
+            : nullptr;
     if (nl || (eof_ && avail > 0) || (too_long && eof_)) {
       std::size_t len = nl ? static_cast<std::size_t>(nl - base) : avail;
       begin_ += nl ? len + 1 : len;
       scanned_ = 0;
       ++line_;
-      if (too_long) {
+      if (too_long || len > max_line_) {
+        first_ = false;
         out_error = "line longer than " + std::to_string(max_line_) + " bytes (the limit)";
         return line_status::error;
       }

@@ -35,6 +35,8 @@ class line_source {
 
   /// Opens `path` ("-" = standard input). On failure returns false and sets `out_error`.
   bool open_file(const std::string& path, std::string& out_error);
+  /// Reads from an open stream (closed by the destructor when `owns`). For fuzzing.
+  void open_stream(std::FILE* file, bool owns);
   /// Reads from memory (not copied).
   void open_memory(const char* data, std::size_t size);
 

@@ -43,8 +43,8 @@ bool parse_fixed_array(json_cursor& c, float* out, int n, const std::string& wha
     bool was_null = false;
     if (!c.parse_float(out[i], &was_null)) return false;
     if (!std::isfinite(out[i]))
-      return c.fail(what + " has a " + (was_null ? "null" : "non-finite") +
-                    " value (expected " + expected + ")");
+      return c.fail(what + " has a " + (was_null ? "null" : "non-finite") + " value (expected " +
+                    expected + ")");
   }
   if (!c.eat(']')) return c.fail(what + " has too many values (expected " + expected + ")");
   return true;
@@ -54,8 +54,8 @@ bool parse_finite(json_cursor& c, float& out, const std::string& what, const cha
   bool was_null = false;
   if (!c.parse_float(out, &was_null)) return false;
   if (!std::isfinite(out))
-    return c.fail(what + " is " + (was_null ? "null" : "not finite") + " (expected " +
-                  expected + ")");
+    return c.fail(what + " is " + (was_null ? "null" : "not finite") + " (expected " + expected +
+                  ")");
   return true;
 }
 
@@ -78,8 +78,8 @@ struct pose_reader::impl {
         std::string_view v;
         if (!c.parse_string(v, scratch2)) return false;
         if (v != k_pose_format) {
-          problem = "wrong format " + quoted(v) + " (expected \"" + std::string(k_pose_format) +
-                    "\")";
+          problem =
+              "wrong format " + quoted(v) + " (expected \"" + std::string(k_pose_format) + "\")";
           return false;
         }
         format_ok = true;
@@ -138,11 +138,12 @@ struct pose_reader::impl {
       std::string what = "bone \"" + std::string(bone_name(*b)) + "\"";
       float v[4];
       if (!parse_fixed_array(c, v, 4, what, "4 finite numbers [x, y, z, w]")) return false;
-      double n2 = double(v[0]) * v[0] + double(v[1]) * v[1] + double(v[2]) * v[2] +
-                  double(v[3]) * v[3];
+      double n2 =
+          double(v[0]) * v[0] + double(v[1]) * v[1] + double(v[2]) * v[2] + double(v[3]) * v[3];
       if (!(n2 > 1e-24))
-        return c.fail(what + " is a zero quaternion (expected a rotation [x, y, z, w] of "
-                             "non-zero length)");
+        return c.fail(what +
+                      " is a zero quaternion (expected a rotation [x, y, z, w] of "
+                      "non-zero length)");
       // A quaternion already unit to float precision is kept bit for bit, so that a file
       // written by pose_writer reads back exactly.
       if (std::abs(n2 - 1.0) > 4.0 * std::numeric_limits<float>::epsilon()) {
@@ -232,8 +233,9 @@ struct pose_reader::impl {
       if (header.fps > 0) {
         out.t = static_cast<double>(index) / header.fps;
       } else {
-        core.set_error("missing \"t\" (expected the frame time in seconds; it may only be "
-                       "omitted when the header gives \"fps\")");
+        core.set_error(
+            "missing \"t\" (expected the frame time in seconds; it may only be "
+            "omitted when the header gives \"fps\")");
         out.set_rest();
         return read_result::error;
       }

@@ -44,8 +44,8 @@ status text_output::open(const std::string& path) {
   name.push_back('\0');
   int fd = ::mkstemp(name.data());
   if (fd < 0)
-    return status::error(path + ": cannot create a temporary file beside it: " +
-                         std::strerror(errno));
+    return status::error(path +
+                         ": cannot create a temporary file beside it: " + std::strerror(errno));
   // mkstemp creates the file 0600; give the result the mode of the file it replaces, or
   // the usual 0644 for a new file.
   struct stat st;

@@ -43,6 +43,9 @@ class text_output {
   }
   void put_number(float v) {
     if (!std::isfinite(v)) return put("null");
+    // Identity rotations and unused weights are common; skip the shortest-digits search.
+    if (v == 0.f && !std::signbit(v)) return put('0');
+    if (v == 1.f) return put('1');
     pos_ = static_cast<std::size_t>(
         std::to_chars(buf_.data() + pos_, buf_.data() + buf_.size(), v).ptr - buf_.data());
   }

@@ -2,7 +2,6 @@
 
 #include <fstream>
 #include <limits>
-
 #include <nlohmann/json.hpp>
 
 #include "avatarmap/io/landmark_file.hpp"
@@ -31,8 +30,8 @@ status read_frame(const nlohmann::json& doc, std::size_t i, const std::string& p
   for (int k = 0; k < k_pose_landmark_count; ++k) {
     const nlohmann::json& p = f[static_cast<std::size_t>(k)];
     if (!p.is_array() || p.size() < 3)
-      return status::error(path + ": frame " + std::to_string(i) + " point " +
-                           std::to_string(k) + ": expected [x, y, z]");
+      return status::error(path + ": frame " + std::to_string(i) + " point " + std::to_string(k) +
+                           ": expected [x, y, z]");
     for (int c = 0; c < 3; ++c) {
       const nlohmann::json& v = p[static_cast<std::size_t>(c)];
       out[k][c] = v.is_number() ? v.get<double>() : std::numeric_limits<double>::quiet_NaN();

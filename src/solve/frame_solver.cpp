@@ -16,10 +16,11 @@ using namespace solve_detail;
 // ---- input preparation --------------------------------------------------------------------
 
 float landmark_confidence(const landmark& l) {
-  if (!std::isfinite(l.x) || !std::isfinite(l.y) || !std::isfinite(l.z)) return 0.f;
-  float v = std::isfinite(l.visibility) ? l.visibility : 0.f;
-  float p = std::isfinite(l.presence) ? l.presence : 0.f;
-  return glm::clamp(std::min(v, p), 0.f, 1.f);
+  // x * 0 is NaN for NaN and +-inf: one comparison tests all three coordinates.
+  const float probe = l.x * 0.f + l.y * 0.f + l.z * 0.f;
+  if (probe != 0.f) return 0.f;
+  const float c = std::min(l.visibility, l.presence);  // NaN compares false below
+  return c >= 0.f ? (c <= 1.f ? c : 1.f) : 0.f;
 }
 
 // Pose points in VRM space after mirroring: metres when from pose_world, else VRM pixels.
@@ -110,16 +111,27 @@ void prepare_face(const landmark_frame& in, const solver_options& o, prepared_fr
   if (!in.has(frame_part::face) ||
       (in.face_count != k_face_mesh_count && in.face_count != k_face_mesh_iris_count))
     return;
-  bool ok = true;
+  namespace fi = face_index;
+  // Perspective: a face off the optical axis is seen along its own viewing ray, so its image
+  // points are sheared by (x/z, y/z) of that ray times their depth. Undo it with the ray of
+  // the face's centre (focal length from the field of view) so that the head's rotation is
+  // relative to the camera's axes, not to the ray.
+  const landmark& c0 = in.face[fi::forehead];
+  const landmark& c1 = in.face[fi::chin];
+  const float focal = 0.5f * f.width / std::tan(0.5f * o.horizontal_fov_degrees * k_deg);
+  const float shear_x = (0.5f * (c0.x + c1.x) * f.width - 0.5f * f.width) / focal;
+  const float shear_y = (0.5f * (c0.y + c1.y) * f.height - 0.5f * f.height) / focal;
+  bool ok = std::isfinite(shear_x) && std::isfinite(shear_y);
   auto get = [&](int i) {
-    glm::vec3 v = image_to_vrm_pixels(to_vec(in.face[i]), f.width, f.height);
+    const landmark& l = in.face[i];
+    const float zp = l.z * f.width;
+    glm::vec3 v(l.x * f.width + shear_x * zp, -(l.y * f.height + shear_y * zp), -zp);
     if (!is_finite(v)) {
       ok = false;
       return glm::vec3(0.f);
     }
     return o.mirror ? mirror_x(v) : v;
   };
-  namespace fi = face_index;
   const int l = o.mirror ? 1 : 0;  // slot of the person's left side
   const int r = 1 - l;
   fp.forehead = get(fi::forehead);
@@ -164,8 +176,18 @@ float min_conf(const body_points& b, std::initializer_list<int> ids) {
 }
 
 void set(frame_measurement& m, bone b, const glm::quat& world, float c) {
-  m.bones[idx(b)].world = world;
-  m.bones[idx(b)].confidence = c;
+  bone_measurement& bm = m.bones[idx(b)];
+  bm.world = world;
+  bm.confidence = c;
+  bm.has_local = false;
+}
+// Same, with the rotation relative to the (measured) parent known already.
+void set(frame_measurement& m, bone b, const glm::quat& world, const glm::quat& local, float c) {
+  bone_measurement& bm = m.bones[idx(b)];
+  bm.world = world;
+  bm.local = local;
+  bm.confidence = c;
+  bm.has_local = true;
 }
 
 // Arm of the avatar's left side, in (possibly mirrored) canonical space.
@@ -176,7 +198,7 @@ void measure_arm(const glm::vec3& sh, const glm::vec3& el, const glm::vec3& wr,
   glm::vec3 d1 = el - sh;
   glm::vec3 d2 = wr - el;
   // The elbow is a hinge: the forearm leaves the upper arm toward the upper arm's local +Z.
-  out_upper = aim_with_bend(twist_reference, k_x, k_z, d1, d2, glm::vec3(0.f));
+  out_upper = aim_with_bend(twist_reference, k_px, k_pz, d1, d2, glm::vec3(0.f));
   out_lower = out_upper * swing_local(out_upper, k_x, d2);
 }
 
@@ -190,7 +212,7 @@ void measure_leg(const glm::vec3& hip, const glm::vec3& knee, const glm::vec3& a
   // The knee flexes backward: the shin leaves the thigh toward the thigh's local -Z. For a
   // straight leg the knee points where the foot points.
   glm::vec3 forward = foot_ok ? (toe - heel) : glm::vec3(0.f);
-  out_upper = aim_with_bend(hips_world, -k_y, -k_z, d1, d2, -forward);
+  out_upper = aim_with_bend(hips_world, k_ny, k_nz, d1, d2, -forward);
   out_lower = out_upper * swing_local(out_upper, -k_y, d2);
   if (foot_ok) {
     constexpr glm::vec3 k_foot_rest(0.f, -0.44721360f, 0.89442719f);
@@ -206,9 +228,9 @@ void measure_leg(const glm::vec3& hip, const glm::vec3& knee, const glm::vec3& a
 // Wrist orientation of the avatar's left hand from the 21 hand points: +X along wrist ->
 // middle knuckle, +Z toward the index side (palm faces -Y at rest).
 glm::quat hand_world_from_points(const hand_points& h) {
-  return frame_from_two_vectors(k_x, k_z, h.p[idx(hand_landmark::middle_mcp)] - h.p[0],
-                                h.p[idx(hand_landmark::index_mcp)] -
-                                    h.p[idx(hand_landmark::pinky_mcp)]);
+  return frame_from_axes(k_px, k_pz,
+                         normalize_or(h.p[idx(hand_landmark::middle_mcp)] - h.p[0], k_x),
+                         h.p[idx(hand_landmark::index_mcp)] - h.p[idx(hand_landmark::pinky_mcp)]);
 }
 
 // Thumb rest frame: X along the thumb's rest direction (1, 0, 1)/sqrt2, Y up.
@@ -217,10 +239,13 @@ const glm::quat k_thumb_frame = axis_angle(k_y, -0.25f * k_pi);
 // Finger bones of the avatar's left hand (world rotations), given the hand's world rotation.
 void measure_fingers(const hand_points& h, const glm::quat& hand_w, float c, bool left,
                      frame_measurement& m) {
+  const int first = left ? idx(bone::left_thumb_metacarpal) : idx(bone::right_thumb_metacarpal);
   auto emit = [&](int offset, const glm::quat& w) {
-    int first = left ? idx(bone::left_thumb_metacarpal) : idx(bone::right_thumb_metacarpal);
-    bone b = static_cast<bone>(first + offset);
-    set(m, b, left ? w : mirror_x(w), c);
+    set(m, static_cast<bone>(first + offset), left ? w : mirror_x(w), c);
+  };
+  auto emit_local = [&](int offset, const glm::quat& w, const glm::quat& local) {
+    set(m, static_cast<bone>(first + offset), left ? w : mirror_x(w),
+        left ? local : mirror_x(local), c);
   };
   // Thumb: CMC 1, MCP 2, IP 3, tip 4. The metacarpal's twist (opposition) comes from the plane
   // the thumb bends in; its later joints are hinges in that plane.
@@ -228,28 +253,38 @@ void measure_fingers(const hand_points& h, const glm::quat& hand_w, float c, boo
     const glm::vec3 d = h.p[2] - h.p[1];
     const glm::vec3 bend_to = h.p[4] - h.p[2];
     glm::quat rest_frame = hand_w * k_thumb_frame;
-    glm::quat g = aim_with_bend(rest_frame, k_x, -k_y, d, bend_to, glm::vec3(0.f));
-    glm::quat inv_f = glm::inverse(k_thumb_frame);
+    glm::quat g = aim_with_bend(rest_frame, k_px, k_ny, d, bend_to, glm::vec3(0.f));
+    glm::quat inv_f = glm::conjugate(k_thumb_frame);
     emit(0, g * inv_f);
-    glm::quat hinge1 = finger_hinge(glm::inverse(g) * (h.p[3] - h.p[2]));
+    glm::quat hinge1 = finger_hinge(glm::conjugate(g) * (h.p[3] - h.p[2]));
     glm::quat g2 = g * hinge1;
-    emit(1, g2 * inv_f);
-    glm::quat hinge2 = finger_hinge(glm::inverse(g2) * (h.p[4] - h.p[3]));
-    emit(2, g2 * hinge2 * inv_f);
+    emit_local(1, g2 * inv_f, k_thumb_frame * hinge1 * inv_f);
+    glm::quat hinge2 = finger_hinge(glm::conjugate(g2) * (h.p[4] - h.p[3]));
+    emit_local(2, g2 * hinge2 * inv_f, k_thumb_frame * hinge2 * inv_f);
   }
-  const glm::quat inv_hand = glm::inverse(hand_w);
+  const glm::quat inv_hand = glm::conjugate(hand_w);
   for (int finger = 1; finger < 5; ++finger) {
     int j = finger_base_landmark(finger);
     glm::vec3 v = normalize_or(inv_hand * (h.p[j + 1] - h.p[j]), k_x);
     // Proximal: spread about local Y, then flexion about the hand's lateral axis (Z).
-    float spread = std::asin(glm::clamp(-v.z, -1.f, 1.f));
-    float flex = std::atan2(-v.y, v.x);
-    glm::quat prox = hand_w * axis_angle(k_z, -flex) * axis_angle(k_y, spread);
-    emit(3 * finger, prox);
-    glm::quat mid = prox * finger_hinge(glm::inverse(prox) * (h.p[j + 2] - h.p[j + 1]));
-    emit(3 * finger + 1, mid);
-    glm::quat dist = mid * finger_hinge(glm::inverse(mid) * (h.p[j + 3] - h.p[j + 2]));
-    emit(3 * finger + 2, dist);
+    const glm::quat prox_local = finger_proximal(v);
+    const glm::quat prox = hand_w * prox_local;
+    emit_local(3 * finger, prox, prox_local);
+    // The intermediate and distal joints hinge about the proximal's Z, so both are angles in
+    // the proximal's XY plane: take the two segments there once and work with 2-D unit
+    // vectors (the distal's angle is the difference, a complex division).
+    const glm::quat to_prox = glm::conjugate(prox);
+    const glm::vec3 s2 = to_prox * (h.p[j + 2] - h.p[j + 1]);
+    const glm::vec3 s3 = to_prox * (h.p[j + 3] - h.p[j + 2]);
+    const float l2 = s2.x * s2.x + s2.y * s2.y, l3 = s3.x * s3.x + s3.y * s3.y;
+    const float i2 = l2 > 1e-24f ? inv_sqrt(l2) : 0.f, i3 = l3 > 1e-24f ? inv_sqrt(l3) : 0.f;
+    const float c2 = i2 > 0.f ? s2.x * i2 : 1.f, n2 = s2.y * i2;
+    const float c3 = i3 > 0.f ? s3.x * i3 : c2, n3 = i3 > 0.f ? s3.y * i3 : n2;
+    const glm::quat mid_local = axis_cos_sin(k_z, c2, n2);
+    const glm::quat mid = prox * mid_local;
+    emit_local(3 * finger + 1, mid, mid_local);
+    const glm::quat dist_local = axis_cos_sin(k_z, c3 * c2 + n3 * n2, n3 * c2 - c3 * n2);
+    emit_local(3 * finger + 2, mid * dist_local, dist_local);
   }
 }
 
@@ -259,9 +294,11 @@ hand_points mirrored(const hand_points& h) {
   return r;
 }
 
-// `prev_world`: the previous frame's output world rotations, or null on the first frame.
-void measure_body(const prepared_frame& f, const solver_options& o,
-                  const std::array<glm::quat, k_bone_count>* prev_world, frame_measurement& m) {
+// `prev_world(b)`: the previous frame's output world rotation of bone b; null on the first
+// frame.
+template <class prev_world_fn>
+void measure_body(const prepared_frame& f, const solver_options& o, const prev_world_fn* prev_world_ptr,
+                  frame_measurement& m) {
   const body_points& b = f.body;
   if (!b.valid || !o.parts.body) return;
   using pl = pose_landmark;
@@ -272,22 +309,25 @@ void measure_body(const prepared_frame& f, const solver_options& o,
   const float c_torso = min_conf(b, {idx(pl::left_hip), idx(pl::right_hip),
                                      idx(pl::left_shoulder), idx(pl::right_shoulder)});
   // Hips: yaw and roll from the hip line; a share of the torso's lean about the hip line.
-  const glm::quat upright = frame_from_two_vectors(k_x, k_y, hip_l - hip_r, k_y);
-  const glm::quat leaning = frame_from_two_vectors(k_x, k_y, hip_l - hip_r, up);
-  const glm::quat hips_w = slerp_shortest(upright, leaning, o.hips_lean_share);
-  // Spine chain: the rest of the way to the shoulder line's frame, split evenly.
-  const glm::quat shoulders_w = frame_from_two_vectors(k_x, k_y, sh_l - sh_r, up);
-  const glm::quat third = quat_fraction(glm::inverse(hips_w) * shoulders_w, 1.f / 3.f);
+  const glm::vec3 hip_line = normalize_or(hip_l - hip_r, k_x);
+  const glm::quat upright = frame_from_axes(k_px, k_py, hip_line, k_y);
+  const glm::quat leaning = frame_from_axes(k_px, k_py, hip_line, up);
+  const glm::quat hips_w = nlerp_shortest(upright, leaning, o.hips_lean_share);
+  // Spine chain: the rest of the way to the shoulder line's frame, split about evenly; the
+  // upper chest closes the chain exactly, so the shoulder line is matched whatever the split.
+  const glm::quat shoulders_w = frame_from_axes(k_px, k_py, normalize_or(sh_l - sh_r, k_x), up);
+  const glm::quat bend = glm::conjugate(hips_w) * shoulders_w;
+  const glm::quat third = nlerp_shortest(identity_quat(), bend, 1.f / 3.f);
   const glm::quat spine_w = hips_w * third;
   const glm::quat chest_w = spine_w * third;
-  const glm::quat upper_chest_w = chest_w * third;
+  const glm::quat upper_chest_w = shoulders_w;
   set(m, bone::hips, hips_w, c_torso);
   set(m, bone::spine, spine_w, c_torso);
   set(m, bone::chest, chest_w, c_torso);
   set(m, bone::upper_chest, upper_chest_w, c_torso);
   // Clavicles are not observable from BlazePose's points: they follow the upper chest.
-  set(m, bone::left_shoulder, upper_chest_w, c_torso);
-  set(m, bone::right_shoulder, upper_chest_w, c_torso);
+  set(m, bone::left_shoulder, upper_chest_w, identity_quat(), c_torso);
+  set(m, bone::right_shoulder, upper_chest_w, identity_quat(), c_torso);
 
   for (int side = 0; side < 2; ++side) {
     const bool left = side == 0;
@@ -306,8 +346,9 @@ void measure_body(const prepared_frame& f, const solver_options& o,
 
     glm::quat ua, la;
     glm::quat twist_ref = uc;
-    if (prev_world) {
-      const glm::quat& p = (*prev_world)[idx(left ? bone::left_upper_arm : bone::right_upper_arm)];
+    if (prev_world_ptr) {
+      const auto& prev_world = *prev_world_ptr;
+      const glm::quat& p = prev_world(idx(left ? bone::left_upper_arm : bone::right_upper_arm));
       twist_ref = left ? p : mirror_x(p);
     }
     measure_arm(P(pl::left_shoulder, pl::right_shoulder), P(pl::left_elbow, pl::right_elbow),
@@ -322,7 +363,7 @@ void measure_body(const prepared_frame& f, const solver_options& o,
       glm::vec3 wr = P(pl::left_wrist, pl::right_wrist);
       glm::vec3 pk = P(pl::left_pinky, pl::right_pinky);
       glm::vec3 ix = P(pl::left_index, pl::right_index);
-      glm::quat hand = frame_from_two_vectors(k_x, k_z, 0.5f * (pk + ix) - wr, ix - pk);
+      glm::quat hand = frame_from_axes(k_px, k_pz, normalize_or(0.5f * (pk + ix) - wr, k_x), ix - pk);
       float c_h = C({pl::left_wrist, pl::left_pinky, pl::left_index},
                     {pl::right_wrist, pl::right_pinky, pl::right_index});
       set(m, left ? bone::left_hand : bone::right_hand, out(hand), 0.999f * c_h);
@@ -340,7 +381,7 @@ void measure_body(const prepared_frame& f, const solver_options& o,
     set(m, left ? bone::left_lower_leg : bone::right_lower_leg, out(ll),
         C({pl::left_knee, pl::left_ankle}, {pl::right_knee, pl::right_ankle}));
     set(m, left ? bone::left_foot : bone::right_foot, out(foot), c_foot);
-    set(m, left ? bone::left_toes : bone::right_toes, out(foot), c_foot);
+    set(m, left ? bone::left_toes : bone::right_toes, out(foot), identity_quat(), c_foot);
   }
 }
 
@@ -369,6 +410,7 @@ void measure_hips_position(const landmark_frame& in, const prepared_frame& f,
   // Least-squares fit image_px = s * world_xy + t over confident torso and leg points. The
   // world origin is the hip midpoint, so t is the hip midpoint's pixel position.
   static constexpr int k_ids[] = {11, 12, 23, 24, 25, 26, 27, 28};
+  glm::vec2 wp[8], ip[8];
   glm::vec2 mw(0.f), mi(0.f);
   int n = 0;
   for (int i : k_ids) {
@@ -376,22 +418,19 @@ void measure_hips_position(const landmark_frame& in, const prepared_frame& f,
     const landmark& p = in.pose[i];
     if (std::min(landmark_confidence(w), landmark_confidence(p)) < o.confidence.found_above)
       continue;
-    mw += glm::vec2(w.x, w.y);
-    mi += glm::vec2(p.x * f.width, p.y * f.height);
+    wp[n] = glm::vec2(w.x, w.y);
+    ip[n] = glm::vec2(p.x * f.width, p.y * f.height);
+    mw += wp[n];
+    mi += ip[n];
     ++n;
   }
   if (n < 4) return;
   mw /= float(n);
   mi /= float(n);
   float num = 0.f, den = 0.f;
-  for (int i : k_ids) {
-    const landmark& w = in.pose_world[i];
-    const landmark& p = in.pose[i];
-    if (std::min(landmark_confidence(w), landmark_confidence(p)) < o.confidence.found_above)
-      continue;
-    glm::vec2 dw = glm::vec2(w.x, w.y) - mw;
-    glm::vec2 di = glm::vec2(p.x * f.width, p.y * f.height) - mi;
-    num += glm::dot(dw, di);
+  for (int k = 0; k < n; ++k) {
+    glm::vec2 dw = wp[k] - mw;
+    num += glm::dot(dw, ip[k] - mi);
     den += glm::dot(dw, dw);
   }
   if (!(den > 1e-6f) || !(num > 0.f)) return;
@@ -456,7 +495,7 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
   float c_head = 0.f;
   if (fp.valid) {
     glm::vec3 lateral = (fp.eye[0].outer - fp.eye[1].outer) + (fp.cheek[0] - fp.cheek[1]);
-    head_w = frame_from_two_vectors(k_x, k_y, lateral, fp.forehead - fp.chin);
+    head_w = frame_from_axes(k_px, k_py, normalize_or(lateral, k_x), fp.forehead - fp.chin);
     c_head = 1.f;
   } else if (f.body.valid) {
     const body_points& b = f.body;
@@ -464,13 +503,13 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
     glm::vec3 lateral = b.p[idx(pl::left_ear)] - b.p[idx(pl::right_ear)];
     glm::vec3 up = 0.5f * (b.p[idx(pl::left_eye)] + b.p[idx(pl::right_eye)]) -
                    0.5f * (b.p[idx(pl::mouth_left)] + b.p[idx(pl::mouth_right)]);
-    head_w = frame_from_two_vectors(k_x, k_y, lateral, up);
+    head_w = frame_from_axes(k_px, k_py, normalize_or(lateral, k_x), up);
     c_head = min_conf(b, {idx(pl::left_ear), idx(pl::right_ear), idx(pl::left_eye),
                           idx(pl::right_eye), idx(pl::mouth_left), idx(pl::mouth_right)});
   }
   if (c_head > 0.f) {
     const glm::quat& base = upper_chest_w;
-    glm::quat neck_w = base * quat_fraction(glm::inverse(base) * head_w, 0.5f);
+    glm::quat neck_w = base * quat_fraction(glm::conjugate(base) * head_w, 0.5f);
     set(m, bone::neck, neck_w, c_head);
     set(m, bone::head, head_w, c_head);
   }
@@ -526,8 +565,8 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
     float pitch = glm::clamp(pitch_sum / float(gaze_n), -25.f * k_deg, 25.f * k_deg);
     // Eye bones: yaw about Y (toward +X), then pitch up (a negative turn about X).
     glm::quat eye_local = axis_angle(k_y, yaw) * axis_angle(k_x, -pitch);
-    set(m, bone::left_eye, head_w * eye_local, 1.f);
-    set(m, bone::right_eye, head_w * eye_local, 1.f);
+    set(m, bone::left_eye, head_w * eye_local, eye_local, 1.f);
+    set(m, bone::right_eye, head_w * eye_local, eye_local, 1.f);
     ex[idx(expression::look_left)] = glm::clamp(yaw / (25.f * k_deg), 0.f, 1.f);
     ex[idx(expression::look_right)] = glm::clamp(-yaw / (25.f * k_deg), 0.f, 1.f);
     ex[idx(expression::look_up)] = glm::clamp(pitch / (20.f * k_deg), 0.f, 1.f);
@@ -569,6 +608,9 @@ frame_solver::frame_solver(const solver_options& options)
 void frame_solver::reset() {
   for (auto& b : bones_) b = bone_state{};
   prev_world_.fill(identity_quat());
+  world_stamp_.fill(0);
+  world_generation_ = 1;
+  local_.fill(identity_quat());
   hips_height_state_ = scalar_state{};
   ground_state_ = scalar_state{};
   face_state_ = scalar_state{};
@@ -594,12 +636,23 @@ void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const
   prepare_hand(in, options_, 0, f);
   prepare_hand(in, options_, 1, f);
   prepare_face(in, options_, f);
-  measure_body(f, options_, have_prev_world_ ? &prev_world_ : nullptr, m);
+  auto prev = [this](int b) -> const glm::quat& { return previous_world(b); };
+  measure_body(f, options_, have_prev_world_ ? &prev : nullptr, m);
   measure_hips_position(in, f, options_, m);
   measure_hands(f, options_, m);
   const bone_measurement& uc = m.bones[idx(bone::upper_chest)];
   const bool have_uc = uc.confidence > 0.f;
-  measure_face(f, options_, have_uc ? uc.world : prev_world_[idx(bone::upper_chest)], m);
+  measure_face(f, options_, have_uc ? uc.world : previous_world(idx(bone::upper_chest)), m);
+}
+
+const glm::quat& frame_solver::previous_world(int b) const {
+  // World rotation of bone b in the last output, computed on demand (few bones need it) and
+  // memoised until the next output.
+  if (world_stamp_[b] == world_generation_) return prev_world_[b];
+  const int p = bone_parent(b);
+  prev_world_[b] = p == k_no_parent ? bones_[b].output : previous_world(p) * bones_[b].output;
+  world_stamp_[b] = world_generation_;
+  return prev_world_[b];
 }
 
 float frame_solver::gate(scalar_state& s, float c, double t) const {
@@ -628,15 +681,18 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
 
   // Local rotations of the measurement, relative to the measured parent when there is one,
   // else to the parent's last output.
-  std::array<glm::quat, k_bone_count> local;
-  local.fill(identity_quat());
+  std::array<glm::quat, k_bone_count>& local = local_;
   for (int b = 0; b < k_bone_count; ++b) {
-    int p = bone_parent(b);
-    if (m.bones[b].confidence <= 0.f) continue;
-    glm::quat parent = p == k_no_parent ? identity_quat()
-                       : m.bones[p].confidence > 0.f ? m.bones[p].world
-                                                     : prev_world_[p];
-    local[b] = glm::normalize(glm::inverse(parent) * m.bones[b].world);
+    const bone_measurement& bm = m.bones[b];
+    if (bm.confidence <= 0.f) continue;
+    const int p = bone_parent(b);
+    if (p == k_no_parent) {
+      local[b] = bm.world;
+    } else if (m.bones[p].confidence > 0.f) {
+      local[b] = bm.has_local ? bm.local : glm::conjugate(m.bones[p].world) * bm.world;
+    } else {
+      local[b] = glm::conjugate(previous_world(p)) * bm.world;
+    }
   }
   // Move a share of the wrist's twist about the forearm into the lower arm.
   for (int side = 0; side < 2; ++side) {
@@ -644,44 +700,57 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
     int hd = idx(side == 0 ? bone::left_hand : bone::right_hand);
     if (m.bones[la].confidence <= 0.f || m.bones[hd].confidence <= 0.f) continue;
     glm::vec3 axis = bone_rest_direction(static_cast<bone>(hd));
-    glm::quat twist = quat_fraction(swing_twist(local[hd], axis).twist, options_.forearm_twist_share);
-    local[la] = glm::normalize(local[la] * twist);
-    local[hd] = glm::normalize(glm::inverse(twist) * local[hd]);
+    glm::quat twist = nlerp_shortest(identity_quat(), swing_twist(local[hd], axis).twist,
+                                     options_.forearm_twist_share);
+    local[la] = local[la] * twist;
+    local[hd] = glm::conjugate(twist) * local[hd];
   }
 
   // Confidence gating per bone: hold, ease to rest, blend back in.
+  const float inv_regain = co.regain_seconds > 0.f ? 1.f / co.regain_seconds : 0.f;
+  const float inv_ease = co.ease_seconds > 0.f ? 1.f / co.ease_seconds : 0.f;
   for (int b = 0; b < k_bone_count; ++b) {
     bone_state& s = bones_[b];
     const float c = m.bones[b].confidence;
-    if (s.tracked && (c <= 0.f || c < co.lost_below)) {
-      s.tracked = false;
-      s.lost_at = t;
-    } else if (!s.tracked && c > 0.f && c >= co.found_above) {
+    if (s.tracked) {
+      if (c <= 0.f || c < co.lost_below) {
+        s.tracked = false;
+        s.lost_at = t;
+      }
+    } else if (c > 0.f && c >= co.found_above) {
       s.tracked = true;
+      s.blending = s.ever_tracked && inv_regain > 0.f;
       s.regain_from = s.output;
-      s.found_at = s.ever_tracked ? t : -1e30;
+      s.found_at = t;
       s.ever_tracked = true;
     }
     if (s.tracked) {
       s.last_good = local[b];
-      float k = co.regain_seconds > 0.f ? float((t - s.found_at) / co.regain_seconds) : 1.f;
-      s.output = k >= 1.f ? local[b] : slerp_shortest(s.regain_from, local[b], smooth01(k));
+      s.output = local[b];
+      if (s.blending) {
+        const float k = float(t - s.found_at) * inv_regain;
+        if (k < 1.f)
+          s.output = slerp_shortest(s.regain_from, local[b], smooth01(k));
+        else
+          s.blending = false;
+      }
       out.confidence[b] = c;
     } else {
-      double age = t - s.lost_at;
-      if (!s.ever_tracked) {
-        s.output = identity_quat();
-      } else if (age <= co.hold_seconds) {
-        s.output = s.last_good;
-      } else {
-        float e = co.ease_seconds > 0.f ? float((age - co.hold_seconds) / co.ease_seconds) : 1.f;
-        s.output = slerp_shortest(s.last_good, identity_quat(), smooth01(e));
+      if (s.ever_tracked) {
+        const double age = t - s.lost_at;
+        if (age <= co.hold_seconds) {
+          s.output = s.last_good;
+        } else {
+          const float e = inv_ease > 0.f ? float(age - co.hold_seconds) * inv_ease : 1.f;
+          s.output = e >= 1.f ? identity_quat()
+                              : slerp_shortest(s.last_good, identity_quat(), smooth01(e));
+        }
       }
       out.confidence[b] = 0.f;
     }
     out.rotations[b] = s.output;
   }
-  compute_world_rotations(out, prev_world_);
+  ++world_generation_;
   have_prev_world_ = true;
 
   // Hips height: hold, then ease to the last standing height (or the rest height).

@@ -30,49 +30,119 @@ inline float angle_of(const glm::vec3& a, const glm::vec3& b) {
 /// Component of v orthogonal to unit u.
 inline glm::vec3 orth(const glm::vec3& v, const glm::vec3& u) { return v - glm::dot(v, u) * u; }
 
-/// World rotation of a bone that points along `dir` (rest direction `rest_dir`), whose twist is
-/// set by `bend_target` (the next segment's direction, which should lie on the side of the
-/// bone's local axis `rest_bend`) when the joint below is bent more than ~30 degrees, and
-/// otherwise by the minimal twist from `parent_world` (no defined bend plane).
-/// `fallback_secondary`, when non-zero, replaces the parent's minimal twist as the reference
-/// for straight limbs (e.g. the foot's forward direction for the knee).
-inline glm::quat aim_with_bend(const glm::quat& parent_world, const glm::vec3& rest_dir,
-                               const glm::vec3& rest_bend, const glm::vec3& dir,
-                               const glm::vec3& bend_target, const glm::vec3& fallback_secondary) {
-  glm::vec3 d = normalize_or(dir, parent_world * rest_dir);
-  // Minimal-twist frame: the parent's frame swung onto d.
-  glm::quat swing = rotation_between(glm::normalize(parent_world * rest_dir), d) * parent_world;
-  glm::vec3 ref = orth(swing * rest_bend, d);
-  glm::vec3 fb = orth(fallback_secondary, d);
-  if (glm::dot(fb, fb) > 1e-8f * glm::max(1e-20f, glm::dot(fallback_secondary, fallback_secondary)))
-    ref = fb;
-  ref = normalize_or(ref, swing * rest_bend);
-  glm::vec3 b = orth(bend_target, d);
-  float bend = angle_of(d, bend_target);
-  float w = smoothstep(15.f * k_deg, 40.f * k_deg, bend);
-  glm::vec3 secondary = ref;
-  if (w > 0.f) {
-    glm::vec3 bn = normalize_or(b, ref);
-    secondary = w * bn + (1.f - w) * ref;
-    if (glm::dot(secondary, secondary) < 1e-6f) secondary = bn;
+/// A signed coordinate axis of a bone's local frame: index 0 = X, 1 = Y, 2 = Z.
+struct axis {
+  int index;
+  float sign;
+  glm::vec3 vec() const {
+    glm::vec3 v(0.f);
+    v[index] = sign;
+    return v;
   }
-  return frame_from_two_vectors(rest_dir, rest_bend, d, secondary);
+};
+inline constexpr axis k_px{0, 1.f}, k_nx{0, -1.f}, k_py{1, 1.f}, k_ny{1, -1.f}, k_pz{2, 1.f},
+    k_nz{2, -1.f};
+
+/// The rotation that maps local axis `a` onto the unit vector `p` exactly and local axis `b`
+/// (a different axis) into the half-plane of `hint` (orthogonalised against p). When hint is
+/// parallel to p or zero: the shortest rotation of axis a onto p.
+inline glm::quat frame_from_axes(axis a, axis b, const glm::vec3& p, const glm::vec3& hint) {
+  glm::vec3 s = hint - glm::dot(hint, p) * p;
+  const float s2 = glm::dot(s, s);
+  const float h2 = glm::dot(hint, hint);
+  if (!(s2 > 1e-10f * (h2 > 1e-20f ? h2 : 1e-20f)) || !std::isfinite(s2))
+    return rotation_between(a.vec(), p);
+  s *= inv_sqrt(s2);
+  glm::vec3 col[3];
+  col[a.index] = a.sign * p;
+  col[b.index] = b.sign * s;
+  const int c = 3 - a.index - b.index;
+  col[c] = glm::cross(col[(c + 1) % 3], col[(c + 2) % 3]);
+  return quat_from_basis(col[0], col[1], col[2]);
+}
+
+/// World rotation of a bone whose local axis `along` points along `dir`, and whose twist is set
+/// by `bend_target` (the next segment's direction, which leaves toward the bone's local axis
+/// `bend`) when the joint below is bent more than ~30 degrees, and otherwise by the minimal
+/// twist from `reference` (a world rotation whose `along`/`bend` axes are the reference
+/// directions). `fallback_secondary`, when non-zero, replaces that minimal-twist reference as
+/// where `bend` points for straight limbs (e.g. the foot's forward direction for the knee).
+inline glm::quat aim_with_bend(const glm::quat& reference, axis along, axis bend,
+                               const glm::vec3& dir, const glm::vec3& bend_target,
+                               const glm::vec3& fallback_secondary) {
+  const glm::vec3 ref_dir = reference * along.vec();
+  const glm::vec3 ref_bend = reference * bend.vec();
+  const glm::vec3 d = normalize_or(dir, ref_dir);
+  glm::vec3 ref;
+  const float fb2 = glm::dot(fallback_secondary, fallback_secondary);
+  const glm::vec3 fb = orth(fallback_secondary, d);
+  if (glm::dot(fb, fb) > 1e-8f * (fb2 > 1e-20f ? fb2 : 1e-20f)) {
+    ref = fb;
+  } else {
+    // ref_bend carried by the shortest rotation taking ref_dir onto d:
+    // R v = c v + k x v + k (k . v) / (1 + c), with c = ref_dir . d, k = ref_dir x d.
+    const float c = glm::dot(ref_dir, d);
+    if (c > -0.999f) {
+      const glm::vec3 k = glm::cross(ref_dir, d);
+      ref = c * ref_bend + glm::cross(k, ref_bend) + k * (glm::dot(k, ref_bend) / (1.f + c));
+    } else {
+      ref = ref_bend;
+    }
+    ref = orth(ref, d);
+  }
+  // Bend weight: 0 below 15 degrees of bend, 1 above 40, smooth between (on the cosine, which
+  // is monotonic in the angle and needs no atan2).
+  constexpr float k_cos15 = 0.96592583f, k_cos40 = 0.76604444f;
+  const float tl2 = glm::dot(bend_target, bend_target);
+  const float cos_bend = tl2 > 0.f ? glm::dot(d, bend_target) * inv_sqrt(tl2) : 1.f;
+  const float w = smoothstep(k_cos15, k_cos40, cos_bend);
+  glm::vec3 secondary = normalize_or(ref, ref_bend);
+  if (w > 0.f) {
+    const glm::vec3 bn = normalize_or(orth(bend_target, d), secondary);
+    const glm::vec3 mixed = w * bn + (1.f - w) * secondary;
+    secondary = glm::dot(mixed, mixed) < 1e-6f ? bn : mixed;
+  }
+  return frame_from_axes(along, bend, d, secondary);
 }
 
 /// Local rotation of a child bone relative to `parent_world` that points the child's rest
 /// direction along `dir` by the shortest arc (a pure hinge when dir lies in the bend plane).
 inline glm::quat swing_local(const glm::quat& parent_world, const glm::vec3& rest_dir,
                              const glm::vec3& dir) {
-  glm::vec3 v = normalize_or(glm::inverse(parent_world) * dir, rest_dir);
+  glm::vec3 v = normalize_or(glm::conjugate(parent_world) * dir, rest_dir);
   return rotation_between(rest_dir, v);
+}
+
+/// Rotation about the unit axis `k` by the angle whose cosine and sine are c and s (c^2 + s^2
+/// = 1), without trigonometric calls: q ~ (1 + c, s k) normalised (half-angle identity). At
+/// c = -1 (a half turn) it returns (0, k).
+inline glm::quat axis_cos_sin(const glm::vec3& k, float c, float s) {
+  float w = 1.f + c;
+  if (w < 1e-7f) return glm::quat(0.f, k.x, k.y, k.z);
+  float n = inv_sqrt(w * w + s * s);
+  return glm::quat(w * n, k.x * s * n, k.y * s * n, k.z * s * n);
 }
 
 /// Hinge rotation about the local axis that turns +X toward -Y (rotation about Z by -theta),
 /// with theta = atan2(-v.y, v.x) taken from the child's direction v in the parent's frame:
-/// fingers flex past 90 degrees without folding back.
+/// fingers flex past 90 degrees without folding back. v's Z part (off the hinge plane) is
+/// ignored; a v along Z gives identity.
 inline glm::quat finger_hinge(const glm::vec3& v_local) {
-  float theta = std::atan2(-v_local.y, v_local.x);
-  return axis_angle(k_z, -theta);
+  float r2 = v_local.x * v_local.x + v_local.y * v_local.y;
+  if (!(r2 > 1e-24f)) return glm::quat(1.f, 0.f, 0.f, 0.f);
+  // Rotation about +Z by -theta: cos = v.x / r, sin(-theta) = v.y / r.
+  const float ir = inv_sqrt(r2);
+  return axis_cos_sin(k_z, v_local.x * ir, v_local.y * ir);
+}
+
+/// A finger's proximal rotation R_z(-flex) * R_y(spread) that points +X along unit `v`
+/// (hand frame): spread = asin(-v.z), flex = atan2(-v.y, v.x), computed without trig calls.
+inline glm::quat finger_proximal(const glm::vec3& v) {
+  const float r2 = v.x * v.x + v.y * v.y;
+  if (!(r2 > 1e-24f)) return axis_cos_sin(k_y, 0.f, -v.z);
+  const float ir = inv_sqrt(r2);
+  glm::quat spread = axis_cos_sin(k_y, r2 * ir, -v.z);
+  return axis_cos_sin(k_z, v.x * ir, v.y * ir) * spread;
 }
 
 }  // namespace avatarmap::solve_detail

@@ -35,9 +35,9 @@ constexpr float k_eye_y = 0.11f;
 constexpr float k_eye_z = 0.088f;
 constexpr float k_eye_inner_x = 0.016f;
 constexpr float k_eye_width = 0.03f;
-constexpr float k_lid_open = 0.22f;    // lid gap / eye width, open
-constexpr float k_lid_closed = 0.02f;  // closed
-constexpr float k_lid_z = 0.003f;      // lids bulge forward over the eyeball
+constexpr float k_lid_open = 0.22f;                        // lid gap / eye width, open
+constexpr float k_lid_closed = 0.02f;                      // closed
+constexpr float k_lid_z = 0.003f;                          // lids bulge forward over the eyeball
 constexpr float k_lid_fraction[3] = {0.25f, 0.5f, 0.75f};  // from outer to inner corner
 constexpr float k_mouth_y = 0.045f;
 constexpr float k_mouth_z = k_eye_z;  // mouth corners at the eye corners' depth
@@ -54,15 +54,17 @@ constexpr float k_iris_radius = 0.0058f;
 struct eye_indices {
   int inner, outer, outer2;  // outer2: a second index at the outer corner
   int upper[3], lower[3];
-  int brow[5];               // outer -> inner
-  int under[3];              // below the lower lid (outer -> inner)
-  int corner_out, corner_in; // points just outside each corner
-  int iris;                  // centre; ring = iris + 1 .. iris + 4
+  int brow[5];                // outer -> inner
+  int under[3];               // below the lower lid (outer -> inner)
+  int corner_out, corner_in;  // points just outside each corner
+  int iris;                   // centre; ring = iris + 1 .. iris + 4
 };
-constexpr eye_indices k_right_eye{133, 130, 33, {160, 159, 158}, {144, 145, 153},
-                                  {70, 63, 105, 66, 107}, {229, 230, 231}, 35, 244, 468};
-constexpr eye_indices k_left_eye{362, 263, 359, {387, 386, 385}, {373, 374, 380},
-                                 {300, 293, 334, 296, 336}, {449, 450, 451}, 265, 464, 473};
+constexpr eye_indices k_right_eye{
+    133, 130, 33, {160, 159, 158}, {144, 145, 153}, {70, 63, 105, 66, 107}, {229, 230, 231},
+    35,  244, 468};
+constexpr eye_indices k_left_eye{
+    362, 263, 359, {387, 386, 385}, {373, 374, 380}, {300, 293, 334, 296, 336}, {449, 450, 451},
+    265, 464, 473};
 constexpr float k_brow_fraction[5] = {-0.15f, 0.15f, 0.5f, 0.85f, 1.1f};
 constexpr float k_brow_shape[5] = {0.007f, 0.010f, 0.012f, 0.011f, 0.009f};
 
@@ -73,19 +75,18 @@ struct fixed_point {
   glm::vec3 p;
 };
 const fixed_point k_fixed[] = {
-    {1, -1, {0.f, 0.075f, 0.115f}},     // nose tip
-    {4, -1, {0.f, 0.080f, 0.113f}},     // nose tip (upper)
-    {2, -1, {0.f, 0.063f, 0.103f}},     // below the nose
-    {6, -1, {0.f, 0.110f, 0.098f}},     // nose bridge
-    {168, -1, {0.f, 0.120f, 0.096f}},   // between the brows
-    {10, -1, {0.f, 0.185f, 0.085f}},    // forehead
-    {152, -1, {0.f, 0.000f, 0.085f}},   // chin
-    {234, 454, {-0.07f, 0.09f, 0.035f}},  // cheeks
-    {21, 251, {-0.065f, 0.145f, 0.04f}},  // temples
-    {172, 397, {-0.055f, 0.025f, 0.03f}}, // jaw angles
-    {127, 356, {-0.072f, 0.105f, 0.02f}}, // beside the eyes
-    {93, 323, {-0.068f, 0.065f, 0.03f}},
-    {132, 361, {-0.062f, 0.045f, 0.03f}},
+    {1, -1, {0.f, 0.075f, 0.115f}},        // nose tip
+    {4, -1, {0.f, 0.080f, 0.113f}},        // nose tip (upper)
+    {2, -1, {0.f, 0.063f, 0.103f}},        // below the nose
+    {6, -1, {0.f, 0.110f, 0.098f}},        // nose bridge
+    {168, -1, {0.f, 0.120f, 0.096f}},      // between the brows
+    {10, -1, {0.f, 0.185f, 0.085f}},       // forehead
+    {152, -1, {0.f, 0.000f, 0.085f}},      // chin
+    {234, 454, {-0.07f, 0.09f, 0.035f}},   // cheeks
+    {21, 251, {-0.065f, 0.145f, 0.04f}},   // temples
+    {172, 397, {-0.055f, 0.025f, 0.03f}},  // jaw angles
+    {127, 356, {-0.072f, 0.105f, 0.02f}},  // beside the eyes
+    {93, 323, {-0.068f, 0.065f, 0.03f}},  {132, 361, {-0.062f, 0.045f, 0.03f}},
     {58, 288, {-0.06f, 0.035f, 0.03f}},
 };
 
@@ -115,8 +116,8 @@ void set_eye_rest(std::array<glm::vec3, k_face_mesh_iris_count>& t, const eye_in
   }
   t[e.corner_out] = outer + glm::vec3(side * 0.004f * s, -0.002f * s, -0.002f * s);
   t[e.corner_in] = inner + glm::vec3(-side * 0.003f * s, -0.001f * s, 0.f);
-  const glm::vec3 iris = inner + k_iris_along * (outer - inner) +
-                         glm::vec3(0.f, k_iris_above * w, 0.004f * s);
+  const glm::vec3 iris =
+      inner + k_iris_along * (outer - inner) + glm::vec3(0.f, k_iris_above * w, 0.004f * s);
   t[e.iris] = iris;
   const float r = k_iris_radius * s;
   t[e.iris + 1] = iris + glm::vec3(r, 0.f, 0.f);
@@ -126,8 +127,7 @@ void set_eye_rest(std::array<glm::vec3, k_face_mesh_iris_count>& t, const eye_in
 }
 
 // Mouth points for a given width and inner-lip gap (metres).
-void set_mouth(std::array<glm::vec3, k_face_mesh_iris_count>& t, float width, float gap,
-               float s) {
+void set_mouth(std::array<glm::vec3, k_face_mesh_iris_count>& t, float width, float gap, float s) {
   const float y = k_mouth_y * s;
   const float h = 0.5f * width;
   t[61] = glm::vec3(-h, y, k_mouth_z * s);
@@ -291,11 +291,10 @@ void landmark_synth::build_face(const proxy_pose& pose) {
   const float blink = pose[expression::blink];
   const float closure[2] = {clamp01(blink + pose[expression::blink_right]),
                             clamp01(blink + pose[expression::blink_left])};
-  const float brow[2] = {
-      k_brow_up * s * clamp01(pose[expression::brow_up_right]) -
-          k_brow_down * s * clamp01(pose[expression::brow_down_right]),
-      k_brow_up * s * clamp01(pose[expression::brow_up_left]) -
-          k_brow_down * s * clamp01(pose[expression::brow_down_left])};
+  const float brow[2] = {k_brow_up * s * clamp01(pose[expression::brow_up_right]) -
+                             k_brow_down * s * clamp01(pose[expression::brow_down_right]),
+                         k_brow_up * s * clamp01(pose[expression::brow_up_left]) -
+                             k_brow_down * s * clamp01(pose[expression::brow_down_left])};
   const bone eye_bones[2] = {bone::right_eye, bone::left_eye};
   const eye_indices* eyes[2] = {&k_right_eye, &k_left_eye};
   for (int side = 0; side < 2; ++side) {
@@ -366,10 +365,9 @@ void landmark_synth::generate(const proxy_pose& pose, landmark_frame& out) {
     const float s = skeleton_.scale;
     auto head_point = [&](const glm::vec3& local) { return hj + head * local; };
     // Face points: nose, eye corners (as the mesh) and centres, ears, mouth corners (live).
-    const glm::vec3 eye_centre(0.5f * (face_template_[k_left_eye.inner].x +
-                                       face_template_[k_left_eye.outer].x),
-                               face_template_[k_left_eye.inner].y,
-                               face_template_[k_left_eye.inner].z);
+    const glm::vec3 eye_centre(
+        0.5f * (face_template_[k_left_eye.inner].x + face_template_[k_left_eye.outer].x),
+        face_template_[k_left_eye.inner].y, face_template_[k_left_eye.inner].z);
     const glm::vec3 ear = glm::vec3(0.075f, 0.10f, -0.005f) * s;
     P[0] = head_point(face_template_[1]);
     P[1] = head_point(face_template_[k_left_eye.inner]);
@@ -382,15 +380,28 @@ void landmark_synth::generate(const proxy_pose& pose, landmark_frame& out) {
     P[8] = head_point(mirror_x(ear));
     P[9] = points_.face[291];
     P[10] = points_.face[61];
-    const bone body[22] = {
-        bone::left_upper_arm,        bone::right_upper_arm,       bone::left_lower_arm,
-        bone::right_lower_arm,       bone::left_hand,             bone::right_hand,
-        bone::left_little_proximal,  bone::right_little_proximal, bone::left_index_proximal,
-        bone::right_index_proximal,  bone::left_thumb_proximal,   bone::right_thumb_proximal,
-        bone::left_upper_leg,        bone::right_upper_leg,       bone::left_lower_leg,
-        bone::right_lower_leg,       bone::left_foot,             bone::right_foot,
-        bone::left_foot,             bone::right_foot,            bone::left_toes,
-        bone::right_toes};
+    const bone body[22] = {bone::left_upper_arm,
+                           bone::right_upper_arm,
+                           bone::left_lower_arm,
+                           bone::right_lower_arm,
+                           bone::left_hand,
+                           bone::right_hand,
+                           bone::left_little_proximal,
+                           bone::right_little_proximal,
+                           bone::left_index_proximal,
+                           bone::right_index_proximal,
+                           bone::left_thumb_proximal,
+                           bone::right_thumb_proximal,
+                           bone::left_upper_leg,
+                           bone::right_upper_leg,
+                           bone::left_lower_leg,
+                           bone::right_lower_leg,
+                           bone::left_foot,
+                           bone::right_foot,
+                           bone::left_foot,
+                           bone::right_foot,
+                           bone::left_toes,
+                           bone::right_toes};
     for (int i = 0; i < 18; ++i) P[11 + i] = J[idx(body[i])];
     P[29] = fk_.heels[0];
     P[30] = fk_.heels[1];
@@ -437,10 +448,8 @@ void landmark_synth::generate(const proxy_pose& pose, landmark_frame& out) {
         out.set(side == 0 ? frame_part::left_hand : frame_part::right_hand, true);
       }
       if (options_.hands_world) {
-        const glm::vec3 centre =
-            to_mediapipe((H[0] + H[5] + H[9] + H[13] + H[17]) * 0.2f);
-        for (int i = 0; i < k_hand_landmark_count; ++i)
-          put(wld[i], to_mediapipe(H[i]) - centre);
+        const glm::vec3 centre = to_mediapipe((H[0] + H[5] + H[9] + H[13] + H[17]) * 0.2f);
+        for (int i = 0; i < k_hand_landmark_count; ++i) put(wld[i], to_mediapipe(H[i]) - centre);
         out.set(side == 0 ? frame_part::left_hand_world : frame_part::right_hand_world, true);
       }
     }

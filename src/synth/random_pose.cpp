@@ -66,7 +66,8 @@ proxy_pose random_pose(std::mt19937& rng, const random_pose_limits& L) {
   for (int side = 0; side < 2; ++side) {
     const bool right = side == 1;
     // Arm: shoulder, then a direction for the upper arm (in the shoulder's frame).
-    glm::quat shoulder = axis_angle(k_y, sym(rng, L.shoulder)) * axis_angle(k_z, sym(rng, L.shoulder));
+    glm::quat shoulder =
+        axis_angle(k_y, sym(rng, L.shoulder)) * axis_angle(k_z, sym(rng, L.shoulder));
     set_side(p, bone::left_shoulder, shoulder, right);
     glm::vec3 dir;
     for (int tries = 0; tries < 64; ++tries) {
@@ -124,8 +125,8 @@ proxy_pose random_pose(std::mt19937& rng, const random_pose_limits& L) {
   if (L.expressions) {
     if (uniform(rng, 0.f, 1.f) < 0.5f) p[expression::blink] = uniform(rng, 0.f, 1.f);
     if (uniform(rng, 0.f, 1.f) < 0.25f) {
-      expression e = uniform(rng, 0.f, 1.f) < 0.5f ? expression::blink_left
-                                                   : expression::blink_right;
+      expression e =
+          uniform(rng, 0.f, 1.f) < 0.5f ? expression::blink_left : expression::blink_right;
       p[e] = uniform(rng, 0.f, 1.f - p[expression::blink]);
     }
     int viseme = static_cast<int>(uniform(rng, 0.f, 6.f));
@@ -169,11 +170,11 @@ proxy_pose demo_motion_pose(double t_seconds, const synth_skeleton& skeleton) {
 
   // Squats (0-4 s): thighs forward, shins back, feet flat, torso leaning, arms forward.
   const float k = t < 4.f ? 0.5f * (1.f - std::cos(two_pi * t / 2.f)) : 0.f;
-  const glm::quat hips = axis_angle(k_x, 25.f * k_deg * k) *
-                         axis_angle(k_y, 10.f * k_deg * std::sin(two_pi * t / 10.f));
+  // Yaw first, then lean in the yawed frame: both hip joints stay at the same height.
+  const glm::quat yaw_only = axis_angle(k_y, 10.f * k_deg * std::sin(two_pi * t / 10.f));
+  const glm::quat hips = yaw_only * axis_angle(k_x, 25.f * k_deg * k);
   const glm::quat thigh_world = axis_angle(-k_x, 75.f * k_deg * k);
   const glm::quat shin_world = axis_angle(k_x, 30.f * k_deg * k);
-  const glm::quat yaw_only = axis_angle(k_y, 10.f * k_deg * std::sin(two_pi * t / 10.f));
   p[bone::hips] = hips;
   p[bone::left_upper_leg] = glm::inverse(hips) * yaw_only * thigh_world;
   p[bone::right_upper_leg] = p[bone::left_upper_leg];
@@ -196,8 +197,7 @@ proxy_pose demo_motion_pose(double t_seconds, const synth_skeleton& skeleton) {
   const glm::quat raised = axis_angle(k_z, 20.f * k_deg) * axis_angle(k_x, -90.f * k_deg);
   const glm::quat right_upper = slerp_shortest(left_arm, raised, wave);
   p[bone::right_upper_arm] = mirror_x(right_upper);
-  p[bone::right_lower_arm] =
-      mirror_x(axis_angle(-k_y, wave * (90.f + 20.f * swing) * k_deg));
+  p[bone::right_lower_arm] = mirror_x(axis_angle(-k_y, wave * (90.f + 20.f * swing) * k_deg));
   p[bone::right_hand] = mirror_x(axis_angle(k_y, wave * 15.f * swing * k_deg));
 
   // Left-hand finger curls (5-9 s), two of them.
@@ -214,8 +214,8 @@ proxy_pose demo_motion_pose(double t_seconds, const synth_skeleton& skeleton) {
   p[bone::right_eye] = eye;
 
   // Expressions: blinks, talking (6-9.5 s), brows up while waving.
-  p[expression::blink] = pulse(1.0f, 0.15f, t) + pulse(3.3f, 0.15f, t) + pulse(5.6f, 0.15f, t) +
-                         pulse(8.2f, 0.15f, t);
+  p[expression::blink] =
+      pulse(1.0f, 0.15f, t) + pulse(3.3f, 0.15f, t) + pulse(5.6f, 0.15f, t) + pulse(8.2f, 0.15f, t);
   p[expression::blink_left] = pulse(9.5f, 0.2f, t);  // a wink
   const float talk = envelope(6.f, 9.5f, 0.3f, t);
   const float phase = (t - 6.f) / 0.35f;

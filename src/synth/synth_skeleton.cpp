@@ -33,7 +33,7 @@ constexpr float k_toes = 0.04f;   // toe joint -> toe tip
 constexpr float k_clavicle = 0.15f;
 constexpr float k_upper_arm = 0.28f;
 constexpr float k_forearm = 0.25f;
-constexpr float k_hand = 0.095f;  // wrist -> middle-finger MCP
+constexpr float k_hand = 0.095f;                      // wrist -> middle-finger MCP
 const glm::vec3 k_shoulder_joint{0.02f, 0.15f, 0.f};  // on the upperChest
 const glm::vec3 k_eye_joint{0.031f, 0.11f, 0.075f};   // eyeball centre on the head
 const glm::vec3 k_jaw_joint{0.f, 0.03f, 0.02f};
@@ -122,17 +122,17 @@ void compute_synth_fk(const synth_skeleton& skeleton, const proxy_pose& pose, sy
   compute_world_rotations(pose, out.world);
   for (int b = 0; b < k_bone_count; ++b) {
     int p = bone_parent(b);
-    out.joints[b] = p == k_no_parent ? pose.hips_position
-                                     : out.joints[p] + out.world[p] * skeleton.offsets[b];
+    out.joints[b] =
+        p == k_no_parent ? pose.hips_position : out.joints[p] + out.world[p] * skeleton.offsets[b];
   }
   for (int b = 0; b < k_bone_count; ++b) {
     out.tips[b] = out.joints[b] +
                   out.world[b] * (skeleton.lengths[b] * bone_rest_direction(static_cast<bone>(b)));
   }
-  out.heels[0] = out.joints[idx(bone::left_foot)] +
-                 out.world[idx(bone::left_foot)] * skeleton.heel_offset;
-  out.heels[1] = out.joints[idx(bone::right_foot)] +
-                 out.world[idx(bone::right_foot)] * skeleton.heel_offset;
+  out.heels[0] =
+      out.joints[idx(bone::left_foot)] + out.world[idx(bone::left_foot)] * skeleton.heel_offset;
+  out.heels[1] =
+      out.joints[idx(bone::right_foot)] + out.world[idx(bone::right_foot)] * skeleton.heel_offset;
 }
 
 void joint_world_positions(const synth_skeleton& skeleton, const proxy_pose& pose,
@@ -141,8 +141,8 @@ void joint_world_positions(const synth_skeleton& skeleton, const proxy_pose& pos
   compute_world_rotations(pose, world);
   for (int b = 0; b < k_bone_count; ++b) {
     int p = bone_parent(b);
-    out_joints[b] = p == k_no_parent ? pose.hips_position
-                                     : out_joints[p] + world[p] * skeleton.offsets[b];
+    out_joints[b] =
+        p == k_no_parent ? pose.hips_position : out_joints[p] + world[p] * skeleton.offsets[b];
   }
 }
 

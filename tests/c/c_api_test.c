@@ -10,22 +10,22 @@
 
 static int g_failures = 0;
 
-#define CHECK(cond)                                                   \
-  do {                                                                \
-    if (!(cond)) {                                                    \
+#define CHECK(cond)                                                            \
+  do {                                                                         \
+    if (!(cond)) {                                                             \
       fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond); \
-      ++g_failures;                                                   \
-    }                                                                 \
+      ++g_failures;                                                            \
+    }                                                                          \
   } while (0)
 
-#define CHECK_STATUS(expr, expected)                                            \
-  do {                                                                          \
-    avm_status st_ = (expr);                                                    \
-    if (st_ != (expected)) {                                                    \
+#define CHECK_STATUS(expr, expected)                                                     \
+  do {                                                                                   \
+    avm_status st_ = (expr);                                                             \
+    if (st_ != (expected)) {                                                             \
       fprintf(stderr, "%s:%d: %s returned %s, expected %s\n", __FILE__, __LINE__, #expr, \
-              avm_status_string(st_), avm_status_string(expected));             \
-      ++g_failures;                                                             \
-    }                                                                           \
+              avm_status_string(st_), avm_status_string(expected));                      \
+      ++g_failures;                                                                      \
+    }                                                                                    \
   } while (0)
 
 /* ---- a hand-built T-pose ------------------------------------------------------------- */
@@ -34,22 +34,22 @@ static int g_failures = 0;
  * y down, z away from the camera) of a person facing a non-mirrored camera in a T-pose: the
  * person's left (odd indices) is at +x. */
 static const float k_tpose_world[AVM_POSE_LANDMARK_COUNT][3] = {
-    {0.f, -0.62f, -0.10f},                                            /* 0 nose */
-    {0.015f, -0.65f, -0.08f}, {0.03f, -0.65f, -0.08f}, {0.045f, -0.65f, -0.07f}, /* 1-3 */
-    {-0.015f, -0.65f, -0.08f}, {-0.03f, -0.65f, -0.08f}, {-0.045f, -0.65f, -0.07f}, /* 4-6 */
-    {0.075f, -0.63f, 0.f},      {-0.075f, -0.63f, 0.f},               /* 7, 8 ears */
-    {0.025f, -0.57f, -0.09f},   {-0.025f, -0.57f, -0.09f},            /* 9, 10 mouth */
-    {0.18f, -0.50f, 0.f},       {-0.18f, -0.50f, 0.f},                /* 11, 12 shoulders */
-    {0.45f, -0.50f, 0.f},       {-0.45f, -0.50f, 0.f},                /* 13, 14 elbows */
-    {0.70f, -0.50f, 0.f},       {-0.70f, -0.50f, 0.f},                /* 15, 16 wrists */
-    {0.78f, -0.50f, 0.03f},     {-0.78f, -0.50f, 0.03f},              /* 17, 18 pinky */
-    {0.80f, -0.50f, -0.02f},    {-0.80f, -0.50f, -0.02f},             /* 19, 20 index */
-    {0.75f, -0.50f, -0.05f},    {-0.75f, -0.50f, -0.05f},             /* 21, 22 thumb */
-    {0.10f, 0.f, 0.f},          {-0.10f, 0.f, 0.f},                   /* 23, 24 hips */
-    {0.10f, 0.45f, 0.f},        {-0.10f, 0.45f, 0.f},                 /* 25, 26 knees */
-    {0.10f, 0.88f, 0.f},        {-0.10f, 0.88f, 0.f},                 /* 27, 28 ankles */
-    {0.10f, 0.92f, 0.05f},      {-0.10f, 0.92f, 0.05f},               /* 29, 30 heels */
-    {0.10f, 0.95f, -0.12f},     {-0.10f, 0.95f, -0.12f}};             /* 31, 32 toes */
+    {0.f, -0.62f, -0.10f},                                                           /* 0 nose */
+    {0.015f, -0.65f, -0.08f},  {0.03f, -0.65f, -0.08f},   {0.045f, -0.65f, -0.07f},  /* 1-3 */
+    {-0.015f, -0.65f, -0.08f}, {-0.03f, -0.65f, -0.08f},  {-0.045f, -0.65f, -0.07f}, /* 4-6 */
+    {0.075f, -0.63f, 0.f},     {-0.075f, -0.63f, 0.f},                               /* 7, 8 ears */
+    {0.025f, -0.57f, -0.09f},  {-0.025f, -0.57f, -0.09f}, /* 9, 10 mouth */
+    {0.18f, -0.50f, 0.f},      {-0.18f, -0.50f, 0.f},     /* 11, 12 shoulders */
+    {0.45f, -0.50f, 0.f},      {-0.45f, -0.50f, 0.f},     /* 13, 14 elbows */
+    {0.70f, -0.50f, 0.f},      {-0.70f, -0.50f, 0.f},     /* 15, 16 wrists */
+    {0.78f, -0.50f, 0.03f},    {-0.78f, -0.50f, 0.03f},   /* 17, 18 pinky */
+    {0.80f, -0.50f, -0.02f},   {-0.80f, -0.50f, -0.02f},  /* 19, 20 index */
+    {0.75f, -0.50f, -0.05f},   {-0.75f, -0.50f, -0.05f},  /* 21, 22 thumb */
+    {0.10f, 0.f, 0.f},         {-0.10f, 0.f, 0.f},        /* 23, 24 hips */
+    {0.10f, 0.45f, 0.f},       {-0.10f, 0.45f, 0.f},      /* 25, 26 knees */
+    {0.10f, 0.88f, 0.f},       {-0.10f, 0.88f, 0.f},      /* 27, 28 ankles */
+    {0.10f, 0.92f, 0.05f},     {-0.10f, 0.92f, 0.05f},    /* 29, 30 heels */
+    {0.10f, 0.95f, -0.12f},    {-0.10f, 0.95f, -0.12f}};  /* 31, 32 toes */
 
 typedef struct test_frame {
   avm_landmark pose[AVM_POSE_LANDMARK_COUNT];
@@ -108,8 +108,8 @@ static int rotations_are_unit(const avm_pose* p) {
   int b;
   for (b = 0; b < AVM_BONE_COUNT; ++b) {
     const float* q = p->rotations[b];
-    double n = sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] +
-                    (double)q[3] * q[3]);
+    double n =
+        sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] + (double)q[3] * q[3]);
     if (fabs(n - 1.0) > 1e-3) return 0;
   }
   return 1;
@@ -117,8 +117,8 @@ static int rotations_are_unit(const avm_pose* p) {
 
 /* Angle in radians between two {x, y, z, w} rotations (q and -q are the same rotation). */
 static double quat_angle(const float* a, const float* b) {
-  double d = fabs((double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2] +
-                  (double)a[3] * b[3]);
+  double d =
+      fabs((double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2] + (double)a[3] * b[3]);
   if (d > 1.0) d = 1.0;
   return 2.0 * acos(d);
 }
@@ -468,8 +468,7 @@ static void test_sample_between_pushes(void) {
   {
     int k;
     for (k = 0; k < 3; ++k)
-      CHECK(fabs(mid.hips_position[k] - 0.5f * (a.hips_position[k] + b.hips_position[k])) <
-            1e-4);
+      CHECK(fabs(mid.hips_position[k] - 0.5f * (a.hips_position[k] + b.hips_position[k])) < 1e-4);
   }
 
   /* Before the first frame: held at the first; long after the last: finite (extrapolation is
@@ -493,8 +492,9 @@ static int write_landmark_file(const char* path) {
   int frame, i;
   test_frame f;
   if (fp == NULL) return 0;
-  fprintf(fp, "{\"format\":\"avatarmap.landmarks\",\"version\":1,\"image_size\":[640,480],"
-              "\"fps\":10}\n");
+  fprintf(fp,
+          "{\"format\":\"avatarmap.landmarks\",\"version\":1,\"image_size\":[640,480],"
+          "\"fps\":10}\n");
   for (frame = 0; frame < 3; ++frame) {
     make_tpose(&f, 0.1 * frame, 0.2f * (float)frame);
     fprintf(fp, "{\"t\":%.3f,\"pose\":[", 0.1 * frame);

@@ -1,10 +1,10 @@
 /* Compiles avatarmap.h alone as strict C99 (-std=c99 -pedantic -Werror) and checks at run
  * time that its types have the layout FFI users rely on. No library calls: this target does
  * not link avatarmap_c. */
-#include "avatarmap/avatarmap.h"
-
 #include <stddef.h>
 #include <stdio.h>
+
+#include "avatarmap/avatarmap.h"
 
 int main(void) {
   avm_pose pose;

@@ -3,13 +3,12 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <random>
-#include <string>
-
 #include <Eigen/Geometry>
+#include <cmath>
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <random>
+#include <string>
 
 namespace avatarmap {
 namespace {
@@ -18,8 +17,9 @@ constexpr double k_pi_d = 3.14159265358979323846;
 constexpr float k_pi = static_cast<float>(k_pi_d);
 
 Eigen::Vector3d unit_axis(char c) {
-  return c == 'X' ? Eigen::Vector3d::UnitX()
-                  : c == 'Y' ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
+  return c == 'X'   ? Eigen::Vector3d::UnitX()
+         : c == 'Y' ? Eigen::Vector3d::UnitY()
+                    : Eigen::Vector3d::UnitZ();
 }
 int axis_index(char c) { return c - 'X'; }
 

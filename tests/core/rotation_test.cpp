@@ -5,11 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 #include <random>
-
-#include <Eigen/Geometry>
 
 namespace avatarmap {
 namespace {
@@ -60,8 +59,7 @@ TEST(rotation_angle, matches_eigen_angular_distance) {
     const glm::vec3 axis = r.unit();
     const float angle = r.uniform(-3.f, 3.f);
     const glm::quat q = axis_angle(axis, angle);
-    EXPECT_LT(rot_distance(q, Eigen::Quaterniond(Eigen::AngleAxisd(angle, to_eigen(axis)))),
-              2e-6);
+    EXPECT_LT(rot_distance(q, Eigen::Quaterniond(Eigen::AngleAxisd(angle, to_eigen(axis)))), 2e-6);
   }
 }
 
@@ -134,8 +132,7 @@ TEST(rotation_between, random_pairs_match_eigen) {
     EXPECT_NEAR(glm::length(q), 1.f, 1e-5f);
     EXPECT_LT(glm::length(q * from - to), 1e-5f);
     // Shortest: the angle is the angle between the vectors, as Eigen's FromTwoVectors.
-    const Eigen::Quaterniond e =
-        Eigen::Quaterniond::FromTwoVectors(to_eigen(from), to_eigen(to));
+    const Eigen::Quaterniond e = Eigen::Quaterniond::FromTwoVectors(to_eigen(from), to_eigen(to));
     EXPECT_LT(rot_distance(q, e), 2e-4) << i;
   }
 }
@@ -150,8 +147,8 @@ TEST(rotation_between, identical_and_antiparallel) {
     EXPECT_NEAR(rotation_angle(q), k_pi, 1e-5f);
     EXPECT_LT(glm::length(q * v + v), 1e-5f);
   }
-  for (glm::vec3 v : {glm::vec3(1.f, 0.f, 0.f), glm::vec3(-1.f, 0.f, 0.f),
-                      glm::vec3(0.f, 1.f, 0.f), glm::vec3(0.f, 0.f, -1.f)}) {
+  for (glm::vec3 v : {glm::vec3(1.f, 0.f, 0.f), glm::vec3(-1.f, 0.f, 0.f), glm::vec3(0.f, 1.f, 0.f),
+                      glm::vec3(0.f, 0.f, -1.f)}) {
     const glm::quat q = rotation_between(v, -v);
     EXPECT_LT(glm::length(q * v + v), 1e-6f);
     const glm::vec3 axis(q.x, q.y, q.z);
@@ -239,8 +236,8 @@ TEST(frame_from_two_vectors, maps_primary_exactly_and_secondary_into_the_half_pl
     EXPECT_NEAR(glm::dot(qs, n), 0.f, 2e-5f);
     const glm::vec3 pn = glm::normalize(p);
     const glm::vec3 s_perp = glm::normalize(s - glm::dot(s, pn) * pn);
-    const glm::vec3 rest_perp = glm::normalize(rest_s - glm::dot(rest_s, glm::normalize(rest_p)) *
-                                                            glm::normalize(rest_p));
+    const glm::vec3 rest_perp =
+        glm::normalize(rest_s - glm::dot(rest_s, glm::normalize(rest_p)) * glm::normalize(rest_p));
     EXPECT_GT(glm::dot(qs, s_perp), 0.f);
     EXPECT_LT(glm::length(q * rest_perp - s_perp), 2e-5f);
   }
@@ -282,9 +279,9 @@ TEST(mirror_x, equals_m_r_m_with_eigen_matrices) {
     EXPECT_LT(glm::length(mirror_x(q) * mirror_x(v) - mirror_x(q * v)), 1e-5f);
   }
   // Known answers: about X unchanged; about Y and Z reversed.
-  EXPECT_LT(angle_between(mirror_x(axis_angle({1.f, 0.f, 0.f}, 0.6f)),
-                          axis_angle({1.f, 0.f, 0.f}, 0.6f)),
-            1e-6f);
+  EXPECT_LT(
+      angle_between(mirror_x(axis_angle({1.f, 0.f, 0.f}, 0.6f)), axis_angle({1.f, 0.f, 0.f}, 0.6f)),
+      1e-6f);
   EXPECT_LT(angle_between(mirror_x(axis_angle({0.f, 1.f, 0.f}, 0.6f)),
                           axis_angle({0.f, 1.f, 0.f}, -0.6f)),
             1e-6f);

@@ -39,15 +39,16 @@ TEST(spaces, image_to_vrm_pixels_known_answers) {
 // In a raw (non-mirrored) image a person facing the camera has their left side at larger x;
 // in VRM space the avatar's left is +X.
 TEST(spaces, persons_left_maps_to_vrm_plus_x) {
-  const glm::vec3 left_shoulder_img(0.62f, 0.40f, -0.1f);   // larger x
+  const glm::vec3 left_shoulder_img(0.62f, 0.40f, -0.1f);  // larger x
   const glm::vec3 right_shoulder_img(0.38f, 0.41f, -0.1f);
   const glm::vec3 l = image_to_vrm_pixels(left_shoulder_img, 640.f, 480.f);
   const glm::vec3 r = image_to_vrm_pixels(right_shoulder_img, 640.f, 480.f);
   EXPECT_GT(l.x - r.x, 0.f);
   // Same for world landmarks (x toward image right).
   EXPECT_GT(world_to_vrm({0.18f, -0.45f, 0.f}).x - world_to_vrm({-0.18f, -0.45f, 0.f}).x, 0.f);
-  // And MediaPipe's own convention: odd pose indices are the person's left.
-  EXPECT_EQ(k_pose_landmark_count, 33);
+  // MediaPipe's convention: odd pose indices are the person's left.
+  EXPECT_EQ(idx(pose_landmark::left_shoulder) % 2, 1);
+  EXPECT_EQ(idx(pose_landmark::right_shoulder) % 2, 0);
 }
 
 }  // namespace

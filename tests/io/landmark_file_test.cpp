@@ -245,8 +245,9 @@ TEST(landmark_file, non_finite_values_are_written_as_null_and_read_as_not_seen) 
 }
 
 TEST(landmark_file, special_numbers) {
-  std::string pose = "[[null,1e400,-1e400,1,1],[1e308,-1e308,1e-400,1,1],[NaN,Infinity,-Infinity],"
-                     "[-0,1e-7,1E+2],[0.5e1,-2.5E-3,123456789012345678901234567890]";
+  std::string pose =
+      "[[null,1e400,-1e400,1,1],[1e308,-1e308,1e-400,1,1],[NaN,Infinity,-Infinity],"
+      "[-0,1e-7,1E+2],[0.5e1,-2.5E-3,123456789012345678901234567890]";
   for (int i = 5; i < 33; ++i) pose += ",[0,0,0]";
   pose += "]";
   auto o = read_one("{\"t\":1,\"pose\":" + pose + "}\n");
@@ -414,8 +415,9 @@ TEST(landmark_file, header_rules) {
     EXPECT_EQ(r.next(f), read_result::frame);
   }
   {
-    std::string t = "\n  \n{\"version\":1,\"image_size\":[640,480],\"x\":[1],"
-                    "\"format\":\"avatarmap.landmarks\"}\n{\"t\":0}\n";
+    std::string t =
+        "\n  \n{\"version\":1,\"image_size\":[640,480],\"x\":[1],"
+        "\"format\":\"avatarmap.landmarks\"}\n{\"t\":0}\n";
     landmark_reader r;
     ASSERT_TRUE(r.open_memory(t.data(), t.size()).ok());
     EXPECT_TRUE(r.header().present);
@@ -452,8 +454,10 @@ TEST(landmark_file, blank_lines_crlf_bom_and_last_line_without_newline) {
   temp_dir dir;
   const std::string path = dir.file("crlf.jsonl");
   std::string pose = points_json(33);
-  write_text(path, "\xEF\xBB\xBF{\"format\":\"avatarmap.landmarks\",\"version\":1}\r\n\r\n"
-                   "{\"t\":1,\"pose\":" + pose + "}\r\n   \r\n\t\n{\"t\":2}\r\n{\"t\":3}");
+  write_text(path,
+             "\xEF\xBB\xBF{\"format\":\"avatarmap.landmarks\",\"version\":1}\r\n\r\n"
+             "{\"t\":1,\"pose\":" +
+                 pose + "}\r\n   \r\n\t\n{\"t\":2}\r\n{\"t\":3}");
   landmark_reader r;
   ASSERT_TRUE(r.open(path).ok());
   EXPECT_TRUE(r.header().present);
@@ -496,8 +500,10 @@ TEST(landmark_file, lines_across_block_boundaries_read_the_same_for_every_block_
   std::string text = read_text(path);
   std::string crlf;
   for (char c : text) {
-    if (c == '\n') crlf += "\r\n\n";
-    else crlf += c;
+    if (c == '\n')
+      crlf += "\r\n\n";
+    else
+      crlf += c;
   }
   write_text(path, crlf);
   for (std::size_t block : {1u, 2u, 7u, 100u, 4093u, 65536u}) {
@@ -521,8 +527,8 @@ TEST(landmark_file, very_long_lines_and_the_line_cap) {
   const std::string path = dir.file("long.jsonl");
   // A 3 MiB line (an unknown key with a long string) spans several 1 MiB blocks.
   std::string big(3u << 20, 'x');
-  write_text(path, "{\"t\":1,\"junk\":\"" + big + "\",\"pose\":" + points_json(33) +
-                       "}\n{\"t\":2}\n");
+  write_text(path,
+             "{\"t\":1,\"junk\":\"" + big + "\",\"pose\":" + points_json(33) + "}\n{\"t\":2}\n");
   {
     landmark_reader r;
     ASSERT_TRUE(r.open(path).ok());

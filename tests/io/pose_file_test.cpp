@@ -22,8 +22,8 @@ class temp_dir {
  public:
   temp_dir() {
     static int counter = 0;
-    path_ = fs::temp_directory_path() / ("avatarmap_pose_test_" + std::to_string(::getpid()) +
-                                         "_" + std::to_string(++counter));
+    path_ = fs::temp_directory_path() /
+            ("avatarmap_pose_test_" + std::to_string(::getpid()) + "_" + std::to_string(++counter));
     fs::remove_all(path_);
     fs::create_directories(path_);
   }
@@ -174,8 +174,7 @@ TEST(pose_file, malformed_lines) {
     const char* expected;
   };
   std::vector<bad_case> cases = {
-      {"{\"t\":0,\"bones\":{\"leftElbow\":[0,0,0,1]}}",
-       "unknown bone \"leftElbow\" in \"bones\""},
+      {"{\"t\":0,\"bones\":{\"leftElbow\":[0,0,0,1]}}", "unknown bone \"leftElbow\" in \"bones\""},
       {"{\"t\":0,\"bones\":{\"hips\":[0,0,null,1]}}", "bone \"hips\" has a null value"},
       {"{\"t\":0,\"bones\":{\"spine\":[0,0,0,0]}}", "bone \"spine\" is a zero quaternion"},
       {"{\"t\":0,\"bones\":{\"spine\":[0,0,1e400,1]}}", "bone \"spine\" has a non-finite"},

@@ -29,11 +29,18 @@ glm::vec3 v3(const landmark& l) { return glm::vec3(l.x, l.y, l.z); }
 
 int primary_child(int b) {
   switch (static_cast<bone>(b)) {
-    case bone::upper_chest: return idx(bone::neck);
-    case bone::hips: return idx(bone::spine);
-    case bone::left_hand: return idx(bone::left_middle_proximal);
-    case bone::right_hand: return idx(bone::right_middle_proximal);
-    default: break;
+    case bone::upper_chest:
+      return idx(bone::neck);
+    case bone::hips:
+      return idx(bone::spine);
+    case bone::head:
+      return -1;  // leaf: its length reaches the top of the head
+    case bone::left_hand:
+      return idx(bone::left_middle_proximal);
+    case bone::right_hand:
+      return idx(bone::right_middle_proximal);
+    default:
+      break;
   }
   for (int c = b + 1; c < k_bone_count; ++c)
     if (bone_parent(c) == b) return c;
@@ -117,7 +124,8 @@ TEST(SynthFk, MatchesIndependentEigenFk) {
         EXPECT_NEAR(fk.joints[b][k], joints[b][k], 1e-5f);
       }
       glm::vec3 r = bone_rest_direction(static_cast<bone>(b)) * s.lengths[b];
-      Eigen::Vector3f tip = joints[b] + world[b].toRotationMatrix() * Eigen::Vector3f(r.x, r.y, r.z);
+      Eigen::Vector3f tip =
+          joints[b] + world[b].toRotationMatrix() * Eigen::Vector3f(r.x, r.y, r.z);
       for (int k = 0; k < 3; ++k) EXPECT_NEAR(fk.tips[b][k], tip[k], 1e-5f);
     }
     // The generator's landmarks are these joints.
@@ -125,20 +133,29 @@ TEST(SynthFk, MatchesIndependentEigenFk) {
     landmark_frame f;
     gen.generate(p, f);
     const auto& P = gen.points().pose;
-    const bone body[18] = {bone::left_upper_arm,       bone::right_upper_arm,
-                           bone::left_lower_arm,       bone::right_lower_arm,
-                           bone::left_hand,            bone::right_hand,
-                           bone::left_little_proximal, bone::right_little_proximal,
-                           bone::left_index_proximal,  bone::right_index_proximal,
-                           bone::left_thumb_proximal,  bone::right_thumb_proximal,
-                           bone::left_upper_leg,       bone::right_upper_leg,
-                           bone::left_lower_leg,       bone::right_lower_leg,
-                           bone::left_foot,            bone::right_foot};
+    const bone body[18] = {bone::left_upper_arm,
+                           bone::right_upper_arm,
+                           bone::left_lower_arm,
+                           bone::right_lower_arm,
+                           bone::left_hand,
+                           bone::right_hand,
+                           bone::left_little_proximal,
+                           bone::right_little_proximal,
+                           bone::left_index_proximal,
+                           bone::right_index_proximal,
+                           bone::left_thumb_proximal,
+                           bone::right_thumb_proximal,
+                           bone::left_upper_leg,
+                           bone::right_upper_leg,
+                           bone::left_lower_leg,
+                           bone::right_lower_leg,
+                           bone::left_foot,
+                           bone::right_foot};
     for (int i = 0; i < 18; ++i)
       for (int k = 0; k < 3; ++k) EXPECT_NEAR(P[11 + i][k], joints[idx(body[i])][k], 1e-5f);
-    Eigen::Vector3f heel = joints[idx(bone::left_foot)] +
-                           world[idx(bone::left_foot)].toRotationMatrix() *
-                               Eigen::Vector3f(0.f, -0.07f, -0.06f) * s.scale;
+    Eigen::Vector3f heel =
+        joints[idx(bone::left_foot)] + world[idx(bone::left_foot)].toRotationMatrix() *
+                                           Eigen::Vector3f(0.f, -0.07f, -0.06f) * s.scale;
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(P[29][k], heel[k], 1e-5f);
     const auto& H = gen.points().right_hand;
     for (int k = 0; k < 3; ++k) {
@@ -362,8 +379,13 @@ TEST(Synth, MirrorSwapsSidesAndFlipsX) {
       EXPECT_NEAR(b.right_hand_world[i].x, -a.left_hand_world[i].x, 1e-5f);
       EXPECT_NEAR(b.right_hand_world[i].z, a.left_hand_world[i].z, 1e-5f);
     }
-    for (auto [l, r] : {std::array<int, 2>{263, 130}, {362, 133}, {386, 159}, {374, 145},
-                        {454, 234}, {473, 468}, {291, 61}}) {
+    for (auto [l, r] : {std::array<int, 2>{263, 130},
+                        {362, 133},
+                        {386, 159},
+                        {374, 145},
+                        {454, 234},
+                        {473, 468},
+                        {291, 61}}) {
       EXPECT_NEAR(b.face[l].x, 1.f - a.face[r].x, 1e-5f) << l;
       EXPECT_NEAR(b.face[l].y, a.face[r].y, 1e-5f) << l;
     }
@@ -406,8 +428,8 @@ TEST(Synth, ExpressionsDriveTheFace) {
   p[expression::brow_up_left] = 1.f;
   p[expression::brow_down_right] = 1.f;
   const float yaw = 0.3f, pitch = 0.2f;
-  glm::quat eye = axis_angle(glm::vec3(0.f, 1.f, 0.f), yaw) *
-                  axis_angle(glm::vec3(1.f, 0.f, 0.f), pitch);
+  glm::quat eye =
+      axis_angle(glm::vec3(0.f, 1.f, 0.f), yaw) * axis_angle(glm::vec3(1.f, 0.f, 0.f), pitch);
   p[bone::left_eye] = eye;
   landmark_frame f;
   gen.generate(p, f);
@@ -424,11 +446,9 @@ TEST(Synth, ExpressionsDriveTheFace) {
   EXPECT_NEAR(glm::length(F[291] - F[61]), width, 1e-5f);
   EXPECT_NEAR(glm::dot(F[13] - F[14], up), open * width, 1e-5f);
   EXPECT_NEAR(blend_visemes(p).open, open, 1e-6f);
-  EXPECT_NEAR(glm::dot(F[334] - gen.points().head_joint, up) -
-                  face_template_point(334, s).y,
+  EXPECT_NEAR(glm::dot(F[334] - gen.points().head_joint, up) - face_template_point(334, s).y,
               0.008f * s, 1e-5f);
-  EXPECT_NEAR(glm::dot(F[105] - gen.points().head_joint, up) -
-                  face_template_point(105, s).y,
+  EXPECT_NEAR(glm::dot(F[105] - gen.points().head_joint, up) - face_template_point(105, s).y,
               -0.005f * s, 1e-5f);
   // Left iris moved toward +X and down (positive pitch turns the gaze down); right one not.
   glm::vec3 dl = F[473] - (gen.points().head_joint + head * face_template_point(473, s));
@@ -457,9 +477,10 @@ TEST(RandomPose, FingersFlexTowardThePalmOnBothHands) {
     }
     synth_fk fk;
     compute_synth_fk(s, hands, fk);
-    for (bone tip : {bone::left_index_distal, bone::right_ring_distal, bone::left_little_distal,
-                     bone::right_middle_distal})
-      EXPECT_LT(fk.tips[idx(tip)].y, hands.hips_position.y + 0.2f * 0 + fk.joints[idx(bone::left_hand)].y + 1e-4f);
+    // Flexion in [0, 110] degrees: each intermediate joint lies at or below its knuckle.
+    for (bone prox : {bone::left_index_proximal, bone::right_ring_proximal,
+                      bone::left_little_proximal, bone::right_middle_proximal})
+      EXPECT_LE(fk.joints[idx(prox) + 1].y, fk.joints[idx(prox)].y + 1e-6f);
   }
   // A single flexion: left and right tips go down by the same amount.
   proxy_pose p;
@@ -480,6 +501,12 @@ TEST(DemoMotion, FeetOnTheFloorHipsLowerAndLoops) {
   EXPECT_NEAR(a.hips_position.y, standing, 1e-3f);
   EXPECT_LT(squat.hips_position.y, standing - 0.15f);
   EXPECT_NEAR(lowest_foot_point(s, squat), 0.f, 1e-5f);
+  synth_fk sq;
+  compute_synth_fk(s, squat, sq);  // feet stay flat: heel and toe tip on the floor
+  EXPECT_NEAR(sq.heels[0].y, 0.f, 1e-3f);
+  EXPECT_NEAR(sq.tips[idx(bone::right_toes)].y, 0.f, 1e-3f);
+  EXPECT_GT(sq.joints[idx(bone::left_lower_leg)].z,
+            sq.joints[idx(bone::left_foot)].z);  // knees forward
   for (int i = 0; i < k_bone_count; ++i)
     EXPECT_LT(angle_between(a.rotations[i], b.rotations[i]), 1e-3f);
   landmark_synth gen(all_parts());

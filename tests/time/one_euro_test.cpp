@@ -4,11 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <limits>
-#include <random>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <limits>
+#include <random>
 
 #include "avatarmap/core/rotation.hpp"
 
@@ -90,7 +89,8 @@ TEST(one_euro_filter, two_sample_rates_give_the_same_time_response) {
     EXPECT_NEAR(y30, y120, 0.03) << t;
     EXPECT_NEAR(y120, exact, 0.012) << t;
     // A filter with a fixed per-sample factor (SysMocap's "slerp 0.3 per frame") differs a lot.
-    const int n30 = static_cast<int>(std::lround(t * 30)), n120 = static_cast<int>(std::lround(t * 120));
+    const int n30 = static_cast<int>(std::lround(t * 30)),
+              n120 = static_cast<int>(std::lround(t * 120));
     if (t <= 0.2) {
       EXPECT_GT(std::pow(0.7, n30) - std::pow(0.7, n120), 0.1) << t;
     }
@@ -253,14 +253,29 @@ TEST(one_euro_filter_quat, never_produces_non_finite_output) {
     glm::quat q(u(rng), u(rng), u(rng), u(rng));
     float dt = 0.001f + 0.05f * (u(rng) + 1.f);
     switch (kind(rng)) {
-      case 0: q = glm::quat(k_nan, q.x, q.y, q.z); break;
-      case 1: q = glm::quat(0.f, 0.f, 0.f, 0.f); break;
-      case 2: q = -f.value(); break;
-      case 3: dt = 0.f; break;
-      case 4: dt = k_inf; break;
-      case 5: q = q * 1e-7f; break;  // tiny but not zero: normalised
-      case 6: dt = 1e-9f; break;
-      default: break;
+      case 0:
+        q = glm::quat(k_nan, q.x, q.y, q.z);
+        break;
+      case 1:
+        q = glm::quat(0.f, 0.f, 0.f, 0.f);
+        break;
+      case 2:
+        q = -f.value();
+        break;
+      case 3:
+        dt = 0.f;
+        break;
+      case 4:
+        dt = k_inf;
+        break;
+      case 5:
+        q = q * 1e-7f;
+        break;  // tiny but not zero: normalised
+      case 6:
+        dt = 1e-9f;
+        break;
+      default:
+        break;
     }
     const glm::quat y = f(q, dt);
     ASSERT_TRUE(is_finite(y)) << i;

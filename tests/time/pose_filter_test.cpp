@@ -123,8 +123,8 @@ TEST(pose_filter, duplicate_time_holds_and_backwards_time_resets) {
   proxy_pose out, out2;
   f.apply(random_pose(rng, 1.0), out);
   f.apply(random_pose(rng, 1.0 + 1 / 30.0), out);
-  f.apply(random_pose(rng, 1.0 + 1 / 30.0), out2);  // same t: previous output again
-  expect_same_pose(out, out2, 1e-6f, false);  // confidence is the input's
+  f.apply(random_pose(rng, 1.0 + 1 / 30.0), out2);   // same t: previous output again
+  expect_same_pose(out, out2, 1e-6f, false);         // confidence is the input's
   const proxy_pose restart = random_pose(rng, 0.5);  // earlier: restart, passes through
   f.apply(restart, out);
   expect_same_pose(out, restart, 1e-6f);
@@ -153,7 +153,8 @@ TEST(pose_filter, non_finite_values_are_held) {
 
 // The defaults damp capture jitter of a still body: a 30 fps rotation with ~1 degree of noise
 // comes out at least twice as quiet (a first-order low-pass at 1.5 Hz passes ~37 % of white
-// noise's RMS at 30 fps; the speed term adds a little), and a moving bone is followed with bounded lag.
+// noise's RMS at 30 fps; the speed term adds a little), and a moving bone is followed with bounded
+// lag.
 TEST(pose_filter, defaults_reduce_jitter_and_follow_motion) {
   std::mt19937 rng(7);
   std::normal_distribution<float> noise(0.f, 0.01f);  // rad per axis, ~1 degree
@@ -197,12 +198,23 @@ TEST(pose_filter, never_non_finite_on_random_garbage) {
   for (int i = 0; i < 500; ++i) {
     proxy_pose in = random_pose(rng, t);
     switch (kind(rng)) {
-      case 0: in.rotations[i % k_bone_count] = glm::quat(k_nan, k_nan, 0.f, 0.f); break;
-      case 1: in.hips_position.x = k_nan; break;
-      case 2: in.expressions[i % k_expression_count] = -std::numeric_limits<float>::infinity(); break;
-      case 3: in.t = t - 1.0; break;
-      case 4: in.t = std::numeric_limits<double>::quiet_NaN(); break;
-      default: break;
+      case 0:
+        in.rotations[i % k_bone_count] = glm::quat(k_nan, k_nan, 0.f, 0.f);
+        break;
+      case 1:
+        in.hips_position.x = k_nan;
+        break;
+      case 2:
+        in.expressions[i % k_expression_count] = -std::numeric_limits<float>::infinity();
+        break;
+      case 3:
+        in.t = t - 1.0;
+        break;
+      case 4:
+        in.t = std::numeric_limits<double>::quiet_NaN();
+        break;
+      default:
+        break;
     }
     t += 0.01 + 0.05 * (i % 3);
     f.apply(in, out);
@@ -222,7 +234,8 @@ std::unique_ptr<landmark_frame> make_frame(double t, float offset) {
     f->pose[i] = {0.5f + offset, 0.01f * i, 0.f, 0.9f, 0.8f};
     f->pose_world[i] = {0.1f * i + offset, -0.2f, 0.05f, 0.7f, 0.6f};
   }
-  for (int i = 0; i < k_hand_landmark_count; ++i) f->left_hand[i] = {0.3f + offset, 0.4f, 0.f, 1, 1};
+  for (int i = 0; i < k_hand_landmark_count; ++i)
+    f->left_hand[i] = {0.3f + offset, 0.4f, 0.f, 1, 1};
   for (int i = 0; i < 468; ++i) f->face[i] = {0.002f * i + offset, 0.5f, 0.01f, 1, 1};
   return f;
 }

@@ -3,11 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 #include <random>
-
-#include <Eigen/Geometry>
 
 #include "avatarmap/core/rotation.hpp"
 
@@ -160,8 +159,7 @@ TEST(pose_resampler, before_first_gives_first_and_extrapolation_is_bounded) {
   for (double h : {0.01, 0.05, 0.1}) {
     ASSERT_TRUE(r.sample(1.04 + h, out));
     for (int b = 0; b < k_bone_count; ++b)
-      EXPECT_LT(eigen_angle(out.rotations[b], m.rotation(b, 1.04 + h)) * k_rad_to_deg, 0.05)
-          << h;
+      EXPECT_LT(eigen_angle(out.rotations[b], m.rotation(b, 1.04 + h)) * k_rad_to_deg, 0.05) << h;
     EXPECT_NEAR(out.hips_position.x, 0.5f * float(1.04 + h), 1e-5f);
   }
   // Beyond it: held at the horizon.

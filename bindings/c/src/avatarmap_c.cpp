@@ -51,12 +51,15 @@ static_assert(AVM_EXPRESSION_BROW_DOWN_RIGHT == am::idx(am::expression::brow_dow
 static_assert(sizeof(avm_solver_options) % 4 == 0 && alignof(avm_solver_options) == 4,
               "avm_solver_options must hold only 4-byte fields");
 
+namespace avm_detail {
 // Which parts of a pose are filtered (pose_filter itself filters all or nothing).
 struct filter_channels {
   bool rotations = true;
   bool position = true;
   bool expressions = true;
 };
+}  // namespace avm_detail
+using avm_detail::filter_channels;
 
 // The handle. Everything a frame needs is preallocated here.
 struct avm_solver {

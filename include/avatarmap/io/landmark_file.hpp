@@ -31,7 +31,8 @@ class landmark_reader {
   landmark_reader(const landmark_reader&) = delete;
   landmark_reader& operator=(const landmark_reader&) = delete;
 
-  /// Opens `path` ("-" = standard input) and reads the header line if there is one.
+  /// Opens `path` ("-" = standard input) and reads the header line if there is one. Fails
+  /// when the file cannot be opened or the header is bad (wrong format, version > 1).
   status open(const std::string& path);
   /// Reads from a memory buffer (not copied: it must outlive the reader). For tests/fuzzing.
   status open_memory(const char* data, std::size_t size, const std::string& name = "<memory>");
@@ -58,11 +59,16 @@ class landmark_writer {
   landmark_writer(const landmark_writer&) = delete;
   landmark_writer& operator=(const landmark_writer&) = delete;
 
-  /// Starts writing to a temporary file beside `path` ("-" = standard output, not atomic).
+  /// Starts writing to a temporary file `path.tmp.XXXXXX` beside `path` ("-" = standard
+  /// output, not atomic) and writes the header line (always; `header.present` is ignored;
+  /// image_size when both sizes are > 0, fps when > 0). Fails when the temporary file
+  /// cannot be created (message names `path`).
   status open(const std::string& path, const landmark_file_header& header);
-  /// Writes one frame (only the parts it has). Non-finite numbers are written as null.
+  /// Writes one frame (only the parts it has). Numbers are the shortest text that reads back
+  /// bit-identical; non-finite numbers are written as null. Fails on a write error.
   status write(const landmark_frame& frame);
-  /// Flushes and renames the temporary file over `path`.
+  /// Flushes, fsyncs and renames the temporary file over `path`. Destroying the writer
+  /// without commit() removes the temporary file and leaves `path` untouched.
   status commit();
 
  private:

@@ -53,8 +53,13 @@ class pose_writer {
   pose_writer(const pose_writer&) = delete;
   pose_writer& operator=(const pose_writer&) = delete;
 
+  /// Like landmark_writer::open: atomic via a temporary file, "-" = standard output. Writes
+  /// the header {"format":"avatarmap.pose","version":1(,"fps":F when fps > 0)}.
   status open(const std::string& path, const pose_file_header& header,
               const pose_write_options& options = {});
+  /// Writes one pose: t, hips_position, all bones (VRM 1.0 names, bone enum order,
+  /// [x, y, z, w]), all expressions, and confidence when asked. Non-finite numbers are
+  /// written as null (which the reader rejects).
   status write(const proxy_pose& pose);
   status commit();
 

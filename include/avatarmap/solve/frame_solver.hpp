@@ -18,7 +18,11 @@ namespace avatarmap {
 /// confidence (0 = not measured this frame).
 struct bone_measurement {
   glm::quat world{1.f, 0.f, 0.f, 0.f};
+  /// The rotation relative to the measured parent, when the measurement produced it directly
+  /// (has_local); otherwise the solver derives it from the two world rotations.
+  glm::quat local{1.f, 0.f, 0.f, 0.f};
   float confidence = 0.f;
+  bool has_local = false;
 };
 
 /// What the solver measured in one frame, before gating (exposed for tests and tools).
@@ -55,6 +59,7 @@ class frame_solver {
   struct bone_state {
     bool tracked = false;
     bool ever_tracked = false;
+    bool blending = false;  // blending back in after being found again
     double lost_at = 0.0;
     double found_at = -1e9;
     glm::quat last_good{1.f, 0.f, 0.f, 0.f};
@@ -69,10 +74,14 @@ class frame_solver {
   };
 
   float gate(scalar_state& s, float confidence, double t) const;
+  const glm::quat& previous_world(int b) const;
 
   solver_options options_;
   std::array<bone_state, k_bone_count> bones_{};
-  std::array<glm::quat, k_bone_count> prev_world_{};
+  mutable std::array<glm::quat, k_bone_count> prev_world_{};  // memo of previous_world()
+  mutable std::array<unsigned, k_bone_count> world_stamp_{};
+  unsigned world_generation_ = 1;
+  std::array<glm::quat, k_bone_count> local_{};
   scalar_state hips_height_state_{};
   scalar_state ground_state_{};
   scalar_state face_state_{};

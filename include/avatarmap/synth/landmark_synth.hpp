@@ -27,9 +27,8 @@
 
 #include <array>
 #include <cstdint>
-#include <random>
-
 #include <glm/glm.hpp>
+#include <random>
 
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"

@@ -47,8 +47,8 @@ struct random_pose_limits {
   float thumb_flex_max = 80.f;
   float eye_yaw = 25.f;
   float eye_pitch = 15.f;
-  bool fingers = true;     // else finger bones stay at rest
-  bool expressions = true; // else all weights 0
+  bool fingers = true;      // else finger bones stay at rest
+  bool expressions = true;  // else all weights 0
   /// hips_position: X and Z uniform in +-hips_xz_range (metres) around 0, Y = hips_height.
   /// Use ground_pose() afterwards to put the feet on the floor.
   float hips_xz_range = 0.3f;

@@ -10,7 +10,6 @@
 #pragma once
 
 #include <array>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 

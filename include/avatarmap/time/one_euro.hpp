@@ -27,7 +27,6 @@
 #pragma once
 
 #include <cmath>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
@@ -101,8 +100,7 @@ class one_euro_filter {
 /// the axes).
 class one_euro_filter_vec3 {
  public:
-  explicit one_euro_filter_vec3(const one_euro_params& params = {}) noexcept
-      : params_(params) {}
+  explicit one_euro_filter_vec3(const one_euro_params& params = {}) noexcept : params_(params) {}
 
   glm::vec3 operator()(const glm::vec3& x, float dt) noexcept {
     if (!is_finite(x)) return x_hat_;
@@ -147,8 +145,7 @@ class one_euro_filter_vec3 {
 /// length; it is normalised. beta is in seconds per radian.
 class one_euro_filter_quat {
  public:
-  explicit one_euro_filter_quat(const one_euro_params& params = {}) noexcept
-      : params_(params) {}
+  explicit one_euro_filter_quat(const one_euro_params& params = {}) noexcept : params_(params) {}
 
   glm::quat operator()(glm::quat q, float dt) noexcept {
     const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;

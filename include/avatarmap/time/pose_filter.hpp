@@ -13,7 +13,6 @@
 
 #include <array>
 #include <cmath>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
@@ -113,9 +112,12 @@ constexpr bool is_world_part(frame_part p) {
 constexpr int part_capacity(frame_part p) {
   switch (p) {
     case frame_part::pose:
-    case frame_part::pose_world: return k_pose_landmark_count;
-    case frame_part::face: return k_face_mesh_iris_count;
-    default: return k_hand_landmark_count;
+    case frame_part::pose_world:
+      return k_pose_landmark_count;
+    case frame_part::face:
+      return k_face_mesh_iris_count;
+    default:
+      return k_hand_landmark_count;
   }
 }
 constexpr int part_offset(frame_part p) {
@@ -210,13 +212,20 @@ class landmark_filter {
  private:
   static landmark* points(landmark_frame& f, frame_part p) {
     switch (p) {
-      case frame_part::pose: return f.pose.data();
-      case frame_part::pose_world: return f.pose_world.data();
-      case frame_part::left_hand: return f.left_hand.data();
-      case frame_part::left_hand_world: return f.left_hand_world.data();
-      case frame_part::right_hand: return f.right_hand.data();
-      case frame_part::right_hand_world: return f.right_hand_world.data();
-      case frame_part::face: return f.face.data();
+      case frame_part::pose:
+        return f.pose.data();
+      case frame_part::pose_world:
+        return f.pose_world.data();
+      case frame_part::left_hand:
+        return f.left_hand.data();
+      case frame_part::left_hand_world:
+        return f.left_hand_world.data();
+      case frame_part::right_hand:
+        return f.right_hand.data();
+      case frame_part::right_hand_world:
+        return f.right_hand_world.data();
+      case frame_part::face:
+        return f.face.data();
     }
     return nullptr;
   }

@@ -9,7 +9,6 @@
 
 #include <array>
 #include <cmath>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 

@@ -292,9 +292,9 @@ typedef struct avm_solver avm_solver;
  * On success *out_solver is a new handle owned by the caller (free it with
  * avm_solver_destroy()).
  * Failures (*out_solver is set to NULL whenever out_solver is not NULL):
- *   AVM_ERROR_INVALID_ARGUMENT: out_solver is NULL, options->struct_size is too small to
- *     hold any field (not initialised with avm_solver_options_init()), or a field is out of
- *     range;
+ *   AVM_ERROR_INVALID_ARGUMENT: out_solver is NULL; options->struct_size below 8 or above
+ *     4096 (the struct was not initialised with avm_solver_options_init()); a field out of
+ *     its range (the message names it);
  *   AVM_ERROR_OUT_OF_MEMORY; AVM_ERROR_INTERNAL.
  * The message of the last failure is given by avm_last_create_error(). Thread-safe. */
 AVATARMAP_C_API avm_status avm_solver_create(const avm_solver_options* options,
@@ -325,15 +325,18 @@ AVATARMAP_C_API avm_status avm_solver_reset(avm_solver* solver);
 AVATARMAP_C_API avm_status avm_solver_push(avm_solver* solver, const avm_frame* frame);
 
 /* Copies the latest solved and filtered pose into *out_pose (owned by the caller). Before
- * the first push (or after a reset) it is the rest pose (T-pose, default hips height,
- * t = 0).
+ * the first push (or after a reset) it is the rest pose (T-pose, hips 0.95 m above the
+ * floor, t = 0).
  * Failures: AVM_ERROR_INVALID_ARGUMENT when solver or out_pose is NULL. */
 AVATARMAP_C_API avm_status avm_solver_get_pose(const avm_solver* solver, avm_pose* out_pose);
 
-/* Writes the pose at render time t (seconds, on the frames' clock) into *out_pose:
- * interpolated between the two pushed poses around t (rotations by shortest-path slerp),
- * held at the first pose before it, and extrapolated at most max_extrapolation_seconds past
- * the newest. Before the first push it is the rest pose. out_pose->t = t. Allocates nothing.
+/* Writes the pose at render time t (seconds, on the frames' clock) into *out_pose. The solver
+ * keeps the last 4 pushed (filtered) poses: between two of them the pose is interpolated
+ * (rotations by shortest-arc slerp, position and expressions linearly, confidence the
+ * minimum); before the oldest kept it is the oldest; past the newest it is extrapolated at
+ * constant velocity for at most max_extrapolation_seconds, then held. Before the first push
+ * (or after a reset) it is the rest pose. out_pose->t = t. Allocates nothing; does not
+ * change what later calls return.
  * Failures: AVM_ERROR_INVALID_ARGUMENT when solver or out_pose is NULL or t is not finite;
  *   AVM_ERROR_INTERNAL. */
 AVATARMAP_C_API avm_status avm_solver_sample(avm_solver* solver, double t, avm_pose* out_pose);

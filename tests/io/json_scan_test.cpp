@@ -1,0 +1,163 @@
+// The internal scanner: its fast float path must agree bit for bit with std::from_chars.
+#include "io/json_scan.hpp"
+
+#include <gtest/gtest.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <string>
+
+#include "io/line_source.hpp"
+
+namespace avatarmap::io_detail {
+namespace {
+
+std::uint32_t bits(float f) {
+  std::uint32_t u;
+  std::memcpy(&u, &f, 4);
+  return u;
+}
+
+// Parses `s` with the scanner; checks the whole string was used.
+float scan(const std::string& s) {
+  json_cursor c(s.data(), s.data() + s.size());
+  float f = -12345.f;
+  EXPECT_TRUE(c.parse_float(f)) << s << ": " << c.error;
+  EXPECT_TRUE(c.at_end()) << s;
+  return f;
+}
+
+// glibc's strtof: correctly rounded, +-HUGE_VALF on overflow, 0 on underflow (C locale).
+float reference(const std::string& s) { return std::strtof(s.c_str(), nullptr); }
+
+TEST(json_scan, shortest_float_text_reads_back_exactly) {
+  std::mt19937 rng(123);
+  std::uniform_int_distribution<std::uint32_t> any;
+  char buf[64];
+  for (int i = 0; i < 1000000; ++i) {
+    std::uint32_t u = any(rng);
+    float f;
+    std::memcpy(&f, &u, 4);
+    if (!std::isfinite(f)) continue;
+    auto r = std::to_chars(buf, buf + sizeof buf, f);
+    std::string s(buf, r.ptr);
+    ASSERT_EQ(bits(scan(s)), u) << s;
+  }
+}
+
+TEST(json_scan, fast_path_agrees_with_from_chars_on_random_decimals) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> digit(0, 9), ndig(1, 17), epos(-25, 25), coin(0, 3);
+  for (int i = 0; i < 1000000; ++i) {
+    std::string s;
+    if (coin(rng) == 0) s += '-';
+    int n = ndig(rng);
+    int point = std::uniform_int_distribution<int>(0, n)(rng);
+    std::string d;
+    for (int k = 0; k < n; ++k) d += static_cast<char>('0' + digit(rng));
+    // JSON: no leading zeros in the integer part.
+    std::string ip = point == 0 ? "0" : d.substr(0, static_cast<std::size_t>(point));
+    while (ip.size() > 1 && ip[0] == '0') ip.erase(0, 1);
+    s += ip;
+    if (point < n) s += "." + d.substr(static_cast<std::size_t>(point));
+    if (coin(rng) == 0) s += "e" + std::to_string(epos(rng));
+    ASSERT_EQ(bits(scan(s)), bits(reference(s))) << s;
+  }
+}
+
+TEST(json_scan, float_midpoints_round_to_even) {
+  // 16777217 = 2^24 + 1 lies exactly halfway between two floats.
+  EXPECT_EQ(scan("16777217"), 16777216.f);
+  EXPECT_EQ(scan("16777219"), 16777220.f);
+  EXPECT_EQ(scan("1.6777217e7"), 16777216.f);
+  EXPECT_EQ(bits(scan("-0")), bits(-0.f));
+  EXPECT_EQ(bits(scan("-0.0e0")), bits(-0.f));
+  EXPECT_EQ(scan("1e-45"), std::numeric_limits<float>::denorm_min());
+  EXPECT_EQ(scan("3.4028235e38"), std::numeric_limits<float>::max());
+  EXPECT_TRUE(std::isinf(scan("3.5e38")));
+  EXPECT_EQ(scan("1e-50"), 0.f);
+  EXPECT_EQ(bits(scan("-1e-50")), bits(-0.f));
+  EXPECT_TRUE(std::isinf(scan("1e99999999999999999999")));
+  EXPECT_EQ(scan("0.0000000000000000000000000000000000000000000000000000001e55"), 1.f);
+}
+
+TEST(json_scan, strings_with_escapes) {
+  std::string s = R"("a\"b\\c\/d\b\f\n\r\t\u00e9\ud83d\ude00\u0041")";
+  json_cursor c(s.data(), s.data() + s.size());
+  std::string scratch;
+  std::string_view v;
+  ASSERT_TRUE(c.parse_string(v, scratch)) << c.error;
+  EXPECT_EQ(v,
+            "a\"b\\c/d\b\f\n\r\t\xc3\xa9\xf0\x9f\x98\x80"
+            "A");
+  for (std::string bad : {R"("\x")", R"("\u12")", "\"abc", "\"a\tb\""}) {
+    json_cursor b(bad.data(), bad.data() + bad.size());
+    EXPECT_FALSE(b.parse_string(v, scratch)) << bad;
+    EXPECT_FALSE(b.error.empty());
+  }
+}
+
+TEST(json_scan, skip_value_skips_any_value) {
+  std::string s = R"( {"a":[1,-2.5e3,true,false,null,"x",{"b":{}}],"c":[]} ,)";
+  json_cursor c(s.data(), s.data() + s.size());
+  ASSERT_TRUE(c.skip_value()) << c.error;
+  EXPECT_TRUE(c.eat(','));
+  for (std::string bad : {"[1,]", "{\"a\" 1}", "tru", "[", "{\"a\":1,}", "-", "+1", "nul"}) {
+    json_cursor b(bad.data(), bad.data() + bad.size());
+    EXPECT_FALSE(b.skip_value() && b.at_end()) << bad;
+  }
+}
+
+TEST(line_source, lines_across_blocks) {
+  std::string text = "a\nbb\r\n\nccc\r\nlast";
+  std::vector<std::string> expected = {"a", "bb", "", "ccc", "last"};
+  line_source src;
+  src.open_memory(text.data(), text.size());
+  std::string_view line;
+  std::string err;
+  for (auto& e : expected) {
+    ASSERT_EQ(src.next(line, err), line_status::line);
+    EXPECT_EQ(line, e);
+  }
+  EXPECT_EQ(src.next(line, err), line_status::end);
+  EXPECT_EQ(src.line_number(), 5);
+}
+
+}  // namespace
+}  // namespace avatarmap::io_detail
+
+namespace avatarmap::io_detail {
+namespace {
+
+TEST(line_source, memory_and_stream_apply_the_same_line_cap) {
+  line_source_limits saved = default_line_source_limits();
+  default_line_source_limits() = {3, 8};
+  std::string text =
+      "\xEF\xBB\xBF"
+      "12345\n123456789\n12345678\r\n";
+  for (int stream = 0; stream < 2; ++stream) {
+    SCOPED_TRACE(stream ? "stream" : "memory");
+    line_source src;
+    if (stream) {
+      src.open_stream(fmemopen(text.data(), text.size(), "rb"), true);
+    } else {
+      src.open_memory(text.data(), text.size());
+    }
+    std::string_view line;
+    std::string err;
+    ASSERT_EQ(src.next(line, err), line_status::line);  // BOM + 5 bytes: within the cap
+    EXPECT_EQ(line, "12345");
+    ASSERT_EQ(src.next(line, err), line_status::error);
+    EXPECT_NE(err.find("longer than 8 bytes"), std::string::npos);
+    ASSERT_EQ(src.next(line, err), line_status::error);  // 8 bytes + '\r'
+    EXPECT_EQ(src.line_number(), 3);
+    EXPECT_EQ(src.next(line, err), line_status::end);
+  }
+  default_line_source_limits() = saved;
+}
+
+}  // namespace
+}  // namespace avatarmap::io_detail
