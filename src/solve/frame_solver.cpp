@@ -53,6 +53,7 @@ struct prepared_frame {
   hand_points hand[2];  // 0 = avatar's left
   face_points face;
   float width = 1.f, height = 1.f;
+  float focal = 1.f;  // pixels, from the horizontal field of view
 };
 
 glm::vec3 to_vec(const landmark& l) { return glm::vec3(l.x, l.y, l.z); }
@@ -68,7 +69,7 @@ void prepare_body(const landmark_frame& in, const solver_options& o, prepared_fr
     const landmark& l = src[s];
     float c = landmark_confidence(l);
     glm::vec3 v = world ? world_to_vrm(to_vec(l)) : image_to_vrm_pixels(to_vec(l), f.width, f.height);
-    if (!is_finite(v)) {
+    if (v.x * 0.f + v.y * 0.f + v.z * 0.f != 0.f) {  // NaN or infinite (also after scaling)
       v = glm::vec3(0.f);
       c = 0.f;
     }
@@ -95,7 +96,7 @@ void prepare_hand(const landmark_frame& in, const solver_options& o, int side, p
   for (int i = 0; i < k_hand_landmark_count; ++i) {
     glm::vec3 v = world ? world_to_vrm(to_vec(src[i]))
                         : image_to_vrm_pixels(to_vec(src[i]), f.width, f.height);
-    if (!is_finite(v)) {
+    if (v.x * 0.f + v.y * 0.f + v.z * 0.f != 0.f) {  // NaN or infinite
       c = 0.f;
       v = glm::vec3(0.f);
     }
@@ -118,7 +119,7 @@ void prepare_face(const landmark_frame& in, const solver_options& o, prepared_fr
   // relative to the camera's axes, not to the ray.
   const landmark& c0 = in.face[fi::forehead];
   const landmark& c1 = in.face[fi::chin];
-  const float focal = 0.5f * f.width / std::tan(0.5f * o.horizontal_fov_degrees * k_deg);
+  const float focal = f.focal;
   const float shear_x = (0.5f * (c0.x + c1.x) * f.width - 0.5f * f.width) / focal;
   const float shear_y = (0.5f * (c0.y + c1.y) * f.height - 0.5f * f.height) / focal;
   bool ok = std::isfinite(shear_x) && std::isfinite(shear_y);
@@ -181,6 +182,15 @@ void set(frame_measurement& m, bone b, const glm::quat& world, float c) {
   bm.confidence = c;
   bm.has_local = false;
 }
+// A bone measured only relative to its (measured) parent: `world` stays unset (identity);
+// use it for bones whose children are all measured relative to them too.
+void set_local(frame_measurement& m, bone b, const glm::quat& local, float c) {
+  bone_measurement& bm = m.bones[idx(b)];
+  bm.world = identity_quat();
+  bm.local = local;
+  bm.confidence = c;
+  bm.has_local = true;
+}
 // Same, with the rotation relative to the (measured) parent known already.
 void set(frame_measurement& m, bone b, const glm::quat& world, const glm::quat& local, float c) {
   bone_measurement& bm = m.bones[idx(b)];
@@ -194,26 +204,29 @@ void set(frame_measurement& m, bone b, const glm::quat& world, const glm::quat& 
 // `twist_reference` sets the twist of a straight arm (no bend plane): the upper arm's world
 // rotation of the previous frame (temporal coherence), or the shoulder's on the first frame.
 void measure_arm(const glm::vec3& sh, const glm::vec3& el, const glm::vec3& wr,
-                 const glm::quat& twist_reference, glm::quat& out_upper, glm::quat& out_lower) {
+                 const glm::quat& twist_reference, glm::quat& out_upper, glm::quat& out_lower,
+                 glm::quat& out_lower_local) {
   glm::vec3 d1 = el - sh;
   glm::vec3 d2 = wr - el;
   // The elbow is a hinge: the forearm leaves the upper arm toward the upper arm's local +Z.
-  out_upper = aim_with_bend(twist_reference, k_px, k_pz, d1, d2, glm::vec3(0.f));
-  out_lower = out_upper * swing_local(out_upper, k_x, d2);
+  out_upper = aim_with_bend<k_px, k_pz>(twist_reference, d1, d2, glm::vec3(0.f));
+  out_lower_local = swing_local(out_upper, k_x, d2);
+  out_lower = out_upper * out_lower_local;
 }
 
 // Leg of the avatar's left side: hip, knee, ankle, heel, toe tip (foot index).
 void measure_leg(const glm::vec3& hip, const glm::vec3& knee, const glm::vec3& ankle,
                  const glm::vec3& heel, const glm::vec3& toe, bool foot_ok,
                  const glm::quat& hips_world, glm::quat& out_upper, glm::quat& out_lower,
-                 glm::quat& out_foot) {
+                 glm::quat& out_lower_local, glm::quat& out_foot) {
   glm::vec3 d1 = knee - hip;
   glm::vec3 d2 = ankle - knee;
   // The knee flexes backward: the shin leaves the thigh toward the thigh's local -Z. For a
   // straight leg the knee points where the foot points.
   glm::vec3 forward = foot_ok ? (toe - heel) : glm::vec3(0.f);
-  out_upper = aim_with_bend(hips_world, k_ny, k_nz, d1, d2, -forward);
-  out_lower = out_upper * swing_local(out_upper, -k_y, d2);
+  out_upper = aim_with_bend<k_ny, k_nz>(hips_world, d1, d2, -forward);
+  out_lower_local = swing_local(out_upper, -k_y, d2);
+  out_lower = out_upper * out_lower_local;
   if (foot_ok) {
     constexpr glm::vec3 k_foot_rest(0.f, -0.44721360f, 0.89442719f);
     glm::vec3 dir = toe - ankle;
@@ -228,8 +241,7 @@ void measure_leg(const glm::vec3& hip, const glm::vec3& knee, const glm::vec3& a
 // Wrist orientation of the avatar's left hand from the 21 hand points: +X along wrist ->
 // middle knuckle, +Z toward the index side (palm faces -Y at rest).
 glm::quat hand_world_from_points(const hand_points& h) {
-  return frame_from_axes(k_px, k_pz,
-                         normalize_or(h.p[idx(hand_landmark::middle_mcp)] - h.p[0], k_x),
+  return frame_from_axes<k_px, k_pz>(normalize_or(h.p[idx(hand_landmark::middle_mcp)] - h.p[0], k_x),
                          h.p[idx(hand_landmark::index_mcp)] - h.p[idx(hand_landmark::pinky_mcp)]);
 }
 
@@ -237,54 +249,94 @@ glm::quat hand_world_from_points(const hand_points& h) {
 const glm::quat k_thumb_frame = axis_angle(k_y, -0.25f * k_pi);
 
 // Finger bones of the avatar's left hand (world rotations), given the hand's world rotation.
+// Two hinge joints about the same local Z axis, from their segments' directions (x, y) in the
+// frame of the bone before them: the first hinge's rotation, and the second's relative to the
+// first (a complex division of the two unit 2-D directions). No trig calls.
+void hinge_pair(float x2, float y2, float x3, float y3, glm::quat& out_first,
+                glm::quat& out_second) {
+  const float l2 = x2 * x2 + y2 * y2, l3 = x3 * x3 + y3 * y3;
+  float c2 = 1.f, n2 = 0.f;
+  if (l2 > 1e-24f) {
+    const float i = inv_sqrt(l2);
+    c2 = x2 * i;
+    n2 = y2 * i;
+  }
+  float c3 = c2, n3 = n2;
+  if (l3 > 1e-24f) {
+    const float i = inv_sqrt(l3);
+    c3 = x3 * i;
+    n3 = y3 * i;
+  }
+  out_first = axis_cos_sin(k_z, c2, n2);
+  out_second = axis_cos_sin(k_z, c3 * c2 + n3 * n2, n3 * c2 - c3 * n2);
+}
+
+// Finger bones of the avatar's left hand (canonical space), given the hand's world rotation.
+// The proximal, intermediate and distal bones' rotations relative to their parents come out
+// directly (only the thumb's metacarpal needs a world rotation).
 void measure_fingers(const hand_points& h, const glm::quat& hand_w, float c, bool left,
                      frame_measurement& m) {
   const int first = left ? idx(bone::left_thumb_metacarpal) : idx(bone::right_thumb_metacarpal);
-  auto emit = [&](int offset, const glm::quat& w) {
-    set(m, static_cast<bone>(first + offset), left ? w : mirror_x(w), c);
-  };
-  auto emit_local = [&](int offset, const glm::quat& w, const glm::quat& local) {
-    set(m, static_cast<bone>(first + offset), left ? w : mirror_x(w),
-        left ? local : mirror_x(local), c);
+  auto emit_local = [&](int offset, const glm::quat& local) {
+    set_local(m, static_cast<bone>(first + offset), left ? local : mirror_x(local), c);
   };
   // Thumb: CMC 1, MCP 2, IP 3, tip 4. The metacarpal's twist (opposition) comes from the plane
   // the thumb bends in; its later joints are hinges in that plane.
   {
     const glm::vec3 d = h.p[2] - h.p[1];
     const glm::vec3 bend_to = h.p[4] - h.p[2];
-    glm::quat rest_frame = hand_w * k_thumb_frame;
-    glm::quat g = aim_with_bend(rest_frame, k_px, k_ny, d, bend_to, glm::vec3(0.f));
-    glm::quat inv_f = glm::conjugate(k_thumb_frame);
-    emit(0, g * inv_f);
-    glm::quat hinge1 = finger_hinge(glm::conjugate(g) * (h.p[3] - h.p[2]));
-    glm::quat g2 = g * hinge1;
-    emit_local(1, g2 * inv_f, k_thumb_frame * hinge1 * inv_f);
-    glm::quat hinge2 = finger_hinge(glm::conjugate(g2) * (h.p[4] - h.p[3]));
-    emit_local(2, g2 * hinge2 * inv_f, k_thumb_frame * hinge2 * inv_f);
+    const glm::quat g = aim_with_bend<k_px, k_ny>(hand_w * k_thumb_frame, d, bend_to, glm::vec3(0.f));
+    const glm::quat inv_f = glm::conjugate(k_thumb_frame);
+    const glm::quat mc_w = g * inv_f;
+    set(m, static_cast<bone>(first), left ? mc_w : mirror_x(mc_w), c);
+    const glm::quat to_g = glm::conjugate(g);
+    const glm::vec3 s3 = to_g * (h.p[3] - h.p[2]);
+    const glm::vec3 s4 = to_g * (h.p[4] - h.p[3]);
+    glm::quat h1, h2;
+    hinge_pair(s3.x, s3.y, s4.x, s4.y, h1, h2);
+    // F * R_z(a) * F^-1 is the same turn about F's Z axis, (-1, 0, 1)/sqrt2.
+    constexpr float k_r2 = 0.70710678f;
+    emit_local(1, glm::quat(h1.w, -k_r2 * h1.z, 0.f, k_r2 * h1.z));
+    emit_local(2, glm::quat(h2.w, -k_r2 * h2.z, 0.f, k_r2 * h2.z));
   }
-  const glm::quat inv_hand = glm::conjugate(hand_w);
+  // Other fingers, in the hand's frame (columns of its matrix = the hand's axes in world).
+  const glm::mat3 hm = glm::mat3_cast(hand_w);
+  auto to_hand = [&](const glm::vec3& v) {
+    return glm::vec3(glm::dot(hm[0], v), glm::dot(hm[1], v), glm::dot(hm[2], v));
+  };
   for (int finger = 1; finger < 5; ++finger) {
-    int j = finger_base_landmark(finger);
-    glm::vec3 v = normalize_or(inv_hand * (h.p[j + 1] - h.p[j]), k_x);
-    // Proximal: spread about local Y, then flexion about the hand's lateral axis (Z).
-    const glm::quat prox_local = finger_proximal(v);
-    const glm::quat prox = hand_w * prox_local;
-    emit_local(3 * finger, prox, prox_local);
-    // The intermediate and distal joints hinge about the proximal's Z, so both are angles in
-    // the proximal's XY plane: take the two segments there once and work with 2-D unit
-    // vectors (the distal's angle is the difference, a complex division).
-    const glm::quat to_prox = glm::conjugate(prox);
-    const glm::vec3 s2 = to_prox * (h.p[j + 2] - h.p[j + 1]);
-    const glm::vec3 s3 = to_prox * (h.p[j + 3] - h.p[j + 2]);
-    const float l2 = s2.x * s2.x + s2.y * s2.y, l3 = s3.x * s3.x + s3.y * s3.y;
-    const float i2 = l2 > 1e-24f ? inv_sqrt(l2) : 0.f, i3 = l3 > 1e-24f ? inv_sqrt(l3) : 0.f;
-    const float c2 = i2 > 0.f ? s2.x * i2 : 1.f, n2 = s2.y * i2;
-    const float c3 = i3 > 0.f ? s3.x * i3 : c2, n3 = i3 > 0.f ? s3.y * i3 : n2;
-    const glm::quat mid_local = axis_cos_sin(k_z, c2, n2);
-    const glm::quat mid = prox * mid_local;
-    emit_local(3 * finger + 1, mid, mid_local);
-    const glm::quat dist_local = axis_cos_sin(k_z, c3 * c2 + n3 * n2, n3 * c2 - c3 * n2);
-    emit_local(3 * finger + 2, mid * dist_local, dist_local);
+    const int j = finger_base_landmark(finger);
+    glm::vec3 v1 = normalize_or(to_hand(h.p[j + 1] - h.p[j]), k_x);
+    const glm::vec3 v2 = to_hand(h.p[j + 2] - h.p[j + 1]);
+    const glm::vec3 v3 = to_hand(h.p[j + 3] - h.p[j + 2]);
+    // Proximal: R_z(phi) * R_y(spread) with phi = -flexion (see finger_proximal).
+    const float r2 = v1.x * v1.x + v1.y * v1.y;
+    float cf = 1.f, sf = 0.f, cs = 0.f;
+    if (r2 > 1e-24f) {
+      const float ir = inv_sqrt(r2);
+      cf = v1.x * ir;
+      sf = v1.y * ir;
+      cs = r2 * ir;
+    }
+    const float ss = -v1.z;
+    // R_z * R_y of two single-axis quaternions, multiplied out: (a_w b_w, -a_z b_y, a_w b_y,
+    // a_z b_w).
+    const glm::quat a = axis_cos_sin(k_z, cf, sf), b = axis_cos_sin(k_y, cs, ss);
+    emit_local(3 * finger, glm::quat(a.w * b.w, -a.z * b.y, a.w * b.y, a.z * b.w));
+    // The later segments in the proximal's frame: undo R_z(phi), then R_y(spread); only x and
+    // y matter for hinges about Z.
+    auto in_prox = [&](const glm::vec3& v, float& x, float& y) {
+      const float xr = v.x * cf + v.y * sf;
+      y = -v.x * sf + v.y * cf;
+      x = xr * cs - v.z * ss;
+    };
+    float x2, y2, x3, y3;
+    in_prox(v2, x2, y2);
+    in_prox(v3, x3, y3);
+    glm::quat mid, dist;
+    hinge_pair(x2, y2, x3, y3, mid, dist);
+    emit_local(3 * finger + 1, mid);
+    emit_local(3 * finger + 2, dist);
   }
 }
 
@@ -294,11 +346,10 @@ hand_points mirrored(const hand_points& h) {
   return r;
 }
 
-// `prev_world(b)`: the previous frame's output world rotation of bone b; null on the first
-// frame.
-template <class prev_world_fn>
-void measure_body(const prepared_frame& f, const solver_options& o, const prev_world_fn* prev_world_ptr,
-                  frame_measurement& m) {
+// `arm_reference[side]`: the upper arm's world rotation last measured (side 0 = avatar's
+// left), or null when there is none: it keeps a straight arm's twist continuous.
+void measure_body(const prepared_frame& f, const solver_options& o,
+                  const glm::quat* const arm_reference[2], frame_measurement& m) {
   const body_points& b = f.body;
   if (!b.valid || !o.parts.body) return;
   using pl = pose_landmark;
@@ -310,20 +361,20 @@ void measure_body(const prepared_frame& f, const solver_options& o, const prev_w
                                      idx(pl::left_shoulder), idx(pl::right_shoulder)});
   // Hips: yaw and roll from the hip line; a share of the torso's lean about the hip line.
   const glm::vec3 hip_line = normalize_or(hip_l - hip_r, k_x);
-  const glm::quat upright = frame_from_axes(k_px, k_py, hip_line, k_y);
-  const glm::quat leaning = frame_from_axes(k_px, k_py, hip_line, up);
+  const glm::quat upright = frame_from_axes<k_px, k_py>(hip_line, k_y);
+  const glm::quat leaning = frame_from_axes<k_px, k_py>(hip_line, up);
   const glm::quat hips_w = nlerp_shortest(upright, leaning, o.hips_lean_share);
   // Spine chain: the rest of the way to the shoulder line's frame, split about evenly; the
   // upper chest closes the chain exactly, so the shoulder line is matched whatever the split.
-  const glm::quat shoulders_w = frame_from_axes(k_px, k_py, normalize_or(sh_l - sh_r, k_x), up);
+  const glm::quat shoulders_w = frame_from_axes<k_px, k_py>(normalize_or(sh_l - sh_r, k_x), up);
   const glm::quat bend = glm::conjugate(hips_w) * shoulders_w;
   const glm::quat third = nlerp_shortest(identity_quat(), bend, 1.f / 3.f);
   const glm::quat spine_w = hips_w * third;
   const glm::quat chest_w = spine_w * third;
   const glm::quat upper_chest_w = shoulders_w;
   set(m, bone::hips, hips_w, c_torso);
-  set(m, bone::spine, spine_w, c_torso);
-  set(m, bone::chest, chest_w, c_torso);
+  set(m, bone::spine, spine_w, third, c_torso);
+  set(m, bone::chest, chest_w, third, c_torso);
   set(m, bone::upper_chest, upper_chest_w, c_torso);
   // Clavicles are not observable from BlazePose's points: they follow the upper chest.
   set(m, bone::left_shoulder, upper_chest_w, identity_quat(), c_torso);
@@ -344,41 +395,37 @@ void measure_body(const prepared_frame& f, const solver_options& o, const prev_w
     const glm::quat uc = left ? upper_chest_w : mirror_x(upper_chest_w);
     const glm::quat hw = left ? hips_w : mirror_x(hips_w);
 
-    glm::quat ua, la;
+    glm::quat ua, la, la_local;
     glm::quat twist_ref = uc;
-    if (prev_world_ptr) {
-      const auto& prev_world = *prev_world_ptr;
-      const glm::quat& p = prev_world(idx(left ? bone::left_upper_arm : bone::right_upper_arm));
-      twist_ref = left ? p : mirror_x(p);
-    }
+    if (arm_reference[side]) twist_ref = left ? *arm_reference[side] : mirror_x(*arm_reference[side]);
     measure_arm(P(pl::left_shoulder, pl::right_shoulder), P(pl::left_elbow, pl::right_elbow),
-                P(pl::left_wrist, pl::right_wrist), twist_ref, ua, la);
+                P(pl::left_wrist, pl::right_wrist), twist_ref, ua, la, la_local);
     float c_ua = C({pl::left_shoulder, pl::left_elbow}, {pl::right_shoulder, pl::right_elbow});
     float c_la = C({pl::left_elbow, pl::left_wrist}, {pl::right_elbow, pl::right_wrist});
     set(m, left ? bone::left_upper_arm : bone::right_upper_arm, out(ua), c_ua);
-    set(m, left ? bone::left_lower_arm : bone::right_lower_arm, out(la), c_la);
+    set(m, left ? bone::left_lower_arm : bone::right_lower_arm, out(la), out(la_local), c_la);
     // Coarse wrist orientation from the pose's pinky, index and wrist points; replaced by
     // the hand landmarks when those are present.
-    if (o.parts.hands) {
+    if (o.parts.hands && f.hand[side].c <= 0.f) {
       glm::vec3 wr = P(pl::left_wrist, pl::right_wrist);
       glm::vec3 pk = P(pl::left_pinky, pl::right_pinky);
       glm::vec3 ix = P(pl::left_index, pl::right_index);
-      glm::quat hand = frame_from_axes(k_px, k_pz, normalize_or(0.5f * (pk + ix) - wr, k_x), ix - pk);
+      glm::quat hand = frame_from_axes<k_px, k_pz>(normalize_or(0.5f * (pk + ix) - wr, k_x), ix - pk);
       float c_h = C({pl::left_wrist, pl::left_pinky, pl::left_index},
                     {pl::right_wrist, pl::right_pinky, pl::right_index});
       set(m, left ? bone::left_hand : bone::right_hand, out(hand), 0.999f * c_h);
     }
 
-    glm::quat ul, ll, foot;
+    glm::quat ul, ll, ll_local, foot;
     const float c_foot = C({pl::left_ankle, pl::left_heel, pl::left_foot_index},
                            {pl::right_ankle, pl::right_heel, pl::right_foot_index});
     measure_leg(P(pl::left_hip, pl::right_hip), P(pl::left_knee, pl::right_knee),
                 P(pl::left_ankle, pl::right_ankle), P(pl::left_heel, pl::right_heel),
                 P(pl::left_foot_index, pl::right_foot_index), c_foot > o.confidence.lost_below,
-                hw, ul, ll, foot);
+                hw, ul, ll, ll_local, foot);
     set(m, left ? bone::left_upper_leg : bone::right_upper_leg, out(ul),
         C({pl::left_hip, pl::left_knee}, {pl::right_hip, pl::right_knee}));
-    set(m, left ? bone::left_lower_leg : bone::right_lower_leg, out(ll),
+    set(m, left ? bone::left_lower_leg : bone::right_lower_leg, out(ll), out(ll_local),
         C({pl::left_knee, pl::left_ankle}, {pl::right_knee, pl::right_ankle}));
     set(m, left ? bone::left_foot : bone::right_foot, out(foot), c_foot);
     set(m, left ? bone::left_toes : bone::right_toes, out(foot), identity_quat(), c_foot);
@@ -436,7 +483,7 @@ void measure_hips_position(const landmark_frame& in, const prepared_frame& f,
   if (!(den > 1e-6f) || !(num > 0.f)) return;
   const float s = num / den;             // pixels per metre
   const glm::vec2 t = mi - s * mw;       // hip midpoint in pixels
-  const float focal = 0.5f * f.width / std::tan(0.5f * o.horizontal_fov_degrees * k_deg);
+  const float focal = f.focal;
   const float depth = focal / s;
   float x = (t.x - 0.5f * f.width) / focal * depth;
   if (o.mirror) x = -x;
@@ -452,7 +499,9 @@ void measure_hands(const prepared_frame& f, const solver_options& o, frame_measu
     const hand_points& h = f.hand[side];
     if (h.c <= 0.f) continue;
     const bool left = side == 0;
-    hand_points hc = left ? h : mirrored(h);
+    hand_points mirrored_points;
+    if (!left) mirrored_points = mirrored(h);
+    const hand_points& hc = left ? h : mirrored_points;
     glm::quat hand_w = hand_world_from_points(hc);
     set(m, left ? bone::left_hand : bone::right_hand, left ? hand_w : mirror_x(hand_w), h.c);
     measure_fingers(hc, hand_w, h.c, left, m);
@@ -488,14 +537,14 @@ constexpr viseme_prototype k_visemes[] = {{expression::aa, 0.60f, 1.00f},
                                           {expression::oh, 0.45f, 0.80f}};
 
 void measure_face(const prepared_frame& f, const solver_options& o, const glm::quat& upper_chest_w,
-                  frame_measurement& m) {
+                  bool base_measured, frame_measurement& m) {
   if (!o.parts.face) return;
   const face_points& fp = f.face;
   glm::quat head_w;
   float c_head = 0.f;
   if (fp.valid) {
     glm::vec3 lateral = (fp.eye[0].outer - fp.eye[1].outer) + (fp.cheek[0] - fp.cheek[1]);
-    head_w = frame_from_axes(k_px, k_py, normalize_or(lateral, k_x), fp.forehead - fp.chin);
+    head_w = frame_from_axes<k_px, k_py>(normalize_or(lateral, k_x), fp.forehead - fp.chin);
     c_head = 1.f;
   } else if (f.body.valid) {
     const body_points& b = f.body;
@@ -503,14 +552,19 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
     glm::vec3 lateral = b.p[idx(pl::left_ear)] - b.p[idx(pl::right_ear)];
     glm::vec3 up = 0.5f * (b.p[idx(pl::left_eye)] + b.p[idx(pl::right_eye)]) -
                    0.5f * (b.p[idx(pl::mouth_left)] + b.p[idx(pl::mouth_right)]);
-    head_w = frame_from_axes(k_px, k_py, normalize_or(lateral, k_x), up);
+    head_w = frame_from_axes<k_px, k_py>(normalize_or(lateral, k_x), up);
     c_head = min_conf(b, {idx(pl::left_ear), idx(pl::right_ear), idx(pl::left_eye),
                           idx(pl::right_eye), idx(pl::mouth_left), idx(pl::mouth_right)});
   }
   if (c_head > 0.f) {
     const glm::quat& base = upper_chest_w;
-    glm::quat neck_w = base * quat_fraction(glm::conjugate(base) * head_w, 0.5f);
-    set(m, bone::neck, neck_w, c_head);
+    const glm::quat neck_local = quat_fraction(glm::conjugate(base) * head_w, 0.5f);
+    const glm::quat neck_w = base * neck_local;
+    // The neck's rotation is relative to the upper chest only when that was measured too.
+    if (base_measured)
+      set(m, bone::neck, neck_w, neck_local, c_head);
+    else
+      set(m, bone::neck, neck_w, c_head);
     set(m, bone::head, head_w, c_head);
   }
   if (!fp.valid) return;
@@ -549,10 +603,9 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
       float v = glm::dot(e.iris - 0.5f * (e.inner + e.outer), up_dir) / width;
       // The left eye's outer corner is on the avatar's left (+X): moving toward it is a
       // positive yaw. For the right eye the corner line points the other way.
-      float sy = (u - k_iris_rest_u) / k_eyeball_radius * (s == 0 ? 1.f : -1.f);
-      float sp = (v - k_iris_rest_v) / k_eyeball_radius;
-      yaw_sum += std::asin(glm::clamp(sy, -1.f, 1.f));
-      pitch_sum += std::asin(glm::clamp(sp, -1.f, 1.f));
+      // The iris moves by the eyeball's radius times the sine of the eye's turn.
+      yaw_sum += (u - k_iris_rest_u) / k_eyeball_radius * (s == 0 ? 1.f : -1.f);
+      pitch_sum += (v - k_iris_rest_v) / k_eyeball_radius;
       ++gaze_n;
     }
   }
@@ -561,16 +614,23 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
   ex[idx(expression::blink_left)] = closure[0] - both;
   ex[idx(expression::blink_right)] = closure[1] - both;
   if (gaze_n > 0) {
-    float yaw = glm::clamp(yaw_sum / float(gaze_n), -35.f * k_deg, 35.f * k_deg);
-    float pitch = glm::clamp(pitch_sum / float(gaze_n), -25.f * k_deg, 25.f * k_deg);
+    // Sines of the gaze angles, both eyes averaged, clamped to 35 degrees of yaw and 25 of
+    // pitch.
+    constexpr float k_sin35 = 0.57357644f, k_sin25 = 0.42261826f, k_sin20 = 0.34202014f;
+    const float sy = glm::clamp(yaw_sum / float(gaze_n), -k_sin35, k_sin35);
+    const float sp = glm::clamp(pitch_sum / float(gaze_n), -k_sin25, k_sin25);
     // Eye bones: yaw about Y (toward +X), then pitch up (a negative turn about X).
-    glm::quat eye_local = axis_angle(k_y, yaw) * axis_angle(k_x, -pitch);
+    const glm::quat yq = axis_cos_sin(k_y, std::sqrt(1.f - sy * sy), sy);
+    const glm::quat pq = axis_cos_sin(k_x, std::sqrt(1.f - sp * sp), -sp);
+    // R_y * R_x of two single-axis quaternions: (a_w b_w, a_w b_x, a_y b_w, -a_y b_x).
+    const glm::quat eye_local(yq.w * pq.w, yq.w * pq.x, yq.y * pq.w, -yq.y * pq.x);
     set(m, bone::left_eye, head_w * eye_local, eye_local, 1.f);
     set(m, bone::right_eye, head_w * eye_local, eye_local, 1.f);
-    ex[idx(expression::look_left)] = glm::clamp(yaw / (25.f * k_deg), 0.f, 1.f);
-    ex[idx(expression::look_right)] = glm::clamp(-yaw / (25.f * k_deg), 0.f, 1.f);
-    ex[idx(expression::look_up)] = glm::clamp(pitch / (20.f * k_deg), 0.f, 1.f);
-    ex[idx(expression::look_down)] = glm::clamp(-pitch / (20.f * k_deg), 0.f, 1.f);
+    // look* weights: the gaze's sine over that of 25 degrees (sideways) or 20 (up/down).
+    ex[idx(expression::look_left)] = glm::clamp(sy / k_sin25, 0.f, 1.f);
+    ex[idx(expression::look_right)] = glm::clamp(-sy / k_sin25, 0.f, 1.f);
+    ex[idx(expression::look_up)] = glm::clamp(sp / k_sin20, 0.f, 1.f);
+    ex[idx(expression::look_down)] = glm::clamp(-sp / k_sin20, 0.f, 1.f);
   }
   // Mouth: a point in (openness, width) space, softly assigned to the nearest vowel shape.
   const float mouth_w = glm::length(fp.mouth[0] - fp.mouth[1]);
@@ -579,8 +639,9 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
     float open = glm::length(fp.lip_upper - fp.lip_lower) / mouth_w;
     float width = (mouth_w / face_w) / k_mouth_neutral_width;
     auto kernel = [&](float po, float pw) {
-      float dox = (open - po) / 0.6f, dwx = (width - pw) / 0.5f;
-      return std::exp(-(dox * dox + dwx * dwx) / (0.15f * 0.15f));
+      const float dox = (open - po) / 0.6f, dwx = (width - pw) / 0.5f;
+      const float e = (dox * dox + dwx * dwx) / (0.15f * 0.15f);
+      return e > 12.f ? 0.f : std::exp(-e);  // exp(-12) = 6e-6: skip the far shapes
     };
     float total = kernel(0.f, 1.f);  // closed, neutral mouth
     float k[5];
@@ -602,6 +663,7 @@ float smooth01(float x) {
 
 frame_solver::frame_solver(const solver_options& options)
     : options_(options.validate().ok() ? options : solver_options{}) {
+  focal_per_width_ = 0.5f / std::tan(0.5f * options_.horizontal_fov_degrees * k_deg);
   reset();
 }
 
@@ -611,6 +673,7 @@ void frame_solver::reset() {
   world_stamp_.fill(0);
   world_generation_ = 1;
   local_.fill(identity_quat());
+  have_arm_reference_[0] = have_arm_reference_[1] = false;
   hips_height_state_ = scalar_state{};
   ground_state_ = scalar_state{};
   face_state_ = scalar_state{};
@@ -624,7 +687,7 @@ void frame_solver::reset() {
 }
 
 void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const {
-  for (auto& b : m.bones) b = bone_measurement{};
+  for (auto& b : m.bones) b.confidence = 0.f;  // the other fields are written with it
   m.hips_height_valid = m.hips_ground_valid = m.expressions_valid = false;
   m.expressions.fill(0.f);
   prepared_frame f;
@@ -632,17 +695,20 @@ void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const
     f.width = options_.image_width;
     f.height = options_.image_height;
   }
+  f.focal = focal_per_width_ * f.width;
   prepare_body(in, options_, f);
   prepare_hand(in, options_, 0, f);
   prepare_hand(in, options_, 1, f);
   prepare_face(in, options_, f);
-  auto prev = [this](int b) -> const glm::quat& { return previous_world(b); };
-  measure_body(f, options_, have_prev_world_ ? &prev : nullptr, m);
+  const glm::quat* arm_ref[2] = {have_arm_reference_[0] ? &arm_reference_[0] : nullptr,
+                                 have_arm_reference_[1] ? &arm_reference_[1] : nullptr};
+  measure_body(f, options_, arm_ref, m);
   measure_hips_position(in, f, options_, m);
   measure_hands(f, options_, m);
   const bone_measurement& uc = m.bones[idx(bone::upper_chest)];
   const bool have_uc = uc.confidence > 0.f;
-  measure_face(f, options_, have_uc ? uc.world : previous_world(idx(bone::upper_chest)), m);
+  measure_face(f, options_, have_uc ? uc.world : previous_world(idx(bone::upper_chest)), have_uc,
+               m);
 }
 
 const glm::quat& frame_solver::previous_world(int b) const {
@@ -678,6 +744,13 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
 
   frame_measurement& m = scratch_;
   measure(in, m);
+  for (int side = 0; side < 2; ++side) {
+    const bone_measurement& ua = m.bones[idx(side == 0 ? bone::left_upper_arm : bone::right_upper_arm)];
+    if (ua.confidence > 0.f) {
+      arm_reference_[side] = ua.world;
+      have_arm_reference_[side] = true;
+    }
+  }
 
   // Local rotations of the measurement, relative to the measured parent when there is one,
   // else to the parent's last output.
@@ -716,6 +789,7 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
       if (c <= 0.f || c < co.lost_below) {
         s.tracked = false;
         s.lost_at = t;
+        s.last_good = s.output;  // hold what was last shown: continuous even mid-blend
       }
     } else if (c > 0.f && c >= co.found_above) {
       s.tracked = true;
@@ -725,7 +799,6 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
       s.ever_tracked = true;
     }
     if (s.tracked) {
-      s.last_good = local[b];
       s.output = local[b];
       if (s.blending) {
         const float k = float(t - s.found_at) * inv_regain;

@@ -30,48 +30,68 @@ inline float angle_of(const glm::vec3& a, const glm::vec3& b) {
 /// Component of v orthogonal to unit u.
 inline glm::vec3 orth(const glm::vec3& v, const glm::vec3& u) { return v - glm::dot(v, u) * u; }
 
-/// A signed coordinate axis of a bone's local frame: index 0 = X, 1 = Y, 2 = Z.
+/// A signed coordinate axis of a bone's local frame as a compile-time type: I = 0 (X), 1 (Y),
+/// 2 (Z); S = +1 or -1.
+template <int I, int S>
 struct axis {
-  int index;
-  float sign;
-  glm::vec3 vec() const {
+  static constexpr int index = I;
+  static constexpr float sign = static_cast<float>(S);
+  static glm::vec3 vec() {
     glm::vec3 v(0.f);
-    v[index] = sign;
+    v[I] = sign;
     return v;
   }
+  /// Image of this axis under the rotation q: a signed column of q's matrix.
+  static glm::vec3 rotated(const glm::quat& q) {
+    const float x = q.x, y = q.y, z = q.z, w = q.w;
+    glm::vec3 c;
+    if constexpr (I == 0)
+      c = glm::vec3(1.f - 2.f * (y * y + z * z), 2.f * (x * y + w * z), 2.f * (x * z - w * y));
+    else if constexpr (I == 1)
+      c = glm::vec3(2.f * (x * y - w * z), 1.f - 2.f * (x * x + z * z), 2.f * (y * z + w * x));
+    else
+      c = glm::vec3(2.f * (x * z + w * y), 2.f * (y * z - w * x), 1.f - 2.f * (x * x + y * y));
+    return sign * c;
+  }
 };
-inline constexpr axis k_px{0, 1.f}, k_nx{0, -1.f}, k_py{1, 1.f}, k_ny{1, -1.f}, k_pz{2, 1.f},
-    k_nz{2, -1.f};
+using k_px = axis<0, 1>;
+using k_nx = axis<0, -1>;
+using k_py = axis<1, 1>;
+using k_ny = axis<1, -1>;
+using k_pz = axis<2, 1>;
+using k_nz = axis<2, -1>;
 
-/// The rotation that maps local axis `a` onto the unit vector `p` exactly and local axis `b`
+/// The rotation that maps local axis A onto the unit vector `p` exactly and local axis B
 /// (a different axis) into the half-plane of `hint` (orthogonalised against p). When hint is
-/// parallel to p or zero: the shortest rotation of axis a onto p.
-inline glm::quat frame_from_axes(axis a, axis b, const glm::vec3& p, const glm::vec3& hint) {
+/// parallel to p or zero: the shortest rotation of axis A onto p.
+template <class A, class B>
+inline glm::quat frame_from_axes(const glm::vec3& p, const glm::vec3& hint) {
+  static_assert(A::index != B::index, "two different axes");
   glm::vec3 s = hint - glm::dot(hint, p) * p;
   const float s2 = glm::dot(s, s);
   const float h2 = glm::dot(hint, hint);
   if (!(s2 > 1e-10f * (h2 > 1e-20f ? h2 : 1e-20f)) || !std::isfinite(s2))
-    return rotation_between(a.vec(), p);
+    return rotation_between(A::vec(), p);
   s *= inv_sqrt(s2);
   glm::vec3 col[3];
-  col[a.index] = a.sign * p;
-  col[b.index] = b.sign * s;
-  const int c = 3 - a.index - b.index;
+  col[A::index] = A::sign * p;
+  col[B::index] = B::sign * s;
+  constexpr int c = 3 - A::index - B::index;
   col[c] = glm::cross(col[(c + 1) % 3], col[(c + 2) % 3]);
   return quat_from_basis(col[0], col[1], col[2]);
 }
 
-/// World rotation of a bone whose local axis `along` points along `dir`, and whose twist is set
-/// by `bend_target` (the next segment's direction, which leaves toward the bone's local axis
-/// `bend`) when the joint below is bent more than ~30 degrees, and otherwise by the minimal
-/// twist from `reference` (a world rotation whose `along`/`bend` axes are the reference
+/// World rotation of a bone whose local axis `Along` points along `dir`, and whose twist is
+/// set by `bend_target` (the next segment's direction, which leaves toward the bone's local
+/// axis `Bend`) when the joint below is bent more than ~30 degrees, and otherwise by the
+/// minimal twist from `reference` (a world rotation whose Along/Bend axes are the reference
 /// directions). `fallback_secondary`, when non-zero, replaces that minimal-twist reference as
-/// where `bend` points for straight limbs (e.g. the foot's forward direction for the knee).
-inline glm::quat aim_with_bend(const glm::quat& reference, axis along, axis bend,
-                               const glm::vec3& dir, const glm::vec3& bend_target,
-                               const glm::vec3& fallback_secondary) {
-  const glm::vec3 ref_dir = reference * along.vec();
-  const glm::vec3 ref_bend = reference * bend.vec();
+/// where Bend points for straight limbs (e.g. the foot's forward direction for the knee).
+template <class Along, class Bend>
+inline glm::quat aim_with_bend(const glm::quat& reference, const glm::vec3& dir,
+                               const glm::vec3& bend_target, const glm::vec3& fallback_secondary) {
+  const glm::vec3 ref_dir = Along::rotated(reference);
+  const glm::vec3 ref_bend = Bend::rotated(reference);
   const glm::vec3 d = normalize_or(dir, ref_dir);
   glm::vec3 ref;
   const float fb2 = glm::dot(fallback_secondary, fallback_secondary);
@@ -102,7 +122,7 @@ inline glm::quat aim_with_bend(const glm::quat& reference, axis along, axis bend
     const glm::vec3 mixed = w * bn + (1.f - w) * secondary;
     secondary = glm::dot(mixed, mixed) < 1e-6f ? bn : mixed;
   }
-  return frame_from_axes(along, bend, d, secondary);
+  return frame_from_axes<Along, Bend>(d, secondary);
 }
 
 /// Local rotation of a child bone relative to `parent_world` that points the child's rest

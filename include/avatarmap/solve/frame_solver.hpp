@@ -14,12 +14,12 @@
 
 namespace avatarmap {
 
-/// One bone's measurement before confidence gating: a world rotation in VRM space and its
-/// confidence (0 = not measured this frame).
+/// One bone's measurement before confidence gating and its confidence (0 = not measured this
+/// frame): a world rotation in VRM space, or, when has_local, the rotation relative to the
+/// measured parent (finger joints, eyes, toes, shoulders). For has_local bones `world` is
+/// filled only where a child needs it (shoulders, toes); compose parent world * local to get it.
 struct bone_measurement {
   glm::quat world{1.f, 0.f, 0.f, 0.f};
-  /// The rotation relative to the measured parent, when the measurement produced it directly
-  /// (has_local); otherwise the solver derives it from the two world rotations.
   glm::quat local{1.f, 0.f, 0.f, 0.f};
   float confidence = 0.f;
   bool has_local = false;
@@ -77,11 +77,14 @@ class frame_solver {
   const glm::quat& previous_world(int b) const;
 
   solver_options options_;
+  float focal_per_width_ = 1.f;  // focal length / image width, from the field of view
   std::array<bone_state, k_bone_count> bones_{};
   mutable std::array<glm::quat, k_bone_count> prev_world_{};  // memo of previous_world()
   mutable std::array<unsigned, k_bone_count> world_stamp_{};
   unsigned world_generation_ = 1;
   std::array<glm::quat, k_bone_count> local_{};
+  glm::quat arm_reference_[2]{};  // last measured upper-arm world rotations (left, right)
+  bool have_arm_reference_[2] = {false, false};
   scalar_state hips_height_state_{};
   scalar_state ground_state_{};
   scalar_state face_state_{};
