@@ -1,10 +1,10 @@
 // Per-frame solve cost: a full frame (pose + world, two hands + world, 478-point face) ->
 // proxy pose, one thread. Baseline: copying the landmark frame (the memory floor).
+#include <benchmark/benchmark.h>
+
 #include <cstring>
 #include <random>
 #include <vector>
-
-#include <benchmark/benchmark.h>
 
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"

@@ -72,8 +72,8 @@ status create_estimator(std::string_view name, const estimator_options& options,
     if (!names.empty()) names += ", ";
     names += list.items[i].name;
   }
-  return status::error("unknown estimator backend '" + std::string(name) + "' (available: " +
-                       names + ")");
+  return status::error("unknown estimator backend '" + std::string(name) +
+                       "' (available: " + names + ")");
 }
 
 }  // namespace avatarmap

@@ -37,7 +37,8 @@ class args {
           return false;
         }
         out = items_[i + 1];
-        items_.erase(items_.begin() + static_cast<long>(i), items_.begin() + static_cast<long>(i) + 2);
+        items_.erase(items_.begin() + static_cast<long>(i),
+                     items_.begin() + static_cast<long>(i) + 2);
         return true;
       }
       if (it.rfind(name + "=", 0) == 0) {

@@ -1,10 +1,10 @@
 // avatarmap: the command-line tool. See `avatarmap --help` and docs/cli.md.
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <string>
-
-#include <unistd.h>
 
 #include "avatarmap/version.hpp"
 #include "cli/commands.hpp"

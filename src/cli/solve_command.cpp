@@ -1,10 +1,10 @@
 // `avatarmap solve`: *.landmarks.jsonl -> *.pose.jsonl.
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <string>
-
-#include <unistd.h>
 
 #include "avatarmap/io/landmark_file.hpp"
 #include "avatarmap/io/pose_file.hpp"
@@ -94,13 +94,19 @@ int run_solve(int argc, char** argv) {
     size_t start = 0;
     while (start <= value.size()) {
       size_t end = value.find(',', start);
-      std::string part = value.substr(start, end == std::string::npos ? std::string::npos : end - start);
-      if (part == "body") p.body = true;
-      else if (part == "hands") p.hands = true;
-      else if (part == "face") p.face = true;
-      else if (part == "root") p.hips_translation = true;
+      std::string part =
+          value.substr(start, end == std::string::npos ? std::string::npos : end - start);
+      if (part == "body")
+        p.body = true;
+      else if (part == "hands")
+        p.hands = true;
+      else if (part == "face")
+        p.face = true;
+      else if (part == "root")
+        p.hips_translation = true;
       else {
-        std::fprintf(stderr, "avatarmap solve: unknown part '%s' in --parts (body,hands,face,root)\n",
+        std::fprintf(stderr,
+                     "avatarmap solve: unknown part '%s' in --parts (body,hands,face,root)\n",
                      part.c_str());
         return 2;
       }

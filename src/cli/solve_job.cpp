@@ -1,10 +1,10 @@
 #include "cli/solve_job.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-
-#include <unistd.h>
 
 #include "avatarmap/io/landmark_file.hpp"
 #include "avatarmap/io/pose_file.hpp"
@@ -57,9 +57,8 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
   pose_resampler resampler;
   landmark_frame frame;
   proxy_pose solved, filtered, sampled;
-  const bool show_progress =
-      job.progress == progress_mode::on ||
-      (job.progress == progress_mode::automatic && isatty(STDERR_FILENO));
+  const bool show_progress = job.progress == progress_mode::on ||
+                             (job.progress == progress_mode::automatic && isatty(STDERR_FILENO));
   auto last_progress = t0;
   double next_render_t = 0.0;
   bool have_render = false;
@@ -70,7 +69,8 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
     read_result r = reader.next(frame);
     if (r == read_result::end) break;
     if (r == read_result::error) {
-      if (!job.skip_bad_lines) return status::error(reader.error() + " (use --skip-bad-lines to go on)");
+      if (!job.skip_bad_lines)
+        return status::error(reader.error() + " (use --skip-bad-lines to go on)");
       ++s.bad_lines;
       if (s.bad_lines <= 5) std::fprintf(stderr, "warning: skipped %s\n", reader.error().c_str());
       continue;
@@ -80,7 +80,8 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
     ++s.frames;
     for (int p = 0; p < k_frame_part_count; ++p)
       if (frame.has(static_cast<frame_part>(p))) ++s.part_frames[p];
-    if (frame.has(frame_part::face) && frame.face_count == k_face_mesh_iris_count) ++s.face_iris_frames;
+    if (frame.has(frame_part::face) && frame.face_count == k_face_mesh_iris_count)
+      ++s.face_iris_frames;
 
     solver.solve(frame, solved);
     filter.apply(solved, filtered);
@@ -129,12 +130,12 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
 }
 
 void print_summary(const solve_job& job, const solve_summary& s, std::FILE* to) {
-  std::fprintf(to, "solved %ld frames (%.2f s of capture, t = %.3f .. %.3f) in %.3f s: %.0f frames/s\n",
+  std::fprintf(to,
+               "solved %ld frames (%.2f s of capture, t = %.3f .. %.3f) in %.3f s: %.0f frames/s\n",
                s.frames, s.t_last - s.t_first, s.t_first, s.t_last, s.seconds,
                s.frames / std::max(s.seconds, 1e-9));
   std::fprintf(to, "parts seen: pose %ld, pose_world %ld, left hand %ld, right hand %ld, face %ld",
-               s.part_frames[0], s.part_frames[1],
-               std::max(s.part_frames[2], s.part_frames[3]),
+               s.part_frames[0], s.part_frames[1], std::max(s.part_frames[2], s.part_frames[3]),
                std::max(s.part_frames[4], s.part_frames[5]), s.part_frames[6]);
   if (s.part_frames[6] > 0) std::fprintf(to, " (%ld with iris)", s.face_iris_frames);
   std::fprintf(to, "\n");

@@ -68,7 +68,8 @@ void prepare_body(const landmark_frame& in, const solver_options& o, prepared_fr
     int s = o.mirror ? pose_mirror_index(i) : i;
     const landmark& l = src[s];
     float c = landmark_confidence(l);
-    glm::vec3 v = world ? world_to_vrm(to_vec(l)) : image_to_vrm_pixels(to_vec(l), f.width, f.height);
+    glm::vec3 v =
+        world ? world_to_vrm(to_vec(l)) : image_to_vrm_pixels(to_vec(l), f.width, f.height);
     if (v.x * 0.f + v.y * 0.f + v.z * 0.f != 0.f) {  // NaN or infinite (also after scaling)
       v = glm::vec3(0.f);
       c = 0.f;
@@ -241,8 +242,9 @@ void measure_leg(const glm::vec3& hip, const glm::vec3& knee, const glm::vec3& a
 // Wrist orientation of the avatar's left hand from the 21 hand points: +X along wrist ->
 // middle knuckle, +Z toward the index side (palm faces -Y at rest).
 glm::quat hand_world_from_points(const hand_points& h) {
-  return frame_from_axes<k_px, k_pz>(normalize_or(h.p[idx(hand_landmark::middle_mcp)] - h.p[0], k_x),
-                         h.p[idx(hand_landmark::index_mcp)] - h.p[idx(hand_landmark::pinky_mcp)]);
+  return frame_from_axes<k_px, k_pz>(
+      normalize_or(h.p[idx(hand_landmark::middle_mcp)] - h.p[0], k_x),
+      h.p[idx(hand_landmark::index_mcp)] - h.p[idx(hand_landmark::pinky_mcp)]);
 }
 
 // Thumb rest frame: X along the thumb's rest direction (1, 0, 1)/sqrt2, Y up.
@@ -285,7 +287,8 @@ void measure_fingers(const hand_points& h, const glm::quat& hand_w, float c, boo
   {
     const glm::vec3 d = h.p[2] - h.p[1];
     const glm::vec3 bend_to = h.p[4] - h.p[2];
-    const glm::quat g = aim_with_bend<k_px, k_ny>(hand_w * k_thumb_frame, d, bend_to, glm::vec3(0.f));
+    const glm::quat g =
+        aim_with_bend<k_px, k_ny>(hand_w * k_thumb_frame, d, bend_to, glm::vec3(0.f));
     const glm::quat inv_f = glm::conjugate(k_thumb_frame);
     const glm::quat mc_w = g * inv_f;
     set(m, static_cast<bone>(first), left ? mc_w : mirror_x(mc_w), c);
@@ -357,8 +360,8 @@ void measure_body(const prepared_frame& f, const solver_options& o,
   const glm::vec3 sh_l = b.p[idx(pl::left_shoulder)], sh_r = b.p[idx(pl::right_shoulder)];
   const glm::vec3 hip_mid = 0.5f * (hip_l + hip_r);
   const glm::vec3 up = 0.5f * (sh_l + sh_r) - hip_mid;
-  const float c_torso = min_conf(b, {idx(pl::left_hip), idx(pl::right_hip),
-                                     idx(pl::left_shoulder), idx(pl::right_shoulder)});
+  const float c_torso = min_conf(
+      b, {idx(pl::left_hip), idx(pl::right_hip), idx(pl::left_shoulder), idx(pl::right_shoulder)});
   // Hips: yaw and roll from the hip line; a share of the torso's lean about the hip line.
   const glm::vec3 hip_line = normalize_or(hip_l - hip_r, k_x);
   const glm::quat upright = frame_from_axes<k_px, k_py>(hip_line, k_y);
@@ -397,7 +400,8 @@ void measure_body(const prepared_frame& f, const solver_options& o,
 
     glm::quat ua, la, la_local;
     glm::quat twist_ref = uc;
-    if (arm_reference[side]) twist_ref = left ? *arm_reference[side] : mirror_x(*arm_reference[side]);
+    if (arm_reference[side])
+      twist_ref = left ? *arm_reference[side] : mirror_x(*arm_reference[side]);
     measure_arm(P(pl::left_shoulder, pl::right_shoulder), P(pl::left_elbow, pl::right_elbow),
                 P(pl::left_wrist, pl::right_wrist), twist_ref, ua, la, la_local);
     float c_ua = C({pl::left_shoulder, pl::left_elbow}, {pl::right_shoulder, pl::right_elbow});
@@ -410,7 +414,8 @@ void measure_body(const prepared_frame& f, const solver_options& o,
       glm::vec3 wr = P(pl::left_wrist, pl::right_wrist);
       glm::vec3 pk = P(pl::left_pinky, pl::right_pinky);
       glm::vec3 ix = P(pl::left_index, pl::right_index);
-      glm::quat hand = frame_from_axes<k_px, k_pz>(normalize_or(0.5f * (pk + ix) - wr, k_x), ix - pk);
+      glm::quat hand =
+          frame_from_axes<k_px, k_pz>(normalize_or(0.5f * (pk + ix) - wr, k_x), ix - pk);
       float c_h = C({pl::left_wrist, pl::left_pinky, pl::left_index},
                     {pl::right_wrist, pl::right_pinky, pl::right_index});
       set(m, left ? bone::left_hand : bone::right_hand, out(hand), 0.999f * c_h);
@@ -421,8 +426,8 @@ void measure_body(const prepared_frame& f, const solver_options& o,
                            {pl::right_ankle, pl::right_heel, pl::right_foot_index});
     measure_leg(P(pl::left_hip, pl::right_hip), P(pl::left_knee, pl::right_knee),
                 P(pl::left_ankle, pl::right_ankle), P(pl::left_heel, pl::right_heel),
-                P(pl::left_foot_index, pl::right_foot_index), c_foot > o.confidence.lost_below,
-                hw, ul, ll, ll_local, foot);
+                P(pl::left_foot_index, pl::right_foot_index), c_foot > o.confidence.lost_below, hw,
+                ul, ll, ll_local, foot);
     set(m, left ? bone::left_upper_leg : bone::right_upper_leg, out(ul),
         C({pl::left_hip, pl::left_knee}, {pl::right_hip, pl::right_knee}));
     set(m, left ? bone::left_lower_leg : bone::right_lower_leg, out(ll), out(ll_local),
@@ -440,10 +445,10 @@ void measure_hips_position(const landmark_frame& in, const prepared_frame& f,
   if (!b.valid || !o.parts.body || !o.parts.hips_translation) return;
   using pl = pose_landmark;
   if (b.metric) {
-    float c = min_conf(b, {idx(pl::left_hip), idx(pl::right_hip), idx(pl::left_knee),
-                           idx(pl::right_knee), idx(pl::left_ankle), idx(pl::right_ankle),
-                           idx(pl::left_heel), idx(pl::right_heel), idx(pl::left_foot_index),
-                           idx(pl::right_foot_index)});
+    float c =
+        min_conf(b, {idx(pl::left_hip), idx(pl::right_hip), idx(pl::left_knee), idx(pl::right_knee),
+                     idx(pl::left_ankle), idx(pl::right_ankle), idx(pl::left_heel),
+                     idx(pl::right_heel), idx(pl::left_foot_index), idx(pl::right_foot_index)});
     if (c > o.confidence.lost_below) {
       float floor_y = b.p[idx(pl::left_ankle)].y;
       for (int i = idx(pl::left_ankle); i <= idx(pl::right_foot_index); ++i)
@@ -481,8 +486,8 @@ void measure_hips_position(const landmark_frame& in, const prepared_frame& f,
     den += glm::dot(dw, dw);
   }
   if (!(den > 1e-6f) || !(num > 0.f)) return;
-  const float s = num / den;             // pixels per metre
-  const glm::vec2 t = mi - s * mw;       // hip midpoint in pixels
+  const float s = num / den;        // pixels per metre
+  const glm::vec2 t = mi - s * mw;  // hip midpoint in pixels
   const float focal = f.focal;
   const float depth = focal / s;
   float x = (t.x - 0.5f * f.width) / focal * depth;
@@ -588,8 +593,8 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
     float gap = 0.f;
     for (int k = 0; k < 3; ++k) gap += glm::length(e.upper[k] - e.lower[k]);
     float ratio = gap / (3.f * width);
-    closure[s] = glm::clamp((k_eye_open_ratio - ratio) / (k_eye_open_ratio - k_eye_closed_ratio),
-                            0.f, 1.f);
+    closure[s] =
+        glm::clamp((k_eye_open_ratio - ratio) / (k_eye_open_ratio - k_eye_closed_ratio), 0.f, 1.f);
     glm::vec3 ax = across / width;
     glm::vec3 up_dir = normalize_or(orth(head_up, ax), k_y);
     // Brows: height of the brow above the middle of the upper lid.
@@ -640,7 +645,7 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
     float width = (mouth_w / face_w) / k_mouth_neutral_width;
     auto kernel = [&](float po, float pw) {
       const float dox = (open - po) / 0.6f, dwx = (width - pw) / 0.5f;
-      const float e = (dox * dox + dwx * dwx) / (0.15f * 0.15f);
+      const float e = (dox * dox + dwx * dwx) / (0.12f * 0.12f);
       return e > 12.f ? 0.f : std::exp(-e);  // exp(-12) = 6e-6: skip the far shapes
     };
     float total = kernel(0.f, 1.f);  // closed, neutral mouth
@@ -745,7 +750,8 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
   frame_measurement& m = scratch_;
   measure(in, m);
   for (int side = 0; side < 2; ++side) {
-    const bone_measurement& ua = m.bones[idx(side == 0 ? bone::left_upper_arm : bone::right_upper_arm)];
+    const bone_measurement& ua =
+        m.bones[idx(side == 0 ? bone::left_upper_arm : bone::right_upper_arm)];
     if (ua.confidence > 0.f) {
       arm_reference_[side] = ua.world;
       have_arm_reference_[side] = true;
@@ -833,7 +839,7 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
       hips_height_ = hips_height_held_ = m.hips_height;
     } else if (hips_height_state_.ever_tracked) {
       double age = t - hips_height_state_.lost_at;
-      float e = age <= co.hold_seconds ? 0.f
+      float e = age <= co.hold_seconds  ? 0.f
                 : co.ease_seconds > 0.f ? float((age - co.hold_seconds) / co.ease_seconds)
                                         : 1.f;
       hips_height_ = glm::mix(hips_height_held_, options_.rest_hips_height, smooth01(e));

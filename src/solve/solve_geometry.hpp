@@ -5,7 +5,6 @@
 #pragma once
 
 #include <cmath>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 

@@ -1,11 +1,11 @@
 // Solver accuracy against ground truth: random poses with known rotations are turned into the
 // landmarks they would yield by the synthetic generator (an independent forward model), solved,
 // and compared. Figures are printed with a "[figures]" prefix for the note.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "avatarmap/core/rotation.hpp"
 #include "avatarmap/solve/frame_solver.hpp"
@@ -91,8 +91,7 @@ void print(const char* what, const run_result& r) {
   std::printf(
       "[figures] %s: body limbs mean %.3f max %.3f deg | hands mean %.3f max %.3f | fingers "
       "mean %.3f max %.3f (%s) | head orientation mean %.3f max %.3f (n=%ld poses)\n",
-      what, r.body.mean(), r.body.max, r.hands.mean(), r.hands.max, r.fingers.mean(),
-      r.fingers.max,
+      what, r.body.mean(), r.body.max, r.hands.mean(), r.hands.max, r.fingers.mean(), r.fingers.max,
       r.worst_finger < 0 ? "-" : std::string(bone_name(static_cast<bone>(r.worst_finger))).c_str(),
       r.head.mean(), r.head.max, r.head.n);
 }
@@ -154,7 +153,8 @@ TEST(Accuracy, FingerFlexionOverTheFullRange) {
           glm::vec3 v = (side == 0 ? q : mirror_x(q)) * glm::vec3(1, 0, 0);
           return std::atan2(-v.y, v.x) / k_deg;
         };
-        double e = std::abs(flexion(solved.rotations[first + k]) - flexion(truth.rotations[first + k]));
+        double e =
+            std::abs(flexion(solved.rotations[first + k]) - flexion(truth.rotations[first + k]));
         worst = std::max(worst, e);
         EXPECT_LE(e, 3.0) << "flex " << flex << " bone " << bone_name(static_cast<bone>(first + k));
       }

@@ -1,12 +1,12 @@
 // The per-frame path allocates nothing: a counting global operator new (for this test
 // executable) proves that frame_solver::solve, pose_filter::apply and the resampler make no
 // heap allocation once constructed.
+#include <gtest/gtest.h>
+
 #include <atomic>
 #include <cstdlib>
 #include <new>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"

@@ -3,11 +3,11 @@
 // bad input; confidence gating over time; inputs never modified.
 #include "avatarmap/solve/frame_solver.hpp"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstring>
 #include <limits>
-
-#include <gtest/gtest.h>
 
 #include "avatarmap/core/rotation.hpp"
 
@@ -56,7 +56,8 @@ landmark_frame& add_left_hand(landmark_frame& f, float index_flex_degrees) {
   auto put_h = [&](int i, glm::vec3 v) { f.left_hand_world[i] = landmark{v.x, -v.y, -v.z, 1, 1}; };
   put_h(0, {0.f, 0.f, 0.f});
   // Thumb along (1, 0, 1)/sqrt2.
-  for (int k = 0; k < 4; ++k) put_h(1 + k, glm::vec3(0.02f, 0.f, 0.02f) + float(k) * glm::vec3(0.025f, 0.f, 0.025f));
+  for (int k = 0; k < 4; ++k)
+    put_h(1 + k, glm::vec3(0.02f, 0.f, 0.02f) + float(k) * glm::vec3(0.025f, 0.f, 0.025f));
   const float z[5] = {0.f, 0.025f, 0.f, -0.02f, -0.04f};
   for (int finger = 1; finger < 5; ++finger) {
     glm::vec3 mcp(0.09f, 0.f, z[finger]);
@@ -93,11 +94,11 @@ TEST(FrameSolver, TPoseGivesIdentityBodyRotations) {
   frame_solver solver;
   proxy_pose out;
   solver.solve(t_pose_frame(), out);
-  for (bone b : {bone::hips, bone::spine, bone::chest, bone::upper_chest, bone::left_upper_arm,
-                 bone::left_lower_arm, bone::right_upper_arm, bone::right_lower_arm,
-                 bone::left_upper_leg, bone::left_lower_leg, bone::right_upper_leg,
-                 bone::right_lower_leg, bone::left_hand, bone::right_hand, bone::neck,
-                 bone::head}) {
+  for (bone b :
+       {bone::hips, bone::spine, bone::chest, bone::upper_chest, bone::left_upper_arm,
+        bone::left_lower_arm, bone::right_upper_arm, bone::right_lower_arm, bone::left_upper_leg,
+        bone::left_lower_leg, bone::right_upper_leg, bone::right_lower_leg, bone::left_hand,
+        bone::right_hand, bone::neck, bone::head}) {
     EXPECT_LT(rotation_angle(out[b]) / k_deg, 0.5f) << bone_name(b);
   }
   // Feet: heel -> toe is horizontal here while the rest direction points 26.6 degrees down,
@@ -110,7 +111,7 @@ TEST(FrameSolver, TPoseGivesIdentityBodyRotations) {
 TEST(FrameSolver, ArmDownAndElbowBentForward) {
   landmark_frame f = t_pose_frame();
   using pl = pose_landmark;
-  put(f.pose_world, pl::left_elbow, {0.18f, 0.22f, 0.f});   // upper arm straight down
+  put(f.pose_world, pl::left_elbow, {0.18f, 0.22f, 0.f});    // upper arm straight down
   put(f.pose_world, pl::left_wrist, {0.18f, 0.22f, 0.25f});  // forearm forward (+Z)
   solver_options o;
   o.parts.hands = false;  // no wrist twist moved into the forearm
@@ -266,7 +267,7 @@ TEST(FrameSolver, LostBoneHoldsThenEasesToRestWithoutSnapping) {
     EXPECT_EQ(out.confidence[idx(bone::left_upper_arm)], 0.f);
   }
   EXPECT_LT(rotation_angle(prev) / k_deg, 1e-3f);  // at rest after hold + ease
-  EXPECT_LT(max_step, 90.f / 30.f * 1.6f);           // smoothstep peak slope 1.5x the mean
+  EXPECT_LT(max_step, 90.f / 30.f * 1.6f);         // smoothstep peak slope 1.5x the mean
   // Hysteresis: a confidence between the thresholds does not bring it back...
   f.pose_world[idx(pl::left_elbow)].visibility = 0.4f;
   f.t += 1.0 / 30;

@@ -1,10 +1,10 @@
 // The solver on Google's reference landmarks of a real squat video (tfjs-models test data:
 // pose_squats.full.json = image pixels, pose_squats_3d.full.json = world metres; 65 frames
 // of a 720x1280 video at 5 fps). Skipped without AVATARMAP_TEST_DATA.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <fstream>
-
-#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "avatarmap/core/rotation.hpp"
@@ -31,8 +31,8 @@ bool load(std::vector<landmark_frame>& frames) {
     for (int k = 0; k < 33; ++k) {
       f.pose[k] = landmark{ji[i][k][0].get<float>() / k_width, ji[i][k][1].get<float>() / k_height,
                            ji[i][k][2].get<float>() / k_width, 1.f, 1.f};
-      f.pose_world[k] =
-          landmark{jw[i][k][0].get<float>(), jw[i][k][1].get<float>(), jw[i][k][2].get<float>(), 1.f, 1.f};
+      f.pose_world[k] = landmark{jw[i][k][0].get<float>(), jw[i][k][1].get<float>(),
+                                 jw[i][k][2].get<float>(), 1.f, 1.f};
     }
     f.set(frame_part::pose, true);
     f.set(frame_part::pose_world, true);
@@ -81,9 +81,10 @@ TEST(RealSquats, HipsHeightFollowsTheSquatsAndBonesMovePlausibly) {
   double corr = sxy / std::sqrt(sxx * syy);
   double hmin = *std::min_element(height.begin(), height.end());
   double hmax = *std::max_element(height.begin(), height.end());
-  std::printf("[figures] hips height %.3f..%.3f m, corr(height, image hip y) = %.3f, "
-              "max bone step %.1f deg (%s) between frames at 5 fps\n",
-              hmin, hmax, corr, max_step, std::string(bone_name(static_cast<bone>(max_bone))).c_str());
+  std::printf(
+      "[figures] hips height %.3f..%.3f m, corr(height, image hip y) = %.3f, "
+      "max bone step %.1f deg (%s) between frames at 5 fps\n",
+      hmin, hmax, corr, max_step, std::string(bone_name(static_cast<bone>(max_bone))).c_str());
   EXPECT_LT(corr, -0.9);
   EXPECT_GT(hmax - hmin, 0.25);  // a real squat lowers the hips by decimetres
   EXPECT_GT(hmin, 0.2);

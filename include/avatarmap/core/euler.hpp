@@ -11,11 +11,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <optional>
-#include <string_view>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <optional>
+#include <string_view>
 
 namespace avatarmap {
 
@@ -55,12 +54,18 @@ struct euler_axes {
 };
 constexpr euler_axes axes_of(euler_order order) {
   switch (order) {
-    case euler_order::xyz: return {0, 1, 2, 1.f};
-    case euler_order::xzy: return {0, 2, 1, -1.f};
-    case euler_order::yxz: return {1, 0, 2, -1.f};
-    case euler_order::yzx: return {1, 2, 0, 1.f};
-    case euler_order::zxy: return {2, 0, 1, 1.f};
-    case euler_order::zyx: return {2, 1, 0, -1.f};
+    case euler_order::xyz:
+      return {0, 1, 2, 1.f};
+    case euler_order::xzy:
+      return {0, 2, 1, -1.f};
+    case euler_order::yxz:
+      return {1, 0, 2, -1.f};
+    case euler_order::yzx:
+      return {1, 2, 0, 1.f};
+    case euler_order::zxy:
+      return {2, 0, 1, 1.f};
+    case euler_order::zyx:
+      return {2, 1, 0, -1.f};
   }
   return {0, 1, 2, 1.f};
 }

@@ -96,8 +96,8 @@ inline glm::quat slerp_shortest(const glm::quat& a, glm::quat b, float t) {
 /// heuristic share, not a measurement.
 inline glm::quat nlerp_shortest(const glm::quat& a, glm::quat b, float t) {
   if (a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w < 0.f) b = -b;
-  return normalized(glm::quat(a.w + t * (b.w - a.w), a.x + t * (b.x - a.x),
-                              a.y + t * (b.y - a.y), a.z + t * (b.z - a.z)));
+  return normalized(glm::quat(a.w + t * (b.w - a.w), a.x + t * (b.x - a.x), a.y + t * (b.y - a.y),
+                              a.z + t * (b.z - a.z)));
 }
 
 /// q^t along the shortest arc from identity (t in [0, 1] takes a fraction of the rotation).
@@ -192,8 +192,8 @@ inline glm::quat quat_from_basis(const glm::vec3& x, const glm::vec3& y, const g
 /// `primary` or zero, the result is rotation_between(rest_primary, primary). rest_primary
 /// and rest_secondary must not be parallel.
 inline glm::quat frame_from_two_vectors(const glm::vec3& rest_primary,
-                                        const glm::vec3& rest_secondary,
-                                        const glm::vec3& primary, const glm::vec3& secondary) {
+                                        const glm::vec3& rest_secondary, const glm::vec3& primary,
+                                        const glm::vec3& secondary) {
   // R = [p s t] * [a b c]^T for the orthonormal rest frame (a, b, c) and target frame (p, s, t).
   const glm::vec3 a = rest_primary * inv_sqrt(glm::dot(rest_primary, rest_primary));
   const glm::vec3 p = normalize_or(primary, a);

@@ -37,8 +37,8 @@ inline constexpr int k_frame_part_count = 7;
 /// JSON key of a part in *.landmarks.jsonl ("pose", "pose_world", "left_hand", ...).
 constexpr const char* frame_part_key(frame_part p) {
   constexpr const char* k_keys[k_frame_part_count] = {
-      "pose", "pose_world", "left_hand", "left_hand_world", "right_hand", "right_hand_world",
-      "face"};
+      "pose",       "pose_world",       "left_hand", "left_hand_world",
+      "right_hand", "right_hand_world", "face"};
   return k_keys[static_cast<int>(p)];
 }
 

@@ -47,7 +47,7 @@ enum class pose_landmark : std::uint8_t {
 constexpr int pose_mirror_index(int i) {
   if (i <= 0 || i >= k_pose_landmark_count) return i;
   if (i <= 6) return i <= 3 ? i + 3 : i - 3;  // eyes: 1..3 <-> 4..6
-  return (i % 2 == 1) ? i + 1 : i - 1;          // 7/8, 9/10, ... 31/32
+  return (i % 2 == 1) ? i + 1 : i - 1;        // 7/8, 9/10, ... 31/32
 }
 
 constexpr int idx(pose_landmark p) { return static_cast<int>(p); }

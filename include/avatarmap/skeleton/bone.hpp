@@ -5,29 +5,68 @@
 
 #include <array>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <optional>
 #include <string_view>
-
-#include <glm/glm.hpp>
 
 namespace avatarmap {
 
 enum class bone : std::uint8_t {
-  hips, spine, chest, upper_chest, neck, head, left_eye, right_eye, jaw,
-  left_upper_leg, left_lower_leg, left_foot, left_toes,
-  right_upper_leg, right_lower_leg, right_foot, right_toes,
-  left_shoulder, left_upper_arm, left_lower_arm, left_hand,
-  right_shoulder, right_upper_arm, right_lower_arm, right_hand,
-  left_thumb_metacarpal, left_thumb_proximal, left_thumb_distal,
-  left_index_proximal, left_index_intermediate, left_index_distal,
-  left_middle_proximal, left_middle_intermediate, left_middle_distal,
-  left_ring_proximal, left_ring_intermediate, left_ring_distal,
-  left_little_proximal, left_little_intermediate, left_little_distal,
-  right_thumb_metacarpal, right_thumb_proximal, right_thumb_distal,
-  right_index_proximal, right_index_intermediate, right_index_distal,
-  right_middle_proximal, right_middle_intermediate, right_middle_distal,
-  right_ring_proximal, right_ring_intermediate, right_ring_distal,
-  right_little_proximal, right_little_intermediate, right_little_distal,
+  hips,
+  spine,
+  chest,
+  upper_chest,
+  neck,
+  head,
+  left_eye,
+  right_eye,
+  jaw,
+  left_upper_leg,
+  left_lower_leg,
+  left_foot,
+  left_toes,
+  right_upper_leg,
+  right_lower_leg,
+  right_foot,
+  right_toes,
+  left_shoulder,
+  left_upper_arm,
+  left_lower_arm,
+  left_hand,
+  right_shoulder,
+  right_upper_arm,
+  right_lower_arm,
+  right_hand,
+  left_thumb_metacarpal,
+  left_thumb_proximal,
+  left_thumb_distal,
+  left_index_proximal,
+  left_index_intermediate,
+  left_index_distal,
+  left_middle_proximal,
+  left_middle_intermediate,
+  left_middle_distal,
+  left_ring_proximal,
+  left_ring_intermediate,
+  left_ring_distal,
+  left_little_proximal,
+  left_little_intermediate,
+  left_little_distal,
+  right_thumb_metacarpal,
+  right_thumb_proximal,
+  right_thumb_distal,
+  right_index_proximal,
+  right_index_intermediate,
+  right_index_distal,
+  right_middle_proximal,
+  right_middle_intermediate,
+  right_middle_distal,
+  right_ring_proximal,
+  right_ring_intermediate,
+  right_ring_distal,
+  right_little_proximal,
+  right_little_intermediate,
+  right_little_distal,
 };
 
 inline constexpr int k_bone_count = 55;
@@ -37,26 +76,68 @@ constexpr int idx(bone b) { return static_cast<int>(b); }
 
 namespace detail {
 inline constexpr std::array<std::string_view, k_bone_count> k_bone_names = {
-    "hips", "spine", "chest", "upperChest", "neck", "head", "leftEye", "rightEye", "jaw",
-    "leftUpperLeg", "leftLowerLeg", "leftFoot", "leftToes",
-    "rightUpperLeg", "rightLowerLeg", "rightFoot", "rightToes",
-    "leftShoulder", "leftUpperArm", "leftLowerArm", "leftHand",
-    "rightShoulder", "rightUpperArm", "rightLowerArm", "rightHand",
-    "leftThumbMetacarpal", "leftThumbProximal", "leftThumbDistal",
-    "leftIndexProximal", "leftIndexIntermediate", "leftIndexDistal",
-    "leftMiddleProximal", "leftMiddleIntermediate", "leftMiddleDistal",
-    "leftRingProximal", "leftRingIntermediate", "leftRingDistal",
-    "leftLittleProximal", "leftLittleIntermediate", "leftLittleDistal",
-    "rightThumbMetacarpal", "rightThumbProximal", "rightThumbDistal",
-    "rightIndexProximal", "rightIndexIntermediate", "rightIndexDistal",
-    "rightMiddleProximal", "rightMiddleIntermediate", "rightMiddleDistal",
-    "rightRingProximal", "rightRingIntermediate", "rightRingDistal",
-    "rightLittleProximal", "rightLittleIntermediate", "rightLittleDistal"};
+    "hips",
+    "spine",
+    "chest",
+    "upperChest",
+    "neck",
+    "head",
+    "leftEye",
+    "rightEye",
+    "jaw",
+    "leftUpperLeg",
+    "leftLowerLeg",
+    "leftFoot",
+    "leftToes",
+    "rightUpperLeg",
+    "rightLowerLeg",
+    "rightFoot",
+    "rightToes",
+    "leftShoulder",
+    "leftUpperArm",
+    "leftLowerArm",
+    "leftHand",
+    "rightShoulder",
+    "rightUpperArm",
+    "rightLowerArm",
+    "rightHand",
+    "leftThumbMetacarpal",
+    "leftThumbProximal",
+    "leftThumbDistal",
+    "leftIndexProximal",
+    "leftIndexIntermediate",
+    "leftIndexDistal",
+    "leftMiddleProximal",
+    "leftMiddleIntermediate",
+    "leftMiddleDistal",
+    "leftRingProximal",
+    "leftRingIntermediate",
+    "leftRingDistal",
+    "leftLittleProximal",
+    "leftLittleIntermediate",
+    "leftLittleDistal",
+    "rightThumbMetacarpal",
+    "rightThumbProximal",
+    "rightThumbDistal",
+    "rightIndexProximal",
+    "rightIndexIntermediate",
+    "rightIndexDistal",
+    "rightMiddleProximal",
+    "rightMiddleIntermediate",
+    "rightMiddleDistal",
+    "rightRingProximal",
+    "rightRingIntermediate",
+    "rightRingDistal",
+    "rightLittleProximal",
+    "rightLittleIntermediate",
+    "rightLittleDistal"};
 
 constexpr std::array<std::int8_t, k_bone_count> make_parents() {
   std::array<std::int8_t, k_bone_count> p{};
   using b = bone;
-  auto set = [&p](bone child, bone parent) { p[idx(child)] = static_cast<std::int8_t>(idx(parent)); };
+  auto set = [&p](bone child, bone parent) {
+    p[idx(child)] = static_cast<std::int8_t>(idx(parent));
+  };
   p[idx(b::hips)] = k_no_parent;
   set(b::spine, b::hips);
   set(b::chest, b::spine);
@@ -120,7 +201,8 @@ constexpr bool is_right(bone b) { return bone_name(b).substr(0, 5) == "right"; }
 constexpr bone mirror_bone(bone b) {
   int i = idx(b);
   if (i >= idx(bone::left_upper_leg) && i <= idx(bone::left_toes)) return static_cast<bone>(i + 4);
-  if (i >= idx(bone::right_upper_leg) && i <= idx(bone::right_toes)) return static_cast<bone>(i - 4);
+  if (i >= idx(bone::right_upper_leg) && i <= idx(bone::right_toes))
+    return static_cast<bone>(i - 4);
   if (i >= idx(bone::left_shoulder) && i <= idx(bone::left_hand)) return static_cast<bone>(i + 4);
   if (i >= idx(bone::right_shoulder) && i <= idx(bone::right_hand)) return static_cast<bone>(i - 4);
   if (i >= idx(bone::left_thumb_metacarpal) && i <= idx(bone::left_little_distal))

@@ -32,8 +32,8 @@ inline constexpr int k_expression_count = 16;
 
 namespace detail {
 inline constexpr std::array<std::string_view, k_expression_count> k_expression_names = {
-    "blink",  "blinkLeft",  "blinkRight", "aa",          "ih",           "ou",
-    "ee",     "oh",         "lookUp",     "lookDown",    "lookLeft",     "lookRight",
+    "blink",      "blinkLeft",   "blinkRight",   "aa",           "ih",       "ou",
+    "ee",         "oh",          "lookUp",       "lookDown",     "lookLeft", "lookRight",
     "browUpLeft", "browUpRight", "browDownLeft", "browDownRight"};
 }
 

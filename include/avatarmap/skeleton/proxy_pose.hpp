@@ -4,7 +4,6 @@
 #pragma once
 
 #include <array>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
@@ -21,8 +20,8 @@ struct proxy_pose {
   /// Hips joint in VRM space, metres: Y above the floor (soles at 0); X and Z from the
   /// solver's origin (see solver docs).
   glm::vec3 hips_position{0.f, k_default_hips_height, 0.f};
-  std::array<glm::quat, k_bone_count> rotations;       // local, {w,x,y,z} in GLM's storage
-  std::array<float, k_bone_count> confidence{};        // 0 = not observed .. 1 = observed
+  std::array<glm::quat, k_bone_count> rotations;        // local, {w,x,y,z} in GLM's storage
+  std::array<float, k_bone_count> confidence{};         // 0 = not observed .. 1 = observed
   std::array<float, k_expression_count> expressions{};  // 0 .. 1
 
   proxy_pose() { set_rest(); }

@@ -4,7 +4,6 @@
 #pragma once
 
 #include <array>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 

@@ -68,8 +68,7 @@ struct solver_options {
         !std::isfinite(confidence.ease_seconds) || !std::isfinite(confidence.regain_seconds))
       return status::error("confidence hold/ease/regain seconds must be finite and >= 0");
     if (bad01(hips_lean_share)) return status::error("hips_lean_share must be in [0, 1]");
-    if (bad01(forearm_twist_share))
-      return status::error("forearm_twist_share must be in [0, 1]");
+    if (bad01(forearm_twist_share)) return status::error("forearm_twist_share must be in [0, 1]");
     if (!(horizontal_fov_degrees > 1.f && horizontal_fov_degrees < 179.f))
       return status::error("horizontal_fov_degrees must be in (1, 179)");
     if (!(rest_hips_height > 0.f && rest_hips_height < 10.f))

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs what avatarmap needs from Debian's packages, only when something is missing
+# (idempotent; a no-op on a prepared machine). Used by scripts/demo.sh and scripts/test.sh.
+set -euo pipefail
+
+packages=(build-essential cmake ninja-build pkg-config
+          libglm-dev libeigen3-dev nlohmann-json3-dev libtinygltf-dev
+          libgtest-dev libgmock-dev libbenchmark-dev
+          clang libclang-rt-14-dev clang-format python3)
+if [ "${AVATARMAP_SKIP_FUZZ:-0}" = 1 ]; then
+  packages=("${packages[@]/clang/}")
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  [ -n "$p" ] || continue
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  sudo_cmd=""
+  if [ "$(id -u)" != 0 ]; then sudo_cmd="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo_cmd apt-get update -qq
+  $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
