@@ -2,6 +2,7 @@
 // "--name=value" options, positionals. Errors are messages for the user, never exceptions.
 #pragma once
 
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -85,5 +86,17 @@ class args {
   std::vector<std::string> items_;
   std::string error_;
 };
+
+/// Parses "WxH" (pixels, each 1..100000, nothing else on the line); false when malformed.
+inline bool parse_image_size(const std::string& s, int& out_width, int& out_height) {
+  int a = 0, b = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(s.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') ||
+      a <= 0 || b <= 0 || a > 100000 || b > 100000)
+    return false;
+  out_width = a;
+  out_height = b;
+  return true;
+}
 
 }  // namespace avatarmap::cli

@@ -30,8 +30,10 @@ const char* k_solve_help =
     "  --mirror               mirror the performer (for mirrored webcam recordings)\n"
     "  --image-size WxH       image size in pixels (default: the file's header; without one,\n"
     "                         square pixels are assumed and a warning is printed)\n"
-    "  --filter euro|none     One Euro filter on rotations, position and expressions\n"
-    "                         (default: euro)\n"
+    "  --filter euro|landmarks|both|none\n"
+    "                         One Euro filtering: euro = on the solved rotations, position\n"
+    "                         and expressions (default); landmarks = on every landmark before\n"
+    "                         solving; both; none\n"
     "  --min-cutoff HZ        One Euro cutoff at rest for rotations (default 1.5)\n"
     "  --beta B               One Euro speed coefficient for rotations (default 0.5)\n"
     "  --fps N                resample the output at N frames per second (slerp between\n"
@@ -42,17 +44,6 @@ const char* k_solve_help =
     "  --confidence           also write per-bone confidence\n"
     "  --progress / --quiet   force / silence the progress line (default: when stderr is a\n"
     "                         terminal)\n";
-
-bool parse_size(const std::string& s, float& w, float& h) {
-  int a = 0, b = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(s.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') ||
-      a <= 0 || b <= 0 || a > 100000 || b > 100000)
-    return false;
-  w = static_cast<float>(a);
-  h = static_cast<float>(b);
-  return true;
-}
 
 }  // namespace
 
@@ -71,23 +62,30 @@ int run_solve(int argc, char** argv) {
   if (a.flag("--progress")) job.progress = progress_mode::on;
   if (a.flag("--quiet")) job.progress = progress_mode::off;
   if (a.value("--image-size", value)) {
-    if (!parse_size(value, job.image_width, job.image_height)) {
+    int w = 0, h = 0;
+    if (parse_image_size(value, w, h)) {
+      job.image_width = static_cast<float>(w);
+      job.image_height = static_cast<float>(h);
+    } else {
       std::fprintf(stderr, "avatarmap solve: --image-size wants WxH in pixels, e.g. 1280x720\n");
       return 2;
     }
   }
   if (a.value("--filter", value)) {
-    if (value == "none") {
-      job.filter.enabled = false;
-    } else if (value != "euro") {
-      std::fprintf(stderr, "avatarmap solve: --filter is euro or none, got '%s'\n", value.c_str());
+    if (value == "none" || value == "landmarks") job.filter.enabled = false;
+    if (value == "landmarks" || value == "both") job.landmark_filter.enabled = true;
+    if (value != "none" && value != "euro" && value != "landmarks" && value != "both") {
+      std::fprintf(stderr, "avatarmap solve: --filter is euro, landmarks, both or none, got '%s'\n",
+                   value.c_str());
       return 2;
     }
   }
   double num = 0.0;
   if (a.number("--min-cutoff", num)) job.filter.rotation.min_cutoff = static_cast<float>(num);
   if (a.number("--beta", num)) job.filter.rotation.beta = static_cast<float>(num);
-  if (a.number("--fps", num)) job.output_fps = num;
+  // Remembered separately: output_fps == 0 means "not resampled", but "--fps 0" is an error.
+  const bool fps_given = a.number("--fps", num);
+  if (fps_given) job.output_fps = num;
   if (a.number("--fov", num)) job.options.horizontal_fov_degrees = static_cast<float>(num);
   if (a.value("--parts", value)) {
     solve_parts p{false, false, false, false};
@@ -128,7 +126,7 @@ int run_solve(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap solve: give the output file with -o OUT.pose.jsonl\n");
     return 2;
   }
-  if (job.output_fps != 0.0 && !(job.output_fps > 0.0 && job.output_fps <= 1000.0)) {
+  if (fps_given && !(job.output_fps > 0.0 && job.output_fps <= 1000.0)) {
     std::fprintf(stderr, "avatarmap solve: --fps must be in (0, 1000]\n");
     return 2;
   }

@@ -54,6 +54,8 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
 
   frame_solver solver(options);
   pose_filter filter(job.filter);
+  landmark_filter points_filter(job.landmark_filter);
+  landmark_frame smoothed;
   pose_resampler resampler;
   landmark_frame frame;
   proxy_pose solved, filtered, sampled;
@@ -83,7 +85,12 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
     if (frame.has(frame_part::face) && frame.face_count == k_face_mesh_iris_count)
       ++s.face_iris_frames;
 
-    solver.solve(frame, solved);
+    if (job.landmark_filter.enabled) {
+      points_filter.apply(frame, smoothed);
+      solver.solve(smoothed, solved);
+    } else {
+      solver.solve(frame, solved);
+    }
     filter.apply(solved, filtered);
     s.hips_height_min = std::min(s.hips_height_min, filtered.hips_position.y);
     s.hips_height_max = std::max(s.hips_height_max, filtered.hips_position.y);

@@ -21,6 +21,11 @@ struct solve_job {
   float image_width = 0.f;  // 0 = from the file's header
   float image_height = 0.f;
   pose_filter_options filter{};
+  landmark_filter_options landmark_filter = [] {
+    landmark_filter_options o;
+    o.enabled = false;  // off unless asked for (--filter landmarks|both)
+    return o;
+  }();
   double output_fps = 0.0;  // 0 = one pose per input frame
   bool skip_bad_lines = false;
   bool write_confidence = false;

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 #include "avatarmap/io/landmark_file.hpp"
@@ -77,7 +78,14 @@ bool parse_synth(args& a, synth_settings& s, std::string& err) {
   if (a.number("--seconds", v)) s.seconds = v;
   if (a.number("--fps", v)) s.fps = v;
   if (a.number("--noise", v)) s.noise_mm = v;
-  if (a.number("--seed", v)) s.seed = static_cast<unsigned>(v);
+  if (a.number("--seed", v)) {
+    // Checked before the cast: a negative or huge double cast to unsigned is undefined.
+    if (!(v >= 0 && v <= 4294967295.0 && v == static_cast<double>(static_cast<long long>(v)))) {
+      err = "--seed must be an integer in [0, 4294967295]";
+      return false;
+    }
+    s.seed = static_cast<unsigned>(v);
+  }
   if (a.flag("--no-hands")) s.hands = false;
   if (a.flag("--no-face")) s.face = false;
   if (!a.error().empty()) {
@@ -129,8 +137,8 @@ int run_demo(int argc, char** argv) {
         "Usage: avatarmap demo [--keep DIR]\n"
         "\n"
         "Synthesises a 10 s recording (avatarmap synth, 2 mm noise), solves it (avatarmap solve)\n"
-        "and prints the summary. --keep DIR keeps demo.landmarks.jsonl and demo.pose.jsonl there;\n"
-        "otherwise they go to a temporary folder that is removed.\n",
+        "and prints the summary. --keep DIR keeps demo.landmarks.jsonl and demo.pose.jsonl there\n"
+        "(DIR is created if needed); otherwise they go to a temporary folder that is removed.\n",
         stdout);
     return 0;
   }
@@ -150,6 +158,14 @@ int run_demo(int argc, char** argv) {
       return 1;
     }
     dir = pattern;
+  } else {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) {
+      std::fprintf(stderr, "avatarmap demo: cannot create %s: %s\n", dir.c_str(),
+                   ec.message().c_str());
+      return 1;
+    }
   }
   synth_settings s;
   s.output = dir + "/demo.landmarks.jsonl";
@@ -202,9 +218,8 @@ int run_import_tfjs(int argc, char** argv) {
   a.value("--size", size);
   a.number("--fps", fps);
   int w = 0, h = 0;
-  char x = 0;
   if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 2 || out.empty() ||
-      std::sscanf(size.c_str(), "%d%c%d", &w, &x, &h) != 3 || w <= 0 || h <= 0 || !(fps > 0)) {
+      !parse_image_size(size, w, h) || !(fps > 0)) {
     std::fprintf(stderr,
                  "avatarmap import-tfjs: give IMAGE.json WORLD.json --size WxH --fps F -o OUT "
                  "(see --help)%s%s\n",

@@ -64,7 +64,17 @@ void prepare_body(const landmark_frame& in, const solver_options& o, prepared_fr
   const bool world = in.has(frame_part::pose_world);
   if (!world && !in.has(frame_part::pose)) return;
   const auto& src = world ? in.pose_world : in.pose;
+  // Face points (0..10) serve only when there is no face mesh, hand points (17..22) only when
+  // a hand's own landmarks are missing: skip converting them otherwise.
+  const bool need_face = o.parts.face && !f.face.valid;
+  const bool need_hands = o.parts.hands && (f.hand[0].c <= 0.f || f.hand[1].c <= 0.f);
   for (int i = 0; i < k_pose_landmark_count; ++i) {
+    if ((i <= idx(pose_landmark::mouth_right) && !need_face) ||
+        (i >= idx(pose_landmark::left_pinky) && i <= idx(pose_landmark::right_thumb) &&
+         !need_hands)) {
+      b.c[i] = 0.f;
+      continue;
+    }
     int s = o.mirror ? pose_mirror_index(i) : i;
     const landmark& l = src[s];
     float c = landmark_confidence(l);
@@ -465,11 +475,13 @@ void measure_hips_position(const landmark_frame& in, const prepared_frame& f,
   glm::vec2 wp[8], ip[8];
   glm::vec2 mw(0.f), mi(0.f);
   int n = 0;
+  // With world landmarks present, b.c holds their confidences (mirrored indices, hence the
+  // mirror of i); only the image points' confidence is new here.
   for (int i : k_ids) {
     const landmark& w = in.pose_world[i];
     const landmark& p = in.pose[i];
-    if (std::min(landmark_confidence(w), landmark_confidence(p)) < o.confidence.found_above)
-      continue;
+    const float cw = b.c[o.mirror ? pose_mirror_index(i) : i];
+    if (std::min(cw, landmark_confidence(p)) < o.confidence.found_above) continue;
     wp[n] = glm::vec2(w.x, w.y);
     ip[n] = glm::vec2(p.x * f.width, p.y * f.height);
     mw += wp[n];
@@ -590,22 +602,23 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
       closure[s] = 0.f;
       continue;
     }
+    const float inv_width = 1.f / width;
     float gap = 0.f;
     for (int k = 0; k < 3; ++k) gap += glm::length(e.upper[k] - e.lower[k]);
-    float ratio = gap / (3.f * width);
+    const float ratio = gap * (1.f / 3.f) * inv_width;
     closure[s] =
         glm::clamp((k_eye_open_ratio - ratio) / (k_eye_open_ratio - k_eye_closed_ratio), 0.f, 1.f);
-    glm::vec3 ax = across / width;
+    const glm::vec3 ax = across * inv_width;
     glm::vec3 up_dir = normalize_or(orth(head_up, ax), k_y);
     // Brows: height of the brow above the middle of the upper lid.
-    float brow = glm::dot(e.brow - e.upper[1], up_dir) / width;
+    const float brow = glm::dot(e.brow - e.upper[1], up_dir) * inv_width;
     ex[idx(s == 0 ? expression::brow_up_left : expression::brow_up_right)] =
         glm::clamp((brow - k_brow_rest) / k_brow_up_range, 0.f, 1.f);
     ex[idx(s == 0 ? expression::brow_down_left : expression::brow_down_right)] =
         glm::clamp((k_brow_rest - brow) / k_brow_down_range, 0.f, 1.f);
     if (e.has_iris && closure[s] < 0.7f) {
-      float u = glm::dot(e.iris - e.inner, ax) / width;
-      float v = glm::dot(e.iris - 0.5f * (e.inner + e.outer), up_dir) / width;
+      const float u = glm::dot(e.iris - e.inner, ax) * inv_width;
+      const float v = glm::dot(e.iris - 0.5f * (e.inner + e.outer), up_dir) * inv_width;
       // The left eye's outer corner is on the avatar's left (+X): moving toward it is a
       // positive yaw. For the right eye the corner line points the other way.
       // The iris moves by the eyeball's radius times the sine of the eye's turn.
@@ -677,7 +690,6 @@ void frame_solver::reset() {
   prev_world_.fill(identity_quat());
   world_stamp_.fill(0);
   world_generation_ = 1;
-  local_.fill(identity_quat());
   have_arm_reference_[0] = have_arm_reference_[1] = false;
   hips_height_state_ = scalar_state{};
   ground_state_ = scalar_state{};
@@ -701,10 +713,10 @@ void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const
     f.height = options_.image_height;
   }
   f.focal = focal_per_width_ * f.width;
-  prepare_body(in, options_, f);
   prepare_hand(in, options_, 0, f);
   prepare_hand(in, options_, 1, f);
   prepare_face(in, options_, f);
+  prepare_body(in, options_, f);  // after hands and face: it skips the points they replace
   const glm::quat* arm_ref[2] = {have_arm_reference_[0] ? &arm_reference_[0] : nullptr,
                                  have_arm_reference_[1] ? &arm_reference_[1] : nullptr};
   measure_body(f, options_, arm_ref, m);
@@ -758,32 +770,38 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
     }
   }
 
-  // Local rotations of the measurement, relative to the measured parent when there is one,
+  // Local rotation of a measured bone, relative to the measured parent when there is one,
   // else to the parent's last output.
-  std::array<glm::quat, k_bone_count>& local = local_;
-  for (int b = 0; b < k_bone_count; ++b) {
+  auto local_of = [&](int b) -> glm::quat {
     const bone_measurement& bm = m.bones[b];
-    if (bm.confidence <= 0.f) continue;
     const int p = bone_parent(b);
-    if (p == k_no_parent) {
-      local[b] = bm.world;
-    } else if (m.bones[p].confidence > 0.f) {
-      local[b] = bm.has_local ? bm.local : glm::conjugate(m.bones[p].world) * bm.world;
-    } else {
-      local[b] = glm::conjugate(previous_world(p)) * bm.world;
-    }
-  }
+    if (p == k_no_parent) return bm.world;
+    if (m.bones[p].confidence > 0.f)
+      return bm.has_local ? bm.local : glm::conjugate(m.bones[p].world) * bm.world;
+    return glm::conjugate(previous_world(p)) * bm.world;
+  };
   // Move a share of the wrist's twist about the forearm into the lower arm.
+  glm::quat split[4];  // left lower arm, left hand, right lower arm, right hand
+  bool has_split[2] = {false, false};
   for (int side = 0; side < 2; ++side) {
     int la = idx(side == 0 ? bone::left_lower_arm : bone::right_lower_arm);
     int hd = idx(side == 0 ? bone::left_hand : bone::right_hand);
     if (m.bones[la].confidence <= 0.f || m.bones[hd].confidence <= 0.f) continue;
+    const glm::quat hand_local = local_of(hd);
     glm::vec3 axis = bone_rest_direction(static_cast<bone>(hd));
-    glm::quat twist = nlerp_shortest(identity_quat(), swing_twist(local[hd], axis).twist,
+    glm::quat twist = nlerp_shortest(identity_quat(), swing_twist(hand_local, axis).twist,
                                      options_.forearm_twist_share);
-    local[la] = local[la] * twist;
-    local[hd] = glm::conjugate(twist) * local[hd];
+    split[2 * side] = local_of(la) * twist;
+    split[2 * side + 1] = glm::conjugate(twist) * hand_local;
+    has_split[side] = true;
   }
+  auto measured_local = [&](int b) -> glm::quat {
+    if (b == idx(bone::left_lower_arm) && has_split[0]) return split[0];
+    if (b == idx(bone::left_hand) && has_split[0]) return split[1];
+    if (b == idx(bone::right_lower_arm) && has_split[1]) return split[2];
+    if (b == idx(bone::right_hand) && has_split[1]) return split[3];
+    return local_of(b);
+  };
 
   // Confidence gating per bone: hold, ease to rest, blend back in.
   const float inv_regain = co.regain_seconds > 0.f ? 1.f / co.regain_seconds : 0.f;
@@ -805,11 +823,12 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
       s.ever_tracked = true;
     }
     if (s.tracked) {
-      s.output = local[b];
+      const glm::quat local = measured_local(b);
+      s.output = local;
       if (s.blending) {
         const float k = float(t - s.found_at) * inv_regain;
         if (k < 1.f)
-          s.output = slerp_shortest(s.regain_from, local[b], smooth01(k));
+          s.output = slerp_shortest(s.regain_from, local, smooth01(k));
         else
           s.blending = false;
       }

@@ -94,8 +94,8 @@ inline glm::quat aim_with_bend(const glm::quat& reference, const glm::vec3& dir,
   const glm::vec3 d = normalize_or(dir, ref_dir);
   glm::vec3 ref;
   const float fb2 = glm::dot(fallback_secondary, fallback_secondary);
-  const glm::vec3 fb = orth(fallback_secondary, d);
-  if (glm::dot(fb, fb) > 1e-8f * (fb2 > 1e-20f ? fb2 : 1e-20f)) {
+  const glm::vec3 fb = fb2 > 0.f ? orth(fallback_secondary, d) : glm::vec3(0.f);
+  if (fb2 > 0.f && glm::dot(fb, fb) > 1e-8f * (fb2 > 1e-20f ? fb2 : 1e-20f)) {
     ref = fb;
   } else {
     // ref_bend carried by the shortest rotation taking ref_dir onto d:
@@ -114,7 +114,9 @@ inline glm::quat aim_with_bend(const glm::quat& reference, const glm::vec3& dir,
   constexpr float k_cos15 = 0.96592583f, k_cos40 = 0.76604444f;
   const float tl2 = glm::dot(bend_target, bend_target);
   const float cos_bend = tl2 > 0.f ? glm::dot(d, bend_target) * inv_sqrt(tl2) : 1.f;
-  const float w = smoothstep(k_cos15, k_cos40, cos_bend);
+  constexpr float k_inv_range = 1.f / (k_cos40 - k_cos15);
+  const float tw = glm::clamp((cos_bend - k_cos15) * k_inv_range, 0.f, 1.f);
+  const float w = tw * tw * (3.f - 2.f * tw);
   glm::vec3 secondary = normalize_or(ref, ref_bend);
   if (w > 0.f) {
     const glm::vec3 bn = normalize_or(orth(bend_target, d), secondary);

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "io/line_source.hpp"
+#include "support/temp_dir.hpp"
 
 namespace avatarmap {
 namespace {
@@ -22,29 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // A fresh, empty folder per test, removed afterwards.
-class temp_dir {
- public:
-  temp_dir() {
-    static int counter = 0;
-    path_ = fs::temp_directory_path() /
-            ("avatarmap_io_test_" + std::to_string(::getpid()) + "_" + std::to_string(++counter));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~temp_dir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  std::vector<std::string> entries() const {
-    std::vector<std::string> r;
-    for (auto& e : fs::directory_iterator(path_)) r.push_back(e.path().filename().string());
-    return r;
-  }
-
- private:
-  fs::path path_;
-};
+using test::temp_dir;
 
 void write_text(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;

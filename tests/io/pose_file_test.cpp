@@ -13,34 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "support/temp_dir.hpp"
+
 namespace avatarmap {
 namespace {
 
 namespace fs = std::filesystem;
 
-class temp_dir {
- public:
-  temp_dir() {
-    static int counter = 0;
-    path_ = fs::temp_directory_path() /
-            ("avatarmap_pose_test_" + std::to_string(::getpid()) + "_" + std::to_string(++counter));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~temp_dir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  std::size_t count() const {
-    std::size_t n = 0;
-    for (auto& e : fs::directory_iterator(path_)) (void)e, ++n;
-    return n;
-  }
-
- private:
-  fs::path path_;
-};
+using test::temp_dir;
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -97,7 +77,7 @@ void round_trip(const pose_write_options& options) {
     for (auto& p : poses) ASSERT_TRUE(w.write(p).ok());
     ASSERT_TRUE(w.commit().ok());
   }
-  EXPECT_EQ(dir.count(), 1u);
+  EXPECT_EQ(dir.entries().size(), 1u);
   pose_reader r;
   ASSERT_TRUE(r.open(path).ok());
   EXPECT_TRUE(r.header().present);
@@ -263,7 +243,7 @@ TEST(pose_file, uncommitted_writer_leaves_the_target_untouched) {
     ASSERT_TRUE(w.write(proxy_pose{}).ok());
   }
   EXPECT_EQ(read_text(path), "old\n");
-  EXPECT_EQ(dir.count(), 1u);
+  EXPECT_EQ(dir.entries().size(), 1u);
 }
 
 }  // namespace

@@ -81,7 +81,6 @@ class frame_solver {
   mutable std::array<glm::quat, k_bone_count> prev_world_{};  // memo of previous_world()
   mutable std::array<unsigned, k_bone_count> world_stamp_{};
   unsigned world_generation_ = 1;
-  std::array<glm::quat, k_bone_count> local_{};
   glm::quat arm_reference_[2]{};  // last measured upper-arm world rotations (left, right)
   bool have_arm_reference_[2] = {false, false};
   scalar_state hips_height_state_{};

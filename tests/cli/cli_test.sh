@@ -1,0 +1,259 @@
+#!/usr/bin/env bash
+# Runs one case of the avatarmap command-line tests: cli_test.sh AVATARMAP_EXE WORK_DIR CASE.
+# Each case runs the tool in a fresh folder under WORK_DIR and checks its exit status, its
+# messages and the files it writes. Registered with CTest by tests/cli/CMakeLists.txt.
+set -u
+
+exe=$1
+work=$2
+case_name=$3
+dir="$work/$case_name"
+rm -rf "$dir"
+mkdir -p "$dir"
+cd "$dir" || exit 1
+
+failures=0
+fail() {
+  echo "FAIL [$case_name]: $*" >&2
+  failures=$((failures + 1))
+}
+
+# run EXPECTED_STATUS ARGS...: runs the tool, stdout to out.txt, stderr to err.txt.
+run() {
+  local want=$1
+  shift
+  "$exe" "$@" >out.txt 2>err.txt
+  local got=$?
+  if [ "$got" -ne "$want" ]; then
+    fail "avatarmap $* exited $got, expected $want"
+    echo "--- stdout:" >&2
+    head -c 2000 out.txt >&2
+    echo "--- stderr:" >&2
+    head -c 2000 err.txt >&2
+  fi
+}
+
+# expect_in FILE TEXT: FILE contains TEXT (fixed string).
+expect_in() {
+  if ! grep -qF -- "$2" "$1"; then
+    fail "$1 does not contain '$2'"
+    echo "--- $1:" >&2
+    head -c 2000 "$1" >&2
+  fi
+}
+
+# lines FILE: number of lines.
+lines() { wc -l <"$1" | tr -d ' '; }
+
+# synth_input PATH SECONDS: writes a synthetic recording (30 fps, no face: faster).
+synth_input() {
+  "$exe" synth -o "$1" --seconds "$2" --no-face >synth.out 2>synth.err ||
+    { fail "synth failed: $(cat synth.err)"; return 1; }
+}
+
+case $case_name in
+  help)
+    run 0 --help
+    expect_in out.txt "Usage:"
+    expect_in out.txt "avatarmap solve"
+    run 0 -h
+    expect_in out.txt "Usage:"
+    for cmd in solve synth demo import-tfjs backends; do
+      run 0 "$cmd" --help
+      expect_in out.txt "Usage: avatarmap $cmd"
+    done
+    ;;
+  version)
+    run 0 --version
+    expect_in out.txt "avatarmap "
+    if ! grep -qE '^avatarmap [0-9]+\.[0-9]+\.[0-9]+' out.txt; then
+      fail "--version prints no version number: $(cat out.txt)"
+    fi
+    ;;
+  no_command)
+    run 2
+    expect_in err.txt "Usage:"
+    ;;
+  unknown_command)
+    run 2 frobnicate
+    expect_in err.txt "unknown command 'frobnicate'"
+    ;;
+  unknown_option)
+    run 2 solve in.landmarks.jsonl -o out.pose.jsonl --frobnicate
+    expect_in err.txt "unknown option --frobnicate"
+    run 2 synth -o x.landmarks.jsonl --frobnicate
+    expect_in err.txt "unknown option --frobnicate"
+    run 2 demo --frobnicate
+    expect_in err.txt "unknown option --frobnicate"
+    ;;
+  solve_usage)
+    synth_input in.landmarks.jsonl 1 || exit 1
+    run 2 solve in.landmarks.jsonl
+    expect_in err.txt "-o"
+    [ -e out.pose.jsonl ] && fail "solve without -o wrote a file"
+    run 2 solve -o out.pose.jsonl
+    expect_in err.txt "input"
+    run 2 solve a.landmarks.jsonl b.landmarks.jsonl -o out.pose.jsonl
+    expect_in err.txt "exactly one input"
+    run 2 solve in.landmarks.jsonl -o
+    expect_in err.txt "needs a value"
+    run 2 solve in.landmarks.jsonl -o out.pose.jsonl --image-size 12x
+    expect_in err.txt "--image-size"
+    run 2 solve in.landmarks.jsonl -o out.pose.jsonl --image-size 12x34x
+    expect_in err.txt "--image-size"
+    run 2 solve in.landmarks.jsonl -o out.pose.jsonl --fps abc
+    expect_in err.txt "--fps"
+    run 2 solve in.landmarks.jsonl -o out.pose.jsonl --fps 0
+    expect_in err.txt "--fps"
+    run 2 solve in.landmarks.jsonl -o out.pose.jsonl --parts body,tail
+    expect_in err.txt "tail"
+    run 2 solve in.landmarks.jsonl -o out.pose.jsonl --filter kalman
+    expect_in err.txt "kalman"
+    run 2 solve in.landmarks.jsonl -o out.pose.jsonl --min-cutoff 0
+    expect_in err.txt "--min-cutoff"
+    [ -e out.pose.jsonl ] && fail "a usage error wrote the output file"
+    ;;
+  synth_solve)
+    run 0 synth -o in.landmarks.jsonl --seconds 2
+    expect_in err.txt "wrote 60 synthetic frames"
+    n=$(lines in.landmarks.jsonl)
+    [ "$n" -eq 61 ] || fail "synth wrote $n lines, expected 61 (header + 60 frames)"
+    expect_in in.landmarks.jsonl '"format":"avatarmap.landmarks"'
+    run 0 solve in.landmarks.jsonl -o out.pose.jsonl
+    expect_in err.txt "solved 60 frames"
+    expect_in err.txt "wrote 60 poses to out.pose.jsonl"
+    n=$(lines out.pose.jsonl)
+    [ "$n" -eq 61 ] || fail "solve wrote $n lines, expected 61 (header + 60 frames)"
+    expect_in out.pose.jsonl '"format":"avatarmap.pose"'
+    ls out.pose.jsonl.tmp.* >/dev/null 2>&1 && fail "a temporary file was left beside the output"
+    # --quiet and a second run over an existing output: replaced.
+    run 0 solve in.landmarks.jsonl -o out.pose.jsonl --quiet --filter none --mirror --confidence
+    n=$(lines out.pose.jsonl)
+    [ "$n" -eq 61 ] || fail "second solve wrote $n lines, expected 61"
+    ;;
+  solve_stdio)
+    synth_input in.landmarks.jsonl 1 || exit 1
+    "$exe" solve - -o - <in.landmarks.jsonl >out.pose.jsonl 2>err.txt ||
+      fail "solve - -o - failed: $(cat err.txt)"
+    n=$(lines out.pose.jsonl)
+    [ "$n" -eq 31 ] || fail "solve - -o - wrote $n lines, expected 31"
+    expect_in err.txt "solved 30 frames"
+    ;;
+  solve_fps)
+    synth_input in.landmarks.jsonl 2 || exit 1
+    run 0 solve in.landmarks.jsonl -o out.pose.jsonl --fps 60
+    expect_in err.txt "solved 60 frames"
+    expect_in err.txt "(resampled)"
+    n=$(($(lines out.pose.jsonl) - 1))
+    # 60 frames at 30 fps span 59/30 s: 60 fps gives 119 poses, give or take the first.
+    if [ "$n" -lt 116 ] || [ "$n" -gt 121 ]; then
+      fail "--fps 60 on 30 fps input wrote $n poses, expected about 120"
+    fi
+    expect_in err.txt "wrote $n poses"
+    expect_in out.pose.jsonl '"fps":60'
+    run 0 solve in.landmarks.jsonl -o half.pose.jsonl --fps=15
+    n=$(($(lines half.pose.jsonl) - 1))
+    if [ "$n" -lt 28 ] || [ "$n" -gt 31 ]; then
+      fail "--fps=15 on 30 fps input wrote $n poses, expected about 30"
+    fi
+    ;;
+  solve_parts)
+    synth_input in.landmarks.jsonl 1 || exit 1
+    run 0 solve in.landmarks.jsonl -o body.pose.jsonl --parts body
+    expect_in err.txt "solved 30 frames"
+    n=$(lines body.pose.jsonl)
+    [ "$n" -eq 31 ] || fail "--parts body wrote $n lines, expected 31"
+    run 0 solve in.landmarks.jsonl -o some.pose.jsonl --parts body,hands,root --image-size 1280x720
+    expect_in err.txt "solved 30 frames"
+    ;;
+  bad_line)
+    synth_input in.landmarks.jsonl 1 || exit 1
+    sed '3s/.*/{"t": 0.0333, "pose": [[1, 2]]}/' in.landmarks.jsonl >bad.landmarks.jsonl
+    printf 'previous output\n' >out.pose.jsonl
+    cp out.pose.jsonl before.pose.jsonl
+    run 1 solve bad.landmarks.jsonl -o out.pose.jsonl
+    expect_in err.txt "bad.landmarks.jsonl:3:"
+    expect_in err.txt "--skip-bad-lines"
+    cmp -s out.pose.jsonl before.pose.jsonl ||
+      fail "a failed solve changed the existing output file"
+    ls out.pose.jsonl.tmp.* >/dev/null 2>&1 && fail "a failed solve left a temporary file"
+    run 0 solve bad.landmarks.jsonl -o out.pose.jsonl --skip-bad-lines
+    expect_in err.txt "bad.landmarks.jsonl:3:"
+    expect_in err.txt "skipped 1 malformed lines"
+    expect_in err.txt "solved 29 frames"
+    n=$(lines out.pose.jsonl)
+    [ "$n" -eq 30 ] || fail "--skip-bad-lines wrote $n lines, expected 30 (header + 29 frames)"
+    ;;
+  missing_input)
+    run 1 solve "$dir/no-such.landmarks.jsonl" -o out.pose.jsonl
+    expect_in err.txt "$dir/no-such.landmarks.jsonl"
+    [ -e out.pose.jsonl ] && fail "a failed solve wrote the output file"
+    ;;
+  unwritable_output)
+    synth_input in.landmarks.jsonl 1 || exit 1
+    run 1 solve in.landmarks.jsonl -o "$dir/no-such-dir/out.pose.jsonl"
+    expect_in err.txt "no-such-dir/out.pose.jsonl"
+    run 1 synth -o "$dir/no-such-dir/x.landmarks.jsonl" --seconds 1
+    expect_in err.txt "no-such-dir/x.landmarks.jsonl"
+    ;;
+  synth_usage)
+    run 2 synth
+    expect_in err.txt "-o"
+    run 2 synth -o x.landmarks.jsonl --seconds 0
+    expect_in err.txt "--seconds"
+    run 2 synth -o x.landmarks.jsonl --fps -3
+    expect_in err.txt "--fps"
+    run 2 synth -o x.landmarks.jsonl --seed -1
+    expect_in err.txt "--seed"
+    run 2 synth -o x.landmarks.jsonl --seed 1.5
+    expect_in err.txt "--seed"
+    run 2 synth -o x.landmarks.jsonl extra
+    expect_in err.txt "unexpected argument"
+    [ -e x.landmarks.jsonl ] && fail "a synth usage error wrote the output file"
+    ;;
+  demo)
+    mkdir tmp
+    TMPDIR="$dir/tmp" run 0 demo
+    [ -z "$(ls -A tmp)" ] || fail "demo left files in TMPDIR: $(ls -A tmp)"
+    expect_in out.txt "solved 300 frames"
+    expect_in out.txt "wrote 300 poses"
+    run 0 demo --keep "$dir/kept/new"
+    expect_in out.txt "solved 300 frames"
+    [ -s "$dir/kept/new/demo.landmarks.jsonl" ] || fail "demo --keep did not keep the landmarks"
+    [ -s "$dir/kept/new/demo.pose.jsonl" ] || fail "demo --keep did not keep the poses"
+    ;;
+  backends)
+    run 0 backends
+    expect_in out.txt "replay"
+    if ! grep -qE '^replay +[^ ]' out.txt; then fail "backends lists replay without a description"; fi
+    run 2 backends --frobnicate
+    expect_in err.txt "unknown option --frobnicate"
+    run 2 backends extra
+    expect_in err.txt "no arguments"
+    ;;
+  import_tfjs_usage)
+    run 2 import-tfjs
+    expect_in err.txt "import-tfjs"
+    run 2 import-tfjs a.json b.json --size 640x480 --fps 30
+    expect_in err.txt "-o"
+    run 2 import-tfjs a.json b.json --size 640 --fps 30 -o x.landmarks.jsonl
+    run 2 import-tfjs a.json b.json --size 640x480 --fps 0 -o x.landmarks.jsonl
+    run 2 import-tfjs a.json --size 640x480 --fps 30 -o x.landmarks.jsonl
+    run 2 import-tfjs a.json b.json --size 640x480 --fps 30 -o x.landmarks.jsonl --frobnicate
+    expect_in err.txt "frobnicate"
+    run 1 import-tfjs no-such-image.json no-such-world.json --size 640x480 --fps 30 \
+      -o x.landmarks.jsonl
+    expect_in err.txt "no-such-"
+    [ -e x.landmarks.jsonl ] && fail "a failed import-tfjs wrote the output file"
+    ;;
+  *)
+    fail "unknown case"
+    ;;
+esac
+
+if [ "$failures" -eq 0 ]; then
+  rm -rf "$dir"
+  echo "ok [$case_name]"
+  exit 0
+fi
+exit 1
