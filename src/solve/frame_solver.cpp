@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "avatarmap/core/rotation.hpp"
 #include "avatarmap/core/spaces.hpp"
@@ -31,6 +32,7 @@ struct body_points {
   bool metric = false;
 };
 
+// A hand's 21 points in canonical left-hand space (the avatar's right hand mirrored through X).
 struct hand_points {
   std::array<glm::vec3, k_hand_landmark_count> p;
   float c = 0.f;  // 1 when every point is finite, else 0
@@ -103,18 +105,18 @@ void prepare_hand(const landmark_frame& in, const solver_options& o, int side, p
   if (!world && !in.has(image_part)) return;
   const auto& src = world ? (person_left ? in.left_hand_world : in.right_hand_world)
                           : (person_left ? in.left_hand : in.right_hand);
-  float c = 1.f;
+  // Points go straight into the canonical (left-hand) space the finger code works in: the
+  // avatar's right hand is mirrored through X, and the mirror option flips X once more.
+  const float sx = ((side == 1) != o.mirror) ? -1.f : 1.f;
+  const glm::vec3 scale =
+      world ? glm::vec3(sx, -1.f, -1.f) : glm::vec3(sx * f.width, -f.height, -f.width);
+  bool finite = true;
   for (int i = 0; i < k_hand_landmark_count; ++i) {
-    glm::vec3 v = world ? world_to_vrm(to_vec(src[i]))
-                        : image_to_vrm_pixels(to_vec(src[i]), f.width, f.height);
-    if (v.x * 0.f + v.y * 0.f + v.z * 0.f != 0.f) {  // NaN or infinite
-      c = 0.f;
-      v = glm::vec3(0.f);
-    }
-    if (o.mirror) v = mirror_x(v);
+    const glm::vec3 v = to_vec(src[i]) * scale;
+    if (v.x * 0.f + v.y * 0.f + v.z * 0.f != 0.f) finite = false;  // NaN or infinite
     h.p[i] = v;
   }
-  h.c = c;
+  h.c = finite ? 1.f : 0.f;
 }
 
 void prepare_face(const landmark_frame& in, const solver_options& o, prepared_frame& f) {
@@ -353,12 +355,6 @@ void measure_fingers(const hand_points& h, const glm::quat& hand_w, float c, boo
   }
 }
 
-hand_points mirrored(const hand_points& h) {
-  hand_points r = h;
-  for (auto& p : r.p) p = mirror_x(p);
-  return r;
-}
-
 // `arm_reference[side]`: the upper arm's world rotation last measured (side 0 = avatar's
 // left), or null when there is none: it keeps a straight arm's twist continuous.
 void measure_body(const prepared_frame& f, const solver_options& o,
@@ -516,9 +512,7 @@ void measure_hands(const prepared_frame& f, const solver_options& o, frame_measu
     const hand_points& h = f.hand[side];
     if (h.c <= 0.f) continue;
     const bool left = side == 0;
-    hand_points mirrored_points;
-    if (!left) mirrored_points = mirrored(h);
-    const hand_points& hc = left ? h : mirrored_points;
+    const hand_points& hc = h;  // already in canonical (left-hand) space
     glm::quat hand_w = hand_world_from_points(hc);
     set(m, left ? bone::left_hand : bone::right_hand, left ? hand_w : mirror_x(hand_w), h.c);
     measure_fingers(hc, hand_w, h.c, left, m);
@@ -795,12 +789,17 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
     split[2 * side + 1] = glm::conjugate(twist) * hand_local;
     has_split[side] = true;
   }
+  std::uint64_t split_mask = 0;
+  if (has_split[0])
+    split_mask |= (1ull << idx(bone::left_lower_arm)) | (1ull << idx(bone::left_hand));
+  if (has_split[1])
+    split_mask |= (1ull << idx(bone::right_lower_arm)) | (1ull << idx(bone::right_hand));
   auto measured_local = [&](int b) -> glm::quat {
-    if (b == idx(bone::left_lower_arm) && has_split[0]) return split[0];
-    if (b == idx(bone::left_hand) && has_split[0]) return split[1];
-    if (b == idx(bone::right_lower_arm) && has_split[1]) return split[2];
-    if (b == idx(bone::right_hand) && has_split[1]) return split[3];
-    return local_of(b);
+    if (!((split_mask >> b) & 1u)) return local_of(b);
+    if (b == idx(bone::left_lower_arm)) return split[0];
+    if (b == idx(bone::left_hand)) return split[1];
+    if (b == idx(bone::right_lower_arm)) return split[2];
+    return split[3];
   };
 
   // Confidence gating per bone: hold, ease to rest, blend back in.
