@@ -165,3 +165,66 @@ TEST(Accuracy, FingerFlexionOverTheFullRange) {
 
 }  // namespace
 }  // namespace avatarmap
+
+namespace avatarmap {
+namespace {
+
+// The wrist turned through a full pronation sweep, palm down -> facing the camera -> up: the
+// solved hand orientation follows the truth at every step (no flip when the palm faces the
+// camera, unlike 2-D projection solvers).
+TEST(Accuracy, WristTwistSweepNeverFlips) {
+  landmark_synth synth;
+  solver_options o;
+  o.image_width = 1280.f;
+  o.image_height = 720.f;
+  frame_solver solver(o);
+  landmark_frame frame;
+  proxy_pose solved;
+  std::array<glm::quat, k_bone_count> sw;
+  double worst = 0;
+  int i = 0;
+  for (float twist = -90.f; twist <= 180.f; twist += 5.f, ++i) {
+    proxy_pose truth;
+    truth.hips_position = glm::vec3(0.f, standing_hips_height(synth.skeleton()), 0.f);
+    // Left arm forward at shoulder height, the hand turning about the forearm.
+    truth[bone::left_upper_arm] = axis_angle({0, 1, 0}, -80.f * k_deg);
+    truth[bone::left_hand] = axis_angle({1, 0, 0}, twist * k_deg);
+    synth.generate(truth, frame);
+    frame.t = i / 30.0;
+    solver.solve(frame, solved);
+    compute_world_rotations(solved, sw);
+    const double e =
+        angle_between(sw[idx(bone::left_hand)], synth.fk().world[idx(bone::left_hand)]) / k_deg;
+    worst = std::max(worst, e);
+    EXPECT_LT(e, 0.5) << "twist " << twist;
+  }
+  std::printf("[figures] wrist twist sweep -90..180 deg: worst hand orientation error %.3f deg\n",
+              worst);
+}
+
+// Without a face mesh the head comes from the pose's ears, eyes and mouth.
+TEST(Accuracy, HeadFromPosePointsWithoutFaceMesh) {
+  synth_options so;
+  so.face = synth_face::none;
+  landmark_synth synth(so);
+  std::mt19937 rng(21);
+  landmark_frame frame;
+  proxy_pose solved;
+  std::array<glm::quat, k_bone_count> sw;
+  error_stats head;
+  for (int i = 0; i < 300; ++i) {
+    proxy_pose truth = random_pose(rng);
+    ground_pose(synth.skeleton(), truth);
+    synth.generate(truth, frame);
+    frame_solver solver;
+    solver.solve(frame, solved);
+    compute_world_rotations(solved, sw);
+    head.add(angle_between(sw[idx(bone::head)], synth.fk().world[idx(bone::head)]) / k_deg);
+  }
+  std::printf("[figures] head from pose points (no mesh): mean %.3f max %.3f deg\n", head.mean(),
+              head.max);
+  EXPECT_LE(head.max, 2.0);
+}
+
+}  // namespace
+}  // namespace avatarmap
