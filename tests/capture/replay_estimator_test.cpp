@@ -20,14 +20,9 @@ namespace {
 namespace fs = std::filesystem;
 
 // A fresh, empty folder per test, removed afterwards.
+using test::read_text;
 using test::temp_dir;
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::write_text;
 
 // A frame with every part; point values depend on `i` so frames can be told apart.
 landmark_frame full_frame(int i, double t) {

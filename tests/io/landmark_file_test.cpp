@@ -23,17 +23,9 @@ namespace {
 namespace fs = std::filesystem;
 
 // A fresh, empty folder per test, removed afterwards.
+using test::read_text;
 using test::temp_dir;
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::write_text;
 
 // Restores the line source limits changed by a test.
 struct limits_guard {

@@ -20,14 +20,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+using test::read_text;
 using test::temp_dir;
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::write_text;
 
 bool same_bits(float a, float b) { return std::memcmp(&a, &b, 4) == 0; }
 
