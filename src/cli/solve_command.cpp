@@ -41,6 +41,7 @@ const char* k_solve_help =
     "  --parts LIST           comma list of body,hands,face,root (default: all)\n"
     "  --fov DEG              camera's horizontal field of view for root motion (default 60)\n"
     "  --skip-bad-lines       report malformed lines and go on (default: stop at the first)\n"
+    "  --threads 1|2          2 (default) parses the input on a second thread\n"
     "  --confidence           also write per-bone confidence\n"
     "  --progress / --quiet   force / silence the progress line (default: when stderr is a\n"
     "                         terminal)\n";
@@ -87,6 +88,13 @@ int run_solve(int argc, char** argv) {
   const bool fps_given = a.number("--fps", num);
   if (fps_given) job.output_fps = num;
   if (a.number("--fov", num)) job.options.horizontal_fov_degrees = static_cast<float>(num);
+  if (a.number("--threads", num)) {
+    if (num != 1.0 && num != 2.0) {
+      std::fprintf(stderr, "avatarmap solve: --threads is 1 or 2\n");
+      return 2;
+    }
+    job.threads = static_cast<int>(num);
+  }
   if (a.value("--parts", value)) {
     solve_parts p{false, false, false, false};
     size_t start = 0;

@@ -10,6 +10,7 @@
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
+#include "cli/frame_prefetcher.hpp"
 
 namespace avatarmap::cli {
 
@@ -67,65 +68,87 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
   s.hips_height_min = 1e9f;
   s.hips_height_max = -1e9f;
 
-  for (;;) {
-    read_result r = reader.next(frame);
-    if (r == read_result::end) break;
-    if (r == read_result::error) {
-      if (!job.skip_bad_lines)
-        return status::error(reader.error() + " (use --skip-bad-lines to go on)");
-      ++s.bad_lines;
-      if (s.bad_lines <= 5) std::fprintf(stderr, "warning: skipped %s\n", reader.error().c_str());
-      continue;
-    }
-    if (s.frames == 0) s.t_first = frame.t;
-    s.t_last = frame.t;
-    ++s.frames;
-    for (int p = 0; p < k_frame_part_count; ++p)
-      if (frame.has(static_cast<frame_part>(p))) ++s.part_frames[p];
-    if (frame.has(frame_part::face) && frame.face_count == k_face_mesh_iris_count)
-      ++s.face_iris_frames;
+  // One pass over the frames of `src` (the reader itself, or a prefetcher parsing on a second
+  // thread): solve, filter, resample, write.
+  auto process = [&](auto& src) -> status {
+    for (;;) {
+      const read_result r = src.next();
+      if (r == read_result::end) return {};
+      if (r == read_result::error) {
+        if (!job.skip_bad_lines)
+          return status::error(src.error() + " (use --skip-bad-lines to go on)");
+        ++s.bad_lines;
+        if (s.bad_lines <= 5) std::fprintf(stderr, "warning: skipped %s\n", src.error().c_str());
+        src.release();
+        continue;
+      }
+      const landmark_frame& frame = src.frame();
+      if (s.frames == 0) s.t_first = frame.t;
+      s.t_last = frame.t;
+      ++s.frames;
+      for (int p = 0; p < k_frame_part_count; ++p)
+        if (frame.has(static_cast<frame_part>(p))) ++s.part_frames[p];
+      if (frame.has(frame_part::face) && frame.face_count == k_face_mesh_iris_count)
+        ++s.face_iris_frames;
 
-    if (job.landmark_filter.enabled) {
-      points_filter.apply(frame, smoothed);
-      solver.solve(smoothed, solved);
-    } else {
-      solver.solve(frame, solved);
-    }
-    filter.apply(solved, filtered);
-    s.hips_height_min = std::min(s.hips_height_min, filtered.hips_position.y);
-    s.hips_height_max = std::max(s.hips_height_max, filtered.hips_position.y);
-    if (job.output_fps > 0.0) {
-      if (!resampler.push(filtered)) continue;
-      if (!have_render) {
-        next_render_t = filtered.t;
-        have_render = true;
+      if (job.landmark_filter.enabled) {
+        points_filter.apply(frame, smoothed);
+        solver.solve(smoothed, solved);
+      } else {
+        solver.solve(frame, solved);
       }
-      long k = 0;
-      const double base = next_render_t;
-      for (double rt = base; rt <= filtered.t + 1e-9; rt = base + double(++k) / job.output_fps) {
-        if (!resampler.sample(rt, sampled)) break;
-        sampled.t = rt;
-        st = writer.write(sampled);
-        if (!st.ok()) return st;
+      src.release();
+      filter.apply(solved, filtered);
+      s.hips_height_min = std::min(s.hips_height_min, filtered.hips_position.y);
+      s.hips_height_max = std::max(s.hips_height_max, filtered.hips_position.y);
+      if (job.output_fps > 0.0) {
+        if (!resampler.push(filtered)) continue;
+        if (!have_render) {
+          next_render_t = filtered.t;
+          have_render = true;
+        }
+        long k = 0;
+        const double base = next_render_t;
+        for (double rt = base; rt <= filtered.t + 1e-9; rt = base + double(++k) / job.output_fps) {
+          if (!resampler.sample(rt, sampled)) break;
+          sampled.t = rt;
+          status w = writer.write(sampled);
+          if (!w.ok()) return w;
+          ++s.poses_written;
+          next_render_t = base + double(k + 1) / job.output_fps;
+        }
+      } else {
+        status w = writer.write(filtered);
+        if (!w.ok()) return w;
         ++s.poses_written;
-        next_render_t = base + double(k + 1) / job.output_fps;
       }
-    } else {
-      st = writer.write(filtered);
-      if (!st.ok()) return st;
-      ++s.poses_written;
-    }
-    if (show_progress && (s.frames & 255) == 0) {
-      auto now = clock_type::now();
-      if (std::chrono::duration<double>(now - last_progress).count() > 0.25) {
-        last_progress = now;
-        double el = seconds_since(t0);
-        std::fprintf(stderr, "\rsolve: %ld frames, %.1f s of capture, %.0f frames/s   ", s.frames,
-                     s.t_last - s.t_first, s.frames / std::max(el, 1e-9));
-        std::fflush(stderr);
+      if (show_progress && (s.frames & 255) == 0) {
+        auto now = clock_type::now();
+        if (std::chrono::duration<double>(now - last_progress).count() > 0.25) {
+          last_progress = now;
+          double el = seconds_since(t0);
+          std::fprintf(stderr, "\rsolve: %ld frames, %.1f s of capture, %.0f frames/s   ", s.frames,
+                       s.t_last - s.t_first, s.frames / std::max(el, 1e-9));
+          std::fflush(stderr);
+        }
       }
     }
+  };
+  if (job.threads > 1) {
+    frame_prefetcher prefetcher(reader, !job.skip_bad_lines);
+    st = process(prefetcher);
+  } else {
+    struct direct_source {
+      landmark_reader& reader;
+      landmark_frame& frame_storage;
+      read_result next() { return reader.next(frame_storage); }
+      const landmark_frame& frame() const { return frame_storage; }
+      const std::string& error() const { return reader.error(); }
+      void release() {}
+    } direct{reader, frame};
+    st = process(direct);
   }
+  if (!st.ok()) return st;
   if (show_progress) std::fputs("\r", stderr);
   st = writer.commit();
   if (!st.ok()) return st;

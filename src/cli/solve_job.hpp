@@ -30,6 +30,8 @@ struct solve_job {
   bool skip_bad_lines = false;
   bool write_confidence = false;
   progress_mode progress = progress_mode::automatic;
+  /// 2 parses on a second thread while solving and writing on this one; 1 does it all here.
+  int threads = 2;
 };
 
 struct solve_summary {

@@ -131,6 +131,19 @@ case $case_name in
     n=$(lines out.pose.jsonl)
     [ "$n" -eq 61 ] || fail "second solve wrote $n lines, expected 61"
     ;;
+  solve_threads)
+    # Parsing on a second thread changes nothing in the output, and bad lines still stop it.
+    synth_input in.landmarks.jsonl 3 || exit 1
+    run 0 solve in.landmarks.jsonl -o one.pose.jsonl --threads 1
+    run 0 solve in.landmarks.jsonl -o two.pose.jsonl --threads 2
+    cmp -s one.pose.jsonl two.pose.jsonl || fail "--threads 1 and 2 wrote different poses"
+    { head -n 20 in.landmarks.jsonl; echo '{"t": oops'; tail -n +21 in.landmarks.jsonl; } >bad.landmarks.jsonl
+    run 1 solve bad.landmarks.jsonl -o bad.pose.jsonl --threads 2
+    expect_in err.txt "bad.landmarks.jsonl:21:"
+    run 0 solve bad.landmarks.jsonl -o bad.pose.jsonl --threads 2 --skip-bad-lines
+    expect_in err.txt "solved 90 frames"
+    run 2 solve in.landmarks.jsonl -o x.pose.jsonl --threads 3
+    ;;
   solve_stdio)
     synth_input in.landmarks.jsonl 1 || exit 1
     "$exe" solve - -o - <in.landmarks.jsonl >out.pose.jsonl 2>err.txt ||
