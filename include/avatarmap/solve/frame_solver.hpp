@@ -1,6 +1,8 @@
 // Landmarks -> proxy pose: body, hands, face, confidence gating, hips translation.
 // The solver keeps per-bone state between frames (hysteresis, last good rotation, the
 // translation origin); frames must be fed in capture order. solve() allocates nothing.
+// Thread-safety: one solver per performer and thread; no member (not even the const
+// measure()) may run concurrently with another on the same object. See docs/solver.md.
 #pragma once
 
 #include <array>
