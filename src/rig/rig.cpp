@@ -1,0 +1,102 @@
+#include "avatarmap/rig/rig.hpp"
+
+#include <cmath>
+
+#include "avatarmap/core/rotation.hpp"
+
+namespace avatarmap {
+
+int rig::find(const std::string& name) const {
+  for (int i = 0; i < joint_count(); ++i)
+    if (names[i] == name) return i;
+  return -1;
+}
+
+namespace {
+bool finite_transform(const transform& t) {
+  return is_finite(t.translation) && is_finite(t.rotation) && is_finite(t.scale);
+}
+glm::mat4 to_matrix(const transform& t) {
+  glm::mat4 m = glm::mat4_cast(glm::normalize(t.rotation));
+  m[0] *= t.scale.x;
+  m[1] *= t.scale.y;
+  m[2] *= t.scale.z;
+  m[3] = glm::vec4(t.translation, 1.f);
+  return m;
+}
+}  // namespace
+
+status build_rig(const raw_rig& raw, rig& out) {
+  out = rig{};
+  const int n = static_cast<int>(raw.nodes.size());
+  const std::string where = raw.file.empty() ? std::string("rig") : raw.file;
+  for (int i = 0; i < n; ++i) {
+    const raw_rig::node& node = raw.nodes[i];
+    if (node.parent < -1 || node.parent >= n || node.parent == i)
+      return status::error(where + ": node " + std::to_string(i) + " '" + node.name +
+                           "' has an invalid parent " + std::to_string(node.parent));
+    if (!finite_transform(node.rest))
+      return status::error(where + ": node '" + node.name + "' has a non-finite transform");
+    const glm::quat& q = node.rest.rotation;
+    if (!(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w > 1e-12f))
+      return status::error(where + ": node '" + node.name + "' has a zero rotation");
+  }
+  // Depth-first order from the roots; a node never reached sits on a cycle.
+  std::vector<std::vector<int>> children(static_cast<size_t>(n));
+  std::vector<int> roots;
+  for (int i = 0; i < n; ++i) {
+    if (raw.nodes[i].parent < 0)
+      roots.push_back(i);
+    else
+      children[static_cast<size_t>(raw.nodes[i].parent)].push_back(i);
+  }
+  std::vector<int> order;
+  order.reserve(static_cast<size_t>(n));
+  std::vector<int> stack(roots.rbegin(), roots.rend());
+  while (!stack.empty()) {
+    int i = stack.back();
+    stack.pop_back();
+    order.push_back(i);
+    const auto& c = children[static_cast<size_t>(i)];
+    for (auto it = c.rbegin(); it != c.rend(); ++it) stack.push_back(*it);
+  }
+  if (static_cast<int>(order.size()) != n) {
+    std::vector<bool> seen(static_cast<size_t>(n), false);
+    for (int i : order) seen[static_cast<size_t>(i)] = true;
+    for (int i = 0; i < n; ++i)
+      if (!seen[static_cast<size_t>(i)])
+        return status::error(where + ": node '" + raw.nodes[i].name +
+                             "' is part of a parent cycle");
+  }
+  std::vector<int> new_index(static_cast<size_t>(n), -1);
+  for (int k = 0; k < n; ++k) new_index[static_cast<size_t>(order[k])] = k;
+  out.names.resize(static_cast<size_t>(n));
+  out.parents.resize(static_cast<size_t>(n));
+  out.rest_local.resize(static_cast<size_t>(n));
+  out.rest_world.resize(static_cast<size_t>(n));
+  out.rest_world_rotation.resize(static_cast<size_t>(n));
+  out.source_index = order;
+  for (int k = 0; k < n; ++k) {
+    const raw_rig::node& node = raw.nodes[static_cast<size_t>(order[k])];
+    out.names[k] = node.name;
+    out.parents[k] = node.parent < 0 ? -1 : new_index[static_cast<size_t>(node.parent)];
+    out.rest_local[k] = node.rest;
+    out.rest_local[k].rotation = glm::normalize(node.rest.rotation);
+    const glm::mat4 local = to_matrix(out.rest_local[k]);
+    out.rest_world[k] = out.parents[k] < 0 ? local : out.rest_world[out.parents[k]] * local;
+    // Rotation of the world matrix with scale removed (columns normalised).
+    glm::mat3 r(out.rest_world[k]);
+    for (int c = 0; c < 3; ++c) r[c] = normalize_or(r[c], glm::vec3(c == 0, c == 1, c == 2));
+    out.rest_world_rotation[k] = glm::normalize(glm::quat_cast(r));
+  }
+  for (int b = 0; b < k_bone_count; ++b) {
+    int src = raw.declared_humanoid[b];
+    out.declared_humanoid[b] = (src >= 0 && src < n) ? new_index[static_cast<size_t>(src)] : -1;
+  }
+  out.expressions = raw.expressions;
+  out.source = raw.source;
+  out.file = raw.file;
+  return {};
+}
+
+}  // namespace avatarmap
