@@ -5,11 +5,10 @@
 #pragma once
 
 #include <array>
-#include <string>
-#include <vector>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <string>
+#include <vector>
 
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/skeleton/bone.hpp"
@@ -49,11 +48,11 @@ struct raw_rig {
 /// Immutable runtime rig: joints in parent-first order, names resolved to indices once.
 struct rig {
   std::vector<std::string> names;
-  std::vector<int> parents;            // -1 for roots; parents[i] < i
-  std::vector<transform> rest_local;   // local rest transforms
-  std::vector<glm::mat4> rest_world;   // world rest matrices (all ancestors, scale included)
-  std::vector<glm::quat> rest_world_rotation;  // rotation part of rest_world (unit)
-  std::vector<int> source_index;       // raw_rig node index of each joint
+  std::vector<int> parents;           // -1 for roots; parents[i] < i
+  std::vector<transform> rest_local;  // local rest transforms
+  std::vector<glm::mat4> rest_world;  // world rest matrices (all ancestors, scale included)
+  std::vector<glm::quat> rest_world_rotation;       // rotation part of rest_world (unit)
+  std::vector<int> source_index;                    // raw_rig node index of each joint
   std::array<int, k_bone_count> declared_humanoid;  // joint index per proxy bone, or -1
   std::vector<std::string> expressions;
   rig_source source = rig_source::unknown;
