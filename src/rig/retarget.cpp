@@ -13,24 +13,20 @@ constexpr float k_pi_f = 3.14159265358979f;
 
 glm::vec3 position_of(const glm::mat4& m) { return glm::vec3(m[3]); }
 
-// The proxy child whose direction is the bone's own rest direction (hips -> spine,
-// upperChest -> neck, hand -> middle finger, ...), or -1 for leaves.
+// The proxy child that continues the bone (hips -> spine, upperChest -> neck, hand -> middle
+// finger, ...), or -1 for leaves (head, distal finger bones, toes).
 int primary_child(int b) {
-  const glm::vec3 dir = bone_rest_direction(static_cast<bone>(b));
-  int first = -1;
   for (int c = b + 1; c < k_bone_count; ++c) {
     if (bone_parent(c) != b) continue;
-    if (first < 0) first = c;
     const bone cb = static_cast<bone>(c);
     if (cb == bone::left_eye || cb == bone::right_eye || cb == bone::jaw) continue;
     if (b == idx(bone::hips) && c != idx(bone::spine)) continue;
     if (b == idx(bone::upper_chest) && c != idx(bone::neck)) continue;
     if (b == idx(bone::left_hand) && c != idx(bone::left_middle_proximal)) continue;
     if (b == idx(bone::right_hand) && c != idx(bone::right_middle_proximal)) continue;
-    (void)dir;
     return c;
   }
-  return first;
+  return -1;
 }
 
 bool skips_rest_alignment(bone b) {
@@ -97,9 +93,17 @@ status retargeter::build(const rig& r, const bone_binding& binding,
       int target = -1;
       for (int c = primary_child(b); c >= 0 && target < 0; c = primary_child(c))
         if (binding[c] >= 0) target = binding[c];
-      if (target < 0)
-        for (int k = j + 1; k < n && target < 0; ++k)
-          if (r.parents[k] == j) target = k;
+      // A leaf of the proxy (head, last finger joint): the rig's end joint, when it has
+      // exactly one child that drives nothing else.
+      if (target < 0 && primary_child(b) < 0) {
+        int only = -1, count = 0;
+        for (int k = j + 1; k < n; ++k)
+          if (r.parents[k] == j) {
+            ++count;
+            only = k;
+          }
+        if (count == 1 && bone_of_joint_[only] < 0) target = only;
+      }
       if (target >= 0) {
         const glm::vec3 d = position_of(r.rest_world[target]) - position_of(r.rest_world[j]);
         const glm::vec3 dv = normalize_or(basis_ * d, glm::vec3(0.f));
