@@ -26,6 +26,8 @@ const char* k_usage =
     "      Converts tfjs-models' reference pose landmarks (pixels + world) to our format.\n"
     "  avatarmap backends\n"
     "      Lists the landmark estimator backends in this build.\n"
+    "  avatarmap inspect AVATAR [--json]\n"
+    "      Prints an avatar file's format, joints, humanoid bones, hips height, expressions.\n"
     "  avatarmap --version | --help | COMMAND --help\n";
 
 }  // namespace
@@ -49,6 +51,7 @@ int main(int argc, char** argv) {
   if (cmd == "demo") return avatarmap::cli::run_demo(argc, argv);
   if (cmd == "import-tfjs") return avatarmap::cli::run_import_tfjs(argc, argv);
   if (cmd == "backends") return avatarmap::cli::run_backends(argc, argv);
+  if (cmd == "inspect") return avatarmap::cli::run_inspect(argc, argv);
   std::fprintf(stderr, "avatarmap: unknown command '%s'\n\n%s", cmd.c_str(), k_usage);
   return 2;
 }

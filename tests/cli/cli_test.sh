@@ -259,6 +259,49 @@ case $case_name in
     expect_in err.txt "no-such-"
     [ -e x.landmarks.jsonl ] && fail "a failed import-tfjs wrote the output file"
     ;;
+  inspect)
+    run 0 inspect --help
+    expect_in out.txt "Usage: avatarmap inspect"
+    run 2 inspect
+    expect_in err.txt "Usage: avatarmap inspect"
+    run 2 inspect a.vrm b.vrm
+    expect_in err.txt "exactly one"
+    run 2 inspect a.vrm --frobnicate
+    expect_in err.txt "unknown option --frobnicate"
+    run 1 inspect "$dir/no-such.vrm"
+    expect_in err.txt "$dir/no-such.vrm"
+    printf 'not a model' >bad.vrm
+    run 1 inspect bad.vrm
+    expect_in err.txt "bad.vrm: not a glTF file"
+    printf '{"asset":{"version":"2.0"},"nodes":[{"name":"root","children":[1]},{"name":"j"}]}' \
+      >tiny.gltf
+    run 0 inspect tiny.gltf
+    expect_in out.txt "format: glTF"
+    expect_in out.txt "joints: 2"
+    expect_in out.txt "humanoid: not declared by the file"
+    printf '{"asset":{"version":"2.0"},"nodes":[{"name":"h"}],%s}' \
+      '"extensions":{"VRMC_vrm":{"humanoid":{"humanBones":{"hips":{"node":7}}}}}' >range.vrm
+    run 1 inspect range.vrm
+    expect_in err.txt "range.vrm"
+    expect_in err.txt "out of range"
+    if [ -n "${AVATARMAP_TEST_DATA:-}" ]; then
+      avatar="$AVATARMAP_TEST_DATA/avatars/vrm1_spec_53bones.vrm"
+      run 0 inspect "$avatar"
+      expect_in out.txt "format: VRM 1.0"
+      expect_in out.txt "joints: 58"
+      expect_in out.txt "declared: 53 of 55"
+      expect_in out.txt "missing required: none"
+      expect_in out.txt "hips height: 0.850"
+      run 0 inspect --json "$avatar"
+      expect_in out.txt '"format":"vrm1"'
+      expect_in out.txt '"joints":58'
+      expect_in out.txt '"declared":53'
+      expect_in out.txt '"hips":"hips"'
+      expect_in out.txt '"missing_required":[]'
+    else
+      echo "AVATARMAP_TEST_DATA not set: inspect of a real VRM skipped" >&2
+    fi
+    ;;
   *)
     fail "unknown case"
     ;;

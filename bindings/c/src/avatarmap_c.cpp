@@ -18,6 +18,9 @@
 #include "avatarmap/io/landmark_file.hpp"
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/rig/avatar_loader.hpp"
+#include "avatarmap/rig/retarget.hpp"
+#include "avatarmap/rig/rig.hpp"
 #include "avatarmap/skeleton/bone.hpp"
 #include "avatarmap/skeleton/expression.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
@@ -547,3 +550,131 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
 }
 
 }  // extern "C"
+
+// ---- retargeting ------------------------------------------------------------------------
+
+struct avm_retargeter {
+  am::rig rig;
+  am::retargeter retargeter;
+  am::rig_pose pose;     // scratch: the applied pose
+  am::proxy_pose proxy;  // scratch: the C pose converted
+  mutable std::string last_error;
+};
+
+namespace {
+void set_error(const avm_retargeter* r, const char* msg) noexcept {
+  if (r == nullptr) return;
+  try {
+    r->last_error.assign(msg);
+  } catch (...) {
+    r->last_error.clear();
+  }
+}
+}  // namespace
+
+AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const char* mapping_path,
+                                                 avm_retargeter** out) {
+  if (out != nullptr) *out = nullptr;
+  if (avatar_path == nullptr || out == nullptr) {
+    set_create_error("avatar_path and out must not be NULL");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  try {
+    if (mapping_path != nullptr) {
+      set_create_error(
+          "mapping tables are not supported by the C API yet: pass NULL to use the avatar's "
+          "own humanoid map (VRM)");
+      return AVM_ERROR_UNSUPPORTED;
+    }
+    std::unique_ptr<avm_retargeter> r(new avm_retargeter());
+    am::raw_rig raw;
+    am::status st = am::load_avatar(avatar_path, raw);
+    if (!st.ok()) {
+      set_create_error(st.message().c_str());
+      FILE* f = std::fopen(avatar_path, "rb");
+      if (f == nullptr) return AVM_ERROR_IO;
+      std::fclose(f);
+      return AVM_ERROR_PARSE;
+    }
+    st = am::build_rig(raw, r->rig);
+    if (st.ok()) st = r->retargeter.build(r->rig, r->rig.declared_humanoid);
+    if (!st.ok()) {
+      set_create_error(st.message().c_str());
+      return AVM_ERROR_PARSE;
+    }
+    r->retargeter.prepare(r->pose);
+    set_create_error("");
+    *out = r.release();
+    return AVM_OK;
+  } catch (const std::bad_alloc&) {
+    set_create_error("out of memory");
+    return AVM_ERROR_OUT_OF_MEMORY;
+  } catch (const std::exception& e) {
+    set_create_error(e.what());
+    return AVM_ERROR_INTERNAL;
+  } catch (...) {
+    set_create_error("unknown internal error");
+    return AVM_ERROR_INTERNAL;
+  }
+}
+
+AVATARMAP_C_API void avm_retargeter_destroy(avm_retargeter* retargeter) { delete retargeter; }
+
+AVATARMAP_C_API int avm_retargeter_joint_count(const avm_retargeter* retargeter) {
+  return retargeter == nullptr ? 0 : retargeter->rig.joint_count();
+}
+
+AVATARMAP_C_API const char* avm_retargeter_joint_name(const avm_retargeter* retargeter, int joint) {
+  if (retargeter == nullptr || joint < 0 || joint >= retargeter->rig.joint_count()) return nullptr;
+  return retargeter->rig.names[static_cast<std::size_t>(joint)].c_str();
+}
+
+AVATARMAP_C_API int avm_retargeter_joint_parent(const avm_retargeter* retargeter, int joint) {
+  if (retargeter == nullptr || joint < 0 || joint >= retargeter->rig.joint_count()) return -1;
+  return retargeter->rig.parents[static_cast<std::size_t>(joint)];
+}
+
+AVATARMAP_C_API int avm_retargeter_bone_joint(const avm_retargeter* retargeter, int bone) {
+  if (retargeter == nullptr || bone < 0 || bone >= am::k_bone_count) return -1;
+  return retargeter->retargeter.binding()[static_cast<std::size_t>(bone)];
+}
+
+AVATARMAP_C_API avm_status avm_retargeter_apply(avm_retargeter* retargeter, const avm_pose* pose,
+                                                float* out_rotations, float* out_hips_translation) {
+  if (retargeter == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  if (pose == nullptr || out_rotations == nullptr) {
+    set_error(retargeter, "pose and out_rotations must not be NULL");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  try {
+    am::proxy_pose& p = retargeter->proxy;
+    p.t = pose->t;
+    for (int i = 0; i < 3; ++i)
+      p.hips_position[i] = std::isfinite(pose->hips_position[i]) ? pose->hips_position[i] : 0.f;
+    for (int b = 0; b < am::k_bone_count; ++b) {
+      glm::quat q = am::load_xyzw(pose->rotations[b]);
+      const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+      p.rotations[static_cast<std::size_t>(b)] =
+          (n2 > 1e-12f && std::isfinite(n2)) ? q * (1.f / std::sqrt(n2)) : am::identity_quat();
+    }
+    retargeter->retargeter.apply(p, retargeter->pose);
+    const int n = retargeter->rig.joint_count();
+    for (int j = 0; j < n; ++j)
+      am::store_xyzw(retargeter->pose.local_rotations[static_cast<std::size_t>(j)],
+                     out_rotations + 4 * j);
+    if (out_hips_translation != nullptr) {
+      out_hips_translation[0] = retargeter->pose.hips_translation.x;
+      out_hips_translation[1] = retargeter->pose.hips_translation.y;
+      out_hips_translation[2] = retargeter->pose.hips_translation.z;
+    }
+    retargeter->last_error.clear();
+    return AVM_OK;
+  } catch (...) {
+    set_error(retargeter, "internal error");
+    return AVM_ERROR_INTERNAL;
+  }
+}
+
+AVATARMAP_C_API const char* avm_retargeter_last_error(const avm_retargeter* retargeter) {
+  return retargeter == nullptr ? "" : retargeter->last_error.c_str();
+}

@@ -362,6 +362,53 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
                                           const avm_solver_options* options, char* err,
                                           size_t err_size);
 
+
+/* ---- retargeting onto an avatar ------------------------------------------------------ */
+
+/* A rig loaded from an avatar file (glTF/GLB, VRM 0.x, VRM 1.0) with its proxy-bone binding,
+ * turning proxy poses into the rig's local joint rotations (REFERENCE §5, rest-pose aware).
+ * Typed opaque handle; one thread at a time per handle; different handles are independent. */
+typedef struct avm_retargeter avm_retargeter;
+
+/* Loads `avatar_path` and binds its joints to the proxy bones. `mapping_path` NULL uses the
+ * humanoid map the file declares (VRM); rigs without one need a mapping table (coming with
+ * the mapping tables: until then AVM_ERROR_UNSUPPORTED). On failure *out is NULL and
+ * avm_last_create_error() (thread-local, valid until the next create on this thread) says why.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (NULL arguments), AVM_ERROR_IO (cannot read),
+ *   AVM_ERROR_PARSE (not a valid avatar; no hips bound), AVM_ERROR_UNSUPPORTED,
+ *   AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL. */
+AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path,
+                                                 const char* mapping_path,
+                                                 avm_retargeter** out);
+
+/* Destroys a retargeter; NULL is a no-op. */
+AVATARMAP_C_API void avm_retargeter_destroy(avm_retargeter* retargeter);
+
+/* Number of joints of the rig (0 when retargeter is NULL). Joints are in parent-first order. */
+AVATARMAP_C_API int avm_retargeter_joint_count(const avm_retargeter* retargeter);
+
+/* Name of joint `joint` as in the file (owned by the handle, valid for its lifetime), or NULL
+ * when out of range. */
+AVATARMAP_C_API const char* avm_retargeter_joint_name(const avm_retargeter* retargeter,
+                                                      int joint);
+
+/* Parent joint index (-1 for a root or out of range). */
+AVATARMAP_C_API int avm_retargeter_joint_parent(const avm_retargeter* retargeter, int joint);
+
+/* Joint driven by proxy bone `bone` (an avm_bone), or -1 when the rig has none. */
+AVATARMAP_C_API int avm_retargeter_bone_joint(const avm_retargeter* retargeter, int bone);
+
+/* Applies `pose` and writes every joint's local rotation {x, y, z, w} to out_rotations
+ * (4 * joint_count floats, caller-owned) and the hips joint's local translation (in its
+ * parent's units) to out_hips_translation (3 floats; may be NULL). Allocation-free.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (NULL arguments), AVM_ERROR_INTERNAL. */
+AVATARMAP_C_API avm_status avm_retargeter_apply(avm_retargeter* retargeter, const avm_pose* pose,
+                                                float* out_rotations,
+                                                float* out_hips_translation);
+
+/* Message of the last failed call on `retargeter` ("" when none), owned by the handle. */
+AVATARMAP_C_API const char* avm_retargeter_last_error(const avm_retargeter* retargeter);
+
 #ifdef __cplusplus
 } /* extern "C" */
 #endif

@@ -1,0 +1,96 @@
+// Internal: what the VRMA and BVH writers share: checking and cleaning the caller's frames,
+// and choosing the written key times (the frames' own or a fixed rate, resampled).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "avatarmap/core/rotation.hpp"
+#include "avatarmap/core/status.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+
+namespace avatarmap::export_detail {
+
+/// Checks the frame times (finite, strictly increasing) and `fps` (0 or positive finite).
+inline status check_frames(const std::string& path, const std::vector<proxy_pose>& frames,
+                           double fps) {
+  if (frames.empty()) return status::error(path + ": no frames to write");
+  if (!std::isfinite(fps) || fps < 0.0)
+    return status::error(path + ": fps must be 0 (frames' own times) or positive, got " +
+                         std::to_string(fps));
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    if (!std::isfinite(frames[i].t))
+      return status::error(path + ": frame " + std::to_string(i) + " has a non-finite time");
+    if (i > 0 && !(frames[i].t > frames[i - 1].t))
+      return status::error(path + ": frame times must increase strictly; frame " +
+                           std::to_string(i) + " (t = " + std::to_string(frames[i].t) +
+                           ") is not after frame " + std::to_string(i - 1));
+  }
+  return {};
+}
+
+/// Copy of `in` whose non-finite values are replaced by `prev`'s (the rest pose's for the
+/// first frame); rotations normalised, weights clamped to [0, 1].
+inline void clean_frame(const proxy_pose& in, const proxy_pose* prev, proxy_pose& out) {
+  proxy_pose rest;
+  const proxy_pose& fallback = prev ? *prev : rest;
+  out = in;
+  for (int b = 0; b < k_bone_count; ++b) {
+    const glm::quat& q = in.rotations[b];
+    float n2 = glm::dot(q, q);
+    out.rotations[b] =
+        is_finite(q) && n2 > 1e-20f ? q * (1.f / std::sqrt(n2)) : fallback.rotations[b];
+  }
+  if (!is_finite(in.hips_position)) out.hips_position = fallback.hips_position;
+  for (int e = 0; e < k_expression_count; ++e) {
+    float w = in.expressions[e];
+    out.expressions[e] = std::isfinite(w) ? std::clamp(w, 0.f, 1.f) : fallback.expressions[e];
+  }
+}
+
+/// The frames to write: cleaned copies at the frames' own times (fps == 0) or resampled at
+/// t_first + k / fps (fps > 0). Times are rebased so that the first is 0 when `rebase`.
+/// `frames` must have passed check_frames().
+inline std::vector<proxy_pose> frames_to_write(const std::vector<proxy_pose>& frames, double fps,
+                                               bool rebase) {
+  std::vector<proxy_pose> clean(frames.size());
+  for (std::size_t i = 0; i < frames.size(); ++i)
+    clean_frame(frames[i], i ? &clean[i - 1] : nullptr, clean[i]);
+  double t0 = frames.front().t;
+  if (fps > 0.0) {
+    double span = frames.back().t - t0;
+    auto count = static_cast<std::size_t>(std::floor(span * fps + 1e-6)) + 1;
+    std::vector<proxy_pose> out(count);
+    std::size_t seg = 0;
+    for (std::size_t k = 0; k < count; ++k) {
+      double t = t0 + static_cast<double>(k) / fps;
+      while (seg + 1 < clean.size() && clean[seg + 1].t <= t) ++seg;
+      proxy_pose& o = out[k];
+      if (seg + 1 >= clean.size()) {
+        o = clean.back();
+      } else {
+        const proxy_pose& a = clean[seg];
+        const proxy_pose& b = clean[seg + 1];
+        auto u = static_cast<float>((t - a.t) / (b.t - a.t));
+        u = std::clamp(u, 0.f, 1.f);
+        o = a;
+        for (int i = 0; i < k_bone_count; ++i) {
+          o.rotations[i] = slerp_shortest(a.rotations[i], b.rotations[i], u);
+          o.confidence[i] = std::min(a.confidence[i], b.confidence[i]);
+        }
+        o.hips_position = a.hips_position + (b.hips_position - a.hips_position) * u;
+        for (int e = 0; e < k_expression_count; ++e)
+          o.expressions[e] = a.expressions[e] + (b.expressions[e] - a.expressions[e]) * u;
+      }
+      o.t = rebase ? static_cast<double>(k) / fps : t;
+    }
+    return out;
+  }
+  if (rebase)
+    for (proxy_pose& p : clean) p.t -= t0;
+  return clean;
+}
+
+}  // namespace avatarmap::export_detail
