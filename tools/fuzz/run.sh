@@ -13,7 +13,7 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Re
   -DAVATARMAP_BUILD_FUZZ=ON -DAVATARMAP_BUILD_TESTS=OFF -DAVATARMAP_BUILD_BENCH=OFF \
   -DAVATARMAP_BUILD_CLI=OFF -DAVATARMAP_BUILD_C_API=OFF -DAVATARMAP_BUILD_EXAMPLES=OFF \
   -DAVATARMAP_INSTALL=OFF >/dev/null
-cmake --build "$build" -j"$jobs" --target fuzz_landmark_reader fuzz_pose_reader
+cmake --build "$build" -j"$jobs" --target fuzz_landmark_reader fuzz_pose_reader fuzz_formula
 
 for target in landmark pose; do
   corpus="$build/corpus_$target"
@@ -24,3 +24,10 @@ for target in landmark pose; do
      -max_len=65536 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
      -dict="$root/tools/fuzz/jsonl.dict" "$corpus")
 done
+
+corpus="$build/corpus_formula"
+mkdir -p "$corpus"
+cp -n "$root/tools/fuzz/corpus/formula"/* "$corpus/" 2>/dev/null || true
+echo "== fuzz_formula for ${seconds}s"
+(cd "$build" && ./tools/fuzz/fuzz_formula -max_total_time="$seconds" -max_len=512 -timeout=10 \
+   -rss_limit_mb=2048 -print_final_stats=1 -dict="$root/tools/fuzz/formula.dict" "$corpus")
