@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "avatarmap/core/euler.hpp"
 #include "avatarmap/core/rotation.hpp"
 
 namespace avatarmap {
@@ -39,7 +40,7 @@ bool skips_rest_alignment(bone b) {
 }  // namespace
 
 status retargeter::build(const rig& r, const bone_binding& binding,
-                         const retarget_options& options) {
+                         const retarget_options& options, const mapping_table* table) {
   rig_ = &r;
   binding_ = binding;
   options_ = options;
@@ -134,6 +135,19 @@ status retargeter::build(const rig& r, const bone_binding& binding,
   const int hp = r.parents[hips];
   hips_parent_inverse_ = hp < 0 ? glm::mat4(1.f) : glm::inverse(r.rest_world[hp]);
   floor_vrm_ = floor;
+  formula_bones_.clear();
+  formula_of_joint_.assign(static_cast<size_t>(n), -1);
+  if (table != nullptr) {
+    for (int b = 0; b < k_bone_count; ++b) {
+      const mapping_bone& mb = table->bones[b];
+      const int j = binding[b];
+      if (j < 0 || !mb.has_formulas) continue;
+      formula_bone fb{j, b, mb.order, mb.f,
+                      mb.has_rest ? mb.rest : euler_from_quat(r.rest_local[j].rotation, mb.order)};
+      formula_of_joint_[j] = static_cast<int>(formula_bones_.size());
+      formula_bones_.push_back(fb);
+    }
+  }
   world_.assign(static_cast<size_t>(n), identity_quat());
   positions_.assign(static_cast<size_t>(n), glm::vec3(0.f));
   return {};
@@ -155,7 +169,18 @@ void retargeter::apply(const proxy_pose& pose, rig_pose& out) const {
     const int p = r.parents[j];
     const glm::quat parent_world = p < 0 ? identity_quat() : world_[p];
     const int b = bone_of_joint_[j];
-    if (b >= 0) {
+    const int fi = formula_of_joint_[j];
+    if (fi >= 0) {
+      // SysMocap's conversion: rest Euler angles + f(proxy Euler angles), in the bone's order.
+      const formula_bone& fb = formula_bones_[static_cast<size_t>(fi)];
+      const glm::vec3 e = euler_from_quat(pose.rotations[static_cast<size_t>(b)], fb.order);
+      const glm::vec3 sum(fb.rest.x + fb.f[0].eval(e.x, e.y, e.z),
+                          fb.rest.y + fb.f[1].eval(e.x, e.y, e.z),
+                          fb.rest.z + fb.f[2].eval(e.x, e.y, e.z));
+      out.local_rotations[j] =
+          is_finite(sum) ? quat_from_euler(sum, fb.order) : r.rest_local[j].rotation;
+      world_[j] = parent_world * out.local_rotations[j];
+    } else if (b >= 0) {
       // Unit quaternions stay unit through these products to float precision; the one
       // renormalisation keeps long chains from drifting.
       world_[j] = identity_basis_ ? proxy_world[b] * rest_aligned_[j]

@@ -9,6 +9,7 @@
 #include <random>
 #include <string>
 
+#include "avatarmap/core/euler.hpp"
 #include "avatarmap/core/rotation.hpp"
 #include "avatarmap/synth/random_pose.hpp"
 #include "avatarmap/synth/synth_skeleton.hpp"
@@ -294,6 +295,52 @@ TEST(Retarget, BadBindingsAreErrors) {
   bone_binding crossed = b;
   std::swap(crossed[idx(bone::left_upper_arm)], crossed[idx(bone::left_upper_leg)]);
   EXPECT_FALSE(rt.build(r, crossed).ok());
+}
+
+}  // namespace
+}  // namespace avatarmap
+
+namespace avatarmap {
+namespace {
+
+// A table's formulas replace the rest-aware conversion for their bone, SysMocap's way:
+// rig local = quat_from_euler(rest Euler + f(proxy Euler), order).
+TEST(Retarget, TableFormulasApplySysMocapSemantics) {
+  raw_rig raw;
+  const char* names[] = {"Hips", "Spine", "LeftArm"};
+  for (int i = 0; i < 3; ++i) {
+    raw_rig::node n;
+    n.name = names[i];
+    n.parent = i - 1;
+    n.rest.translation = glm::vec3(0.f, i == 0 ? 1.f : 0.2f, 0.f);
+    if (i == 2) n.rest.rotation = axis_angle({0, 0, 1}, 0.3f);  // a non-zero rest to add to
+    raw.nodes.push_back(n);
+  }
+  rig r;
+  ASSERT_TRUE(build_rig(raw, r).ok());
+  mapping_table table;
+  status st = load_mapping_json(R"({"format_version": 1, "name": "formula-test",
+      "bones": {"hips": {"rig": "Hips"}, "spine": {"rig": "Spine"},
+                "leftUpperArm": {"rig": "LeftArm", "order": "ZXY", "f": ["-x", "y * 0.5", "-z"]}}})",
+                                "formula-test", table);
+  ASSERT_TRUE(st.ok()) << st.message();
+  bone_binding binding;
+  binding.fill(-1);
+  binding[idx(bone::hips)] = r.find("Hips");
+  binding[idx(bone::spine)] = r.find("Spine");
+  binding[idx(bone::left_upper_arm)] = r.find("LeftArm");
+  retargeter rt;
+  ASSERT_TRUE(rt.build(r, binding, {}, &table).ok());
+  rig_pose out;
+  rt.prepare(out);
+  proxy_pose p;
+  p[bone::left_upper_arm] = quat_from_euler({0.2f, -0.4f, 0.6f}, euler_order::zxy);
+  rt.apply(p, out);
+  const glm::vec3 e = euler_from_quat(p[bone::left_upper_arm], euler_order::zxy);
+  const glm::vec3 rest = euler_from_quat(axis_angle({0, 0, 1}, 0.3f), euler_order::zxy);
+  const glm::quat want =
+      quat_from_euler(rest + glm::vec3(-e.x, 0.5f * e.y, -e.z), euler_order::zxy);
+  EXPECT_LT(angle_between(out.local_rotations[binding[idx(bone::left_upper_arm)]], want), 1e-5f);
 }
 
 }  // namespace

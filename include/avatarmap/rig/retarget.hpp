@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "avatarmap/core/status.hpp"
+#include "avatarmap/rig/mapping.hpp"
 #include "avatarmap/rig/rig.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 
@@ -56,7 +57,11 @@ class retargeter {
  public:
   /// Binds `r` (kept by reference: it must outlive the retargeter) with `binding`. Needs at
   /// least the hips bound; the error names what is missing. Precomputes every constant.
-  status build(const rig& r, const bone_binding& binding, const retarget_options& options = {});
+  /// `table`, when given, supplies per-bone formulas (docs/mappings.md): bones with formulas
+  /// take SysMocap's conversion (rest Euler angles + f(x, y, z) in the bone's order) instead
+  /// of the rest-aware one; the formulas are copied.
+  status build(const rig& r, const bone_binding& binding, const retarget_options& options = {},
+               const mapping_table* table = nullptr);
 
   /// Sizes `out` for this rig (allocates; call once).
   void prepare(rig_pose& out) const;
@@ -81,7 +86,16 @@ class retargeter {
   float translation_scale_ = 1.f;
   glm::mat4 hips_parent_inverse_{1.f};  // world -> hips parent's space
   glm::vec3 hips_rest_world_{0.f};
-  float floor_vrm_ = 0.f;                     // rest height of the lowest foot joint
+  float floor_vrm_ = 0.f;  // rest height of the lowest foot joint
+  struct formula_bone {
+    int joint;
+    int bone;
+    euler_order order;
+    std::array<formula, 3> f;
+    glm::vec3 rest;  // Euler angles (radians, in `order`) the results are added to
+  };
+  std::vector<formula_bone> formula_bones_;
+  std::vector<int> formula_of_joint_;         // index into formula_bones_, or -1
   mutable std::vector<glm::quat> world_;      // scratch: posed world rotations
   mutable std::vector<glm::vec3> positions_;  // scratch: posed world positions (grounding)
 };
