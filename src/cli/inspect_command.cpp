@@ -8,6 +8,7 @@
 #include "avatarmap/rig/rig.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
+#include "cli/rig_select.hpp"
 
 namespace avatarmap::cli {
 
@@ -175,7 +176,14 @@ int run_inspect(int argc, char** argv) {
   std::printf("format: %s\n", format_name(r.source));
   std::printf("joints: %d\n", r.joint_count());
   if (!vrm) {
-    std::printf("humanoid: not declared by the file (a mapping table matches names; coming)\n");
+    std::printf("humanoid: not declared by the file; matching the shipped mapping tables:\n");
+    rig_selection sel;
+    status st = select_rig_binding(r, "auto", sel);
+    if (st.ok()) {
+      std::printf("  %s\n", sel.description.c_str());
+    } else {
+      std::printf("  %s\n", st.message().c_str());
+    }
   } else {
     std::printf("humanoid: declared: %d of %d bones\n", declared, k_bone_count);
     std::string m;

@@ -50,8 +50,11 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
   ph.fps = job.output_fps > 0.0 ? job.output_fps : header.fps;
   pose_write_options wo;
   wo.write_confidence = job.write_confidence;
-  st = writer.open(job.output, ph, wo);
-  if (!st.ok()) return st;
+  if (!job.sink) {
+    st = writer.open(job.output, ph, wo);
+    if (!st.ok()) return st;
+  }
+  auto emit = [&](const proxy_pose& p) { return job.sink ? job.sink(p) : writer.write(p); };
 
   frame_solver solver(options);
   pose_filter filter(job.filter);
@@ -112,13 +115,13 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
         for (double rt = base; rt <= filtered.t + 1e-9; rt = base + double(++k) / job.output_fps) {
           if (!resampler.sample(rt, sampled)) break;
           sampled.t = rt;
-          status w = writer.write(sampled);
+          status w = emit(sampled);
           if (!w.ok()) return w;
           ++s.poses_written;
           next_render_t = base + double(k + 1) / job.output_fps;
         }
       } else {
-        status w = writer.write(filtered);
+        status w = emit(filtered);
         if (!w.ok()) return w;
         ++s.poses_written;
       }
@@ -150,7 +153,7 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
   }
   if (!st.ok()) return st;
   if (show_progress) std::fputs("\r", stderr);
-  st = writer.commit();
+  if (!job.sink) st = writer.commit();
   if (!st.ok()) return st;
   s.seconds = seconds_since(t0);
   if (s.frames == 0) {

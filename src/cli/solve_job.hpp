@@ -3,10 +3,12 @@
 #pragma once
 
 #include <cstdio>
+#include <functional>
 #include <string>
 
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
 #include "avatarmap/solve/solver_options.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 
@@ -16,7 +18,9 @@ enum class progress_mode { automatic, on, off };
 
 struct solve_job {
   std::string input;
-  std::string output;
+  std::string output;  // ignored when `sink` is set
+  /// When set, every output pose goes here instead of a *.pose.jsonl file.
+  std::function<status(const proxy_pose&)> sink;
   solver_options options{};
   float image_width = 0.f;  // 0 = from the file's header
   float image_height = 0.f;

@@ -39,8 +39,8 @@ bool skips_rest_alignment(bone b) {
 
 }  // namespace
 
-status retargeter::build(const rig& r, const bone_binding& binding,
-                         const retarget_options& options, const mapping_table* table) {
+status retargeter::build(const rig& r, const bone_binding& binding, const retarget_options& options,
+                         const mapping_table* table) {
   rig_ = &r;
   binding_ = binding;
   options_ = options;

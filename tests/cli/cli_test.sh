@@ -144,6 +144,36 @@ case $case_name in
     expect_in err.txt "solved 90 frames"
     run 2 solve in.landmarks.jsonl -o x.pose.jsonl --threads 3
     ;;
+  convert)
+    synth_input in.landmarks.jsonl 2 || exit 1
+    run 0 convert in.landmarks.jsonl -o out.vrma
+    expect_in err.txt "into 60 frames at 30 fps"
+    [ "$(head -c 4 out.vrma)" = "glTF" ] || fail "out.vrma is not a binary glTF"
+    run 0 convert out.vrma -o back.pose.jsonl --fps 30
+    expect_in err.txt "wrote back.pose.jsonl"
+    run 0 convert in.landmarks.jsonl -o out.bvh --fps 60
+    expect_in out.bvh "HIERARCHY"
+    expect_in out.bvh "Frame Time: 0.01666"
+    run 0 convert in.landmarks.jsonl -o out.pose.jsonl
+    run 2 convert in.landmarks.jsonl -o out.glb
+    expect_in err.txt "--avatar"
+    run 2 convert in.landmarks.jsonl -o out.fbx
+    expect_in err.txt ".vrma, .glb, .bvh or .pose.jsonl"
+    run 1 convert missing.landmarks.jsonl -o x.vrma
+    expect_in err.txt "missing.landmarks.jsonl"
+    run 1 convert in.landmarks.jsonl -o x.glb --avatar no-such-avatar.vrm
+    expect_in err.txt "no-such-avatar.vrm"
+    [ -e x.glb ] && fail "a failed convert wrote its output"
+    if [ -n "${AVATARMAP_TEST_DATA:-}" ]; then
+      run 0 convert in.landmarks.jsonl -o robot.glb --avatar "$AVATARMAP_TEST_DATA/avatars/vrm1_debug_robot.vrm"
+      expect_in err.txt "humanoid declared by the file (53 bones)"
+      [ "$(head -c 4 robot.glb)" = "glTF" ] || fail "robot.glb is not a binary glTF"
+      run 1 convert in.landmarks.jsonl -o man.glb --avatar "$AVATARMAP_TEST_DATA/avatars/gltf_cesium_man.glb"
+      expect_in err.txt "no mapping table fits"
+      run 1 convert in.landmarks.jsonl -o v.glb --rig nonexistent --avatar "$AVATARMAP_TEST_DATA/avatars/gltf_cesium_man.glb"
+      expect_in err.txt "unknown rig table 'nonexistent'"
+    fi
+    ;;
   solve_stdio)
     synth_input in.landmarks.jsonl 1 || exit 1
     "$exe" solve - -o - <in.landmarks.jsonl >out.pose.jsonl 2>err.txt ||

@@ -362,7 +362,6 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
                                           const avm_solver_options* options, char* err,
                                           size_t err_size);
 
-
 /* ---- retargeting onto an avatar ------------------------------------------------------ */
 
 /* A rig loaded from an avatar file (glTF/GLB, VRM 0.x, VRM 1.0) with its proxy-bone binding,
@@ -377,8 +376,7 @@ typedef struct avm_retargeter avm_retargeter;
  * Failures: AVM_ERROR_INVALID_ARGUMENT (NULL arguments), AVM_ERROR_IO (cannot read),
  *   AVM_ERROR_PARSE (not a valid avatar; no hips bound), AVM_ERROR_UNSUPPORTED,
  *   AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL. */
-AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path,
-                                                 const char* mapping_path,
+AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const char* mapping_path,
                                                  avm_retargeter** out);
 
 /* Destroys a retargeter; NULL is a no-op. */
@@ -389,8 +387,7 @@ AVATARMAP_C_API int avm_retargeter_joint_count(const avm_retargeter* retargeter)
 
 /* Name of joint `joint` as in the file (owned by the handle, valid for its lifetime), or NULL
  * when out of range. */
-AVATARMAP_C_API const char* avm_retargeter_joint_name(const avm_retargeter* retargeter,
-                                                      int joint);
+AVATARMAP_C_API const char* avm_retargeter_joint_name(const avm_retargeter* retargeter, int joint);
 
 /* Parent joint index (-1 for a root or out of range). */
 AVATARMAP_C_API int avm_retargeter_joint_parent(const avm_retargeter* retargeter, int joint);
@@ -403,8 +400,7 @@ AVATARMAP_C_API int avm_retargeter_bone_joint(const avm_retargeter* retargeter, 
  * parent's units) to out_hips_translation (3 floats; may be NULL). Allocation-free.
  * Failures: AVM_ERROR_INVALID_ARGUMENT (NULL arguments), AVM_ERROR_INTERNAL. */
 AVATARMAP_C_API avm_status avm_retargeter_apply(avm_retargeter* retargeter, const avm_pose* pose,
-                                                float* out_rotations,
-                                                float* out_hips_translation);
+                                                float* out_rotations, float* out_hips_translation);
 
 /* Message of the last failed call on `retargeter` ("" when none), owned by the handle. */
 AVATARMAP_C_API const char* avm_retargeter_last_error(const avm_retargeter* retargeter);

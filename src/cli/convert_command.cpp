@@ -1,0 +1,257 @@
+// `avatarmap convert IN -o OUT [--avatar AVATAR] [--rig auto|NAME|FILE.json] [--fps N]`:
+// landmarks, proxy poses or VRM Animation in; VRMA, animated GLB, BVH or proxy poses out.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "avatarmap/export/animated_glb.hpp"
+#include "avatarmap/export/bvh.hpp"
+#include "avatarmap/export/vrma.hpp"
+#include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/rig/avatar_loader.hpp"
+#include "avatarmap/rig/retarget.hpp"
+#include "avatarmap/time/pose_resampler.hpp"
+#include "cli/cli_args.hpp"
+#include "cli/commands.hpp"
+#include "cli/rig_select.hpp"
+#include "cli/solve_job.hpp"
+
+namespace avatarmap::cli {
+namespace {
+
+const char* k_convert_help =
+    "Usage: avatarmap convert IN -o OUT [options]\n"
+    "\n"
+    "IN:  *.landmarks.jsonl (solved as by `avatarmap solve`), *.pose.jsonl or *.vrma\n"
+    "OUT: *.vrma (VRM Animation), *.glb (the avatar with the motion; needs --avatar),\n"
+    "     *.bvh (the proxy skeleton, centimetres, ZXY), *.pose.jsonl\n"
+    "\n"
+    "Options:\n"
+    "  -o, --output PATH     output file (required; written atomically)\n"
+    "  --avatar FILE         the avatar (.vrm, .glb, .gltf) to drive (required for .glb)\n"
+    "  --rig auto|NAME|FILE.json\n"
+    "                        how the avatar's joints map to the proxy: auto (default) uses a\n"
+    "                        VRM's own humanoid map, else the best shipped table (mixamo,\n"
+    "                        unity_humanoid, ue4_mannequin, ue5_mannequin, character_creator,\n"
+    "                        ...); NAME picks a shipped table; FILE.json a table of yours\n"
+    "  --fps N               output frame rate (default 30; .pose.jsonl: the input's frames)\n"
+    "  --ground              keep the avatar's lowest foot on the floor every frame\n"
+    "  --no-root-motion      keep the hips where they are at rest\n"
+    "  --mirror, --image-size WxH, --filter euro|landmarks|both|none\n"
+    "                        as for `avatarmap solve` (landmark input only)\n"
+    "  --quiet               no summary\n";
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+status load_motion(const std::string& in, const solve_job& solve, std::vector<proxy_pose>& out,
+                   double& source_fps) {
+  out.clear();
+  source_fps = 0.0;
+  if (ends_with(in, ".vrma")) {
+    vrma_clip clip;
+    status st = read_vrma(in, clip);
+    if (!st.ok()) return st;
+    out = std::move(clip.frames);
+    return {};
+  }
+  if (ends_with(in, ".pose.jsonl")) {
+    pose_reader reader;
+    status st = reader.open(in);
+    if (!st.ok()) return st;
+    source_fps = reader.header().fps;
+    proxy_pose p;
+    for (;;) {
+      read_result r = reader.next(p);
+      if (r == read_result::end) break;
+      if (r == read_result::error) return status::error(reader.error());
+      out.push_back(p);
+    }
+    return {};
+  }
+  if (ends_with(in, ".jsonl") || in == "-") {
+    solve_job job = solve;
+    job.input = in;
+    job.progress = progress_mode::off;
+    job.sink = [&](const proxy_pose& p) {
+      out.push_back(p);
+      return status{};
+    };
+    solve_summary summary;
+    return run_solve_job(job, summary);
+  }
+  return status::error(in +
+                       ": unknown input type (give *.landmarks.jsonl, *.pose.jsonl or *.vrma)");
+}
+
+// Frames at a fixed rate from t = first frame's time, slerped between the input frames.
+std::vector<proxy_pose> resample(const std::vector<proxy_pose>& in, double fps) {
+  std::vector<proxy_pose> out;
+  if (in.empty()) return out;
+  pose_resampler resampler;
+  const double t0 = in.front().t, t1 = in.back().t;
+  size_t next = 0;
+  proxy_pose p;
+  for (long k = 0;; ++k) {
+    const double t = t0 + double(k) / fps;
+    if (t > t1 + 1e-4) break;  // times read from files are floats
+    while (next < in.size() && in[next].t <= t + 1e-9) resampler.push(in[next++]);
+    if (next < in.size()) resampler.push(in[next]);  // the frame after t, to interpolate to
+    if (!resampler.sample(t, p)) break;
+    p.t = t - t0;
+    out.push_back(p);
+    // The look-ahead frame is pushed again (same time: it replaces itself) on the next step.
+  }
+  return out;
+}
+
+}  // namespace
+
+int run_convert(int argc, char** argv) {
+  args a(argc, argv, 2);
+  if (a.flag("--help") || a.flag("-h")) {
+    std::fputs(k_convert_help, stdout);
+    return 0;
+  }
+  std::string out_path, avatar, rig_option = "auto", value;
+  a.value("--output", out_path, "-o");
+  a.value("--avatar", avatar);
+  a.value("--rig", rig_option);
+  double fps = 0.0;
+  const bool fps_given = a.number("--fps", fps);
+  const bool ground = a.flag("--ground");
+  const bool root_motion = !a.flag("--no-root-motion");
+  const bool quiet = a.flag("--quiet");
+  solve_job solve;
+  solve.options.mirror = a.flag("--mirror");
+  if (a.value("--image-size", value)) {
+    int w = 0, h = 0;
+    if (!parse_image_size(value, w, h)) {
+      std::fprintf(stderr, "avatarmap convert: --image-size wants WxH in pixels, e.g. 1280x720\n");
+      return 2;
+    }
+    solve.image_width = float(w);
+    solve.image_height = float(h);
+  }
+  if (a.value("--filter", value)) {
+    if (value == "none" || value == "landmarks") solve.filter.enabled = false;
+    if (value == "landmarks" || value == "both") solve.landmark_filter.enabled = true;
+    if (value != "none" && value != "euro" && value != "landmarks" && value != "both") {
+      std::fprintf(stderr, "avatarmap convert: --filter is euro, landmarks, both or none\n");
+      return 2;
+    }
+  }
+  if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 1 || out_path.empty()) {
+    std::fprintf(stderr, "avatarmap convert: %s\n",
+                 !a.error().empty()     ? a.error().c_str()
+                 : a.rest().size() != 1 ? "give exactly one input file (see --help)"
+                                        : "give the output with -o OUT (see --help)");
+    return 2;
+  }
+  if (fps_given && !(fps > 0.0 && fps <= 1000.0)) {
+    std::fprintf(stderr, "avatarmap convert: --fps must be in (0, 1000]\n");
+    return 2;
+  }
+  const bool to_vrma = ends_with(out_path, ".vrma"), to_glb = ends_with(out_path, ".glb"),
+             to_bvh = ends_with(out_path, ".bvh"), to_pose = ends_with(out_path, ".pose.jsonl");
+  if (!to_vrma && !to_glb && !to_bvh && !to_pose) {
+    std::fprintf(stderr,
+                 "avatarmap convert: the output must end in .vrma, .glb, .bvh or .pose.jsonl\n");
+    return 2;
+  }
+  if (to_glb && avatar.empty()) {
+    std::fprintf(stderr,
+                 "avatarmap convert: .glb output needs --avatar AVATAR (the model to animate)\n");
+    return 2;
+  }
+  const auto t_start = std::chrono::steady_clock::now();
+
+  // The avatar first, so that a bad avatar fails before any long work.
+  raw_rig raw;
+  rig r;
+  rig_selection selection;
+  retargeter rt;
+  if (!avatar.empty()) {
+    status st = load_avatar(avatar, raw);
+    if (st.ok()) st = build_rig(raw, r);
+    if (st.ok()) st = select_rig_binding(r, rig_option, selection);
+    if (!st.ok()) {
+      std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
+      return 1;
+    }
+  }
+
+  std::vector<proxy_pose> frames;
+  double source_fps = 0.0;
+  status st = load_motion(a.rest()[0], solve, frames, source_fps);
+  if (!st.ok()) {
+    std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
+    return 1;
+  }
+  if (frames.empty()) {
+    std::fprintf(stderr, "avatarmap convert: %s has no frames\n", a.rest()[0].c_str());
+    return 1;
+  }
+  const double out_fps = fps_given ? fps : 30.0;
+  std::vector<proxy_pose> sampled = (to_pose && !fps_given) ? frames : resample(frames, out_fps);
+
+  if (to_vrma) {
+    vrma_write_options o;
+    st = write_vrma(out_path, sampled, o);
+  } else if (to_bvh) {
+    bvh_write_options o;
+    o.fps = out_fps;
+    st = write_bvh(out_path, sampled, o);
+  } else if (to_pose) {
+    pose_writer w;
+    pose_file_header h;
+    h.fps = fps_given ? out_fps : source_fps;
+    st = w.open(out_path, h);
+    for (size_t i = 0; st.ok() && i < sampled.size(); ++i) st = w.write(sampled[i]);
+    if (st.ok()) st = w.commit();
+  } else {
+    // The performer's standing hips height: a high percentile of the clip's hips heights.
+    std::vector<float> heights;
+    for (const proxy_pose& p : sampled) heights.push_back(p.hips_position.y);
+    std::sort(heights.begin(), heights.end());
+    retarget_options ro;
+    ro.performer_hips_height = heights[heights.size() * 9 / 10];
+    ro.keep_feet_on_ground = ground;
+    ro.root_motion = root_motion;
+    st = rt.build(r, selection.binding, ro, selection.table);
+    if (st.ok()) {
+      std::vector<rig_pose> poses(sampled.size());
+      for (size_t i = 0; i < sampled.size(); ++i) {
+        rt.prepare(poses[i]);
+        rt.apply(sampled[i], poses[i]);
+      }
+      animated_glb_options go;
+      go.fps = out_fps;
+      st = write_animated_glb(avatar, r, poses, go, out_path);
+    }
+  }
+  if (!st.ok()) {
+    std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
+    return 1;
+  }
+  const double secs =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  if (!quiet) {
+    std::fprintf(
+        stderr, "converted %zu input frames (%.2f s) into %zu frames%s in %.3f s\n", frames.size(),
+        frames.back().t - frames.front().t, sampled.size(),
+        (to_pose && !fps_given) ? "" : (" at " + std::to_string(int(out_fps)) + " fps").c_str(),
+        secs);
+    if (!avatar.empty())
+      std::fprintf(stderr, "avatar %s: %d joints; %s\n", avatar.c_str(), r.joint_count(),
+                   selection.description.c_str());
+    std::fprintf(stderr, "wrote %s\n", out_path.c_str());
+  }
+  return 0;
+}
+
+}  // namespace avatarmap::cli
