@@ -329,7 +329,8 @@ void measure_fingers(const hand_points& h, const glm::quat& hand_w, float c, boo
     glm::vec3 v1 = normalize_or(to_hand(h.p[j + 1] - h.p[j]), k_x);
     const glm::vec3 v2 = to_hand(h.p[j + 2] - h.p[j + 1]);
     const glm::vec3 v3 = to_hand(h.p[j + 3] - h.p[j + 2]);
-    // Proximal: R_z(phi) * R_y(spread) with phi = -flexion (see finger_proximal).
+    // Proximal: R_z(phi) * R_y(spread) with phi = -flexion, spread = asin(-v.z); the cosines
+    // and sines come straight from the unit direction v1 (no trig calls).
     const float r2 = v1.x * v1.x + v1.y * v1.y;
     float cf = 1.f, sf = 0.f, cs = 0.f;
     if (r2 > 1e-24f) {

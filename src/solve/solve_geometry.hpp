@@ -17,15 +17,6 @@ inline constexpr glm::vec3 k_y{0.f, 1.f, 0.f};
 inline constexpr glm::vec3 k_z{0.f, 0.f, 1.f};
 inline constexpr float k_deg = k_pi / 180.f;
 
-inline float smoothstep(float e0, float e1, float x) {
-  float t = glm::clamp((x - e0) / (e1 - e0), 0.f, 1.f);
-  return t * t * (3.f - 2.f * t);
-}
-
-inline float angle_of(const glm::vec3& a, const glm::vec3& b) {
-  return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
-}
-
 /// Component of v orthogonal to unit u.
 inline glm::vec3 orth(const glm::vec3& v, const glm::vec3& u) { return v - glm::dot(v, u) * u; }
 
@@ -142,28 +133,6 @@ inline glm::quat axis_cos_sin(const glm::vec3& k, float c, float s) {
   if (w < 1e-7f) return glm::quat(0.f, k.x, k.y, k.z);
   float n = inv_sqrt(w * w + s * s);
   return glm::quat(w * n, k.x * s * n, k.y * s * n, k.z * s * n);
-}
-
-/// Hinge rotation about the local axis that turns +X toward -Y (rotation about Z by -theta),
-/// with theta = atan2(-v.y, v.x) taken from the child's direction v in the parent's frame:
-/// fingers flex past 90 degrees without folding back. v's Z part (off the hinge plane) is
-/// ignored; a v along Z gives identity.
-inline glm::quat finger_hinge(const glm::vec3& v_local) {
-  float r2 = v_local.x * v_local.x + v_local.y * v_local.y;
-  if (!(r2 > 1e-24f)) return glm::quat(1.f, 0.f, 0.f, 0.f);
-  // Rotation about +Z by -theta: cos = v.x / r, sin(-theta) = v.y / r.
-  const float ir = inv_sqrt(r2);
-  return axis_cos_sin(k_z, v_local.x * ir, v_local.y * ir);
-}
-
-/// A finger's proximal rotation R_z(-flex) * R_y(spread) that points +X along unit `v`
-/// (hand frame): spread = asin(-v.z), flex = atan2(-v.y, v.x), computed without trig calls.
-inline glm::quat finger_proximal(const glm::vec3& v) {
-  const float r2 = v.x * v.x + v.y * v.y;
-  if (!(r2 > 1e-24f)) return axis_cos_sin(k_y, 0.f, -v.z);
-  const float ir = inv_sqrt(r2);
-  glm::quat spread = axis_cos_sin(k_y, r2 * ir, -v.z);
-  return axis_cos_sin(k_z, v.x * ir, v.y * ir) * spread;
 }
 
 }  // namespace avatarmap::solve_detail
