@@ -6,7 +6,9 @@
 #include <filesystem>
 #include <string>
 
+#include "avatarmap/export/vrma.hpp"
 #include "avatarmap/io/landmark_file.hpp"
+#include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/io/tfjs_import.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
@@ -137,7 +139,8 @@ int run_demo(int argc, char** argv) {
         "Usage: avatarmap demo [--keep DIR]\n"
         "\n"
         "Synthesises a 10 s recording (avatarmap synth, 2 mm noise), solves it (avatarmap solve)\n"
-        "and prints the summary. --keep DIR keeps demo.landmarks.jsonl and demo.pose.jsonl there\n"
+        "and prints the summary, then writes the motion as demo.vrma. --keep DIR keeps\n"
+        "demo.landmarks.jsonl, demo.pose.jsonl and demo.vrma there\n"
         "(DIR is created if needed); otherwise they go to a temporary folder that is removed.\n",
         stdout);
     return 0;
@@ -191,9 +194,25 @@ int run_demo(int argc, char** argv) {
     return 1;
   }
   print_summary(job, summary, stdout);
+  // The same motion as a VRM Animation clip any VRM viewer can play.
+  std::vector<proxy_pose> poses;
+  {
+    pose_reader reader;
+    st = reader.open(job.output);
+    proxy_pose p;
+    while (st.ok() && reader.next(p) == read_result::frame) poses.push_back(p);
+  }
+  const std::string vrma = dir + "/demo.vrma";
+  if (st.ok()) st = write_vrma(vrma, poses);
+  if (!st.ok()) {
+    std::fprintf(stderr, "avatarmap demo: %s\n", st.message().c_str());
+    return 1;
+  }
+  std::printf("wrote %zu frames of VRM Animation to %s\n", poses.size(), vrma.c_str());
   if (keep.empty()) {
     std::remove(s.output.c_str());
     std::remove(job.output.c_str());
+    std::remove(vrma.c_str());
     rmdir(dir.c_str());
   }
   return 0;
