@@ -2,12 +2,17 @@
 """Drive the avatarmap C API from Python with ctypes only (no numpy, no build step).
 
 Usage:
-    solve_ctypes.py [--library PATH] [--mirror] [FILE.landmarks.jsonl]
+    solve_ctypes.py [--library PATH] [--mirror] [--avatar FILE [--rig auto|NAME|FILE.json]]
+                    [--mappings DIR] [--output OUT] [FILE.landmarks.jsonl]
 
 The shared library is taken from --library, else from the environment variable
 AVATARMAP_C_LIBRARY, else from the system search path (libavatarmap_c). Without a landmark
 file, a built-in synthetic T-pose is solved. Prints the hips rotation {x, y, z, w} of every
-frame, then a summary. Exits with status 1 on any avm error, 2 on bad usage.
+frame, then a summary. With --avatar, every pose is also retargeted onto the avatar's rig
+(avm_retargeter; --rig as for `avatarmap convert`, tables from --mappings or
+$AVATARMAP_MAPPINGS) and the hips joint's rotation printed. With --output, the poses are
+collected in an avm_clip and written (.vrma, .bvh, .pose.jsonl, or .glb with --avatar).
+Exits with status 1 on any avm error, 2 on bad usage.
 """
 
 import argparse
@@ -113,6 +118,26 @@ def load_library(path):
         "avm_solver_sample": (ctypes.c_int, [solver_p, ctypes.c_double,
                                              ctypes.POINTER(AvmPose)]),
         "avm_solver_last_error": (ctypes.c_char_p, [solver_p]),
+        "avm_set_mappings_folder": (ctypes.c_int, [ctypes.c_char_p]),
+        "avm_retargeter_create": (ctypes.c_int, [ctypes.c_char_p, ctypes.c_char_p,
+                                                 ctypes.POINTER(ctypes.c_void_p)]),
+        "avm_retargeter_destroy": (None, [ctypes.c_void_p]),
+        "avm_retargeter_joint_count": (ctypes.c_int, [ctypes.c_void_p]),
+        "avm_retargeter_joint_name": (ctypes.c_char_p, [ctypes.c_void_p, ctypes.c_int]),
+        "avm_retargeter_bone_joint": (ctypes.c_int, [ctypes.c_void_p, ctypes.c_int]),
+        "avm_retargeter_binding_description": (ctypes.c_char_p, [ctypes.c_void_p]),
+        "avm_retargeter_apply": (ctypes.c_int, [ctypes.c_void_p, ctypes.POINTER(AvmPose),
+                                                ctypes.POINTER(ctypes.c_float),
+                                                ctypes.POINTER(ctypes.c_float)]),
+        "avm_retargeter_last_error": (ctypes.c_char_p, [ctypes.c_void_p]),
+        "avm_clip_create": (ctypes.c_int, [ctypes.POINTER(ctypes.c_void_p)]),
+        "avm_clip_destroy": (None, [ctypes.c_void_p]),
+        "avm_clip_add": (ctypes.c_int, [ctypes.c_void_p, ctypes.POINTER(AvmPose)]),
+        "avm_clip_frame_count": (ctypes.c_int, [ctypes.c_void_p]),
+        "avm_clip_write": (ctypes.c_int, [ctypes.c_void_p, ctypes.c_char_p, ctypes.c_double,
+                                          ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p,
+                                          ctypes.c_size_t]),
+        "avm_clip_last_error": (ctypes.c_char_p, [ctypes.c_void_p]),
     }
     for name, (restype, argtypes) in sigs.items():
         fn = getattr(lib, name)
@@ -156,6 +181,66 @@ class Solver:
     def close(self):
         if self.handle:
             self.lib.avm_solver_destroy(self.handle)
+            self.handle = ctypes.c_void_p()
+
+
+class Retargeter:
+    """Owns one avm_retargeter handle: proxy poses -> the avatar's joint rotations."""
+
+    def __init__(self, lib, avatar, rig):
+        self.lib = lib
+        self.handle = ctypes.c_void_p()
+        st = lib.avm_retargeter_create(os.fsencode(avatar), rig.encode() if rig else None,
+                                       ctypes.byref(self.handle))
+        if st != AVM_OK:
+            raise AvmError("avm_retargeter_create: %s: %s" % (
+                lib.avm_status_string(st).decode(), lib.avm_last_create_error().decode()))
+        self.joints = lib.avm_retargeter_joint_count(self.handle)
+        self.rotations = (ctypes.c_float * (4 * self.joints))()
+        self.hips_translation = (ctypes.c_float * 3)()
+
+    def description(self):
+        return self.lib.avm_retargeter_binding_description(self.handle).decode()
+
+    def apply(self, pose):
+        """Returns (rotations as a flat list of x, y, z, w per joint, hips translation)."""
+        st = self.lib.avm_retargeter_apply(self.handle, ctypes.byref(pose), self.rotations,
+                                           self.hips_translation)
+        if st != AVM_OK:
+            raise AvmError("retarget: %s" % self.lib.avm_retargeter_last_error(self.handle).decode())
+        return list(self.rotations), list(self.hips_translation)
+
+    def close(self):
+        if self.handle:
+            self.lib.avm_retargeter_destroy(self.handle)
+            self.handle = ctypes.c_void_p()
+
+
+class Clip:
+    """Owns one avm_clip handle: poses collected, then written as an animation file."""
+
+    def __init__(self, lib):
+        self.lib = lib
+        self.handle = ctypes.c_void_p()
+        if lib.avm_clip_create(ctypes.byref(self.handle)) != AVM_OK:
+            raise AvmError("avm_clip_create: %s" % lib.avm_last_create_error().decode())
+
+    def add(self, pose):
+        if self.lib.avm_clip_add(self.handle, ctypes.byref(pose)) != AVM_OK:
+            raise AvmError("clip: %s" % self.lib.avm_clip_last_error(self.handle).decode())
+
+    def write(self, path, fps=0.0, avatar=None, rig=None):
+        err = ctypes.create_string_buffer(1024)
+        st = self.lib.avm_clip_write(self.handle, os.fsencode(path), fps,
+                                     os.fsencode(avatar) if avatar else None,
+                                     rig.encode() if rig else None, err, len(err))
+        if st != AVM_OK:
+            raise AvmError("write: %s: %s" % (self.lib.avm_status_string(st).decode(),
+                                              err.value.decode()))
+
+    def close(self):
+        if self.handle:
+            self.lib.avm_clip_destroy(self.handle)
             self.handle = ctypes.c_void_p()
 
 
@@ -253,7 +338,13 @@ def main(argv):
     parser.add_argument("landmarks", nargs="?", help="*.landmarks.jsonl (default: synthetic)")
     parser.add_argument("--library", help="path of libavatarmap_c (or AVATARMAP_C_LIBRARY)")
     parser.add_argument("--mirror", action="store_true", help="mirrored (selfie) input")
+    parser.add_argument("--avatar", help="retarget onto this avatar (.vrm, .glb, .gltf)")
+    parser.add_argument("--rig", help="auto (default), a mapping table name or FILE.json")
+    parser.add_argument("--mappings", help="folder of the mapping tables (or AVATARMAP_MAPPINGS)")
+    parser.add_argument("--output", help="write the poses: .vrma, .bvh, .pose.jsonl, .glb")
     args = parser.parse_args(argv)
+    if args.output and args.output.lower().endswith(".glb") and not args.avatar:
+        parser.error("--output *.glb needs --avatar")
 
     try:
         lib = load_library(args.library)
@@ -265,7 +356,7 @@ def main(argv):
     print("avatarmap %s (%d.%d.%d)" % (lib.avm_version_string().decode(), major.value,
                                        minor.value, patch.value))
 
-    solver = None
+    solver = retargeter = clip = None
     try:
         options = AvmSolverOptions()
         if lib.avm_solver_options_init(ctypes.byref(options)) != AVM_OK:
@@ -280,6 +371,15 @@ def main(argv):
             frames = synthetic_frames()
         solver = Solver(lib, options)
         hips = lib.avm_bone_from_name(b"hips")
+        if args.mappings and lib.avm_set_mappings_folder(os.fsencode(args.mappings)) != AVM_OK:
+            raise AvmError("avm_set_mappings_folder failed")
+        if args.avatar:
+            retargeter = Retargeter(lib, args.avatar, args.rig)
+            hips_joint = lib.avm_retargeter_bone_joint(retargeter.handle, hips)
+            print("avatar %s: %d joints; %s" % (args.avatar, retargeter.joints,
+                                                retargeter.description()))
+        if args.output:
+            clip = Clip(lib)
         max_angle, last_t = 0.0, None
         for obj in frames:
             frame, _keep = to_avm_frame(obj)
@@ -291,19 +391,31 @@ def main(argv):
             max_angle = max(max_angle, angle_deg(q))
             print("t=%8.4f hips [x y z w] = [% .4f % .4f % .4f % .4f]  position = [% .3f % .3f % .3f]"
                   % (pose.t, q[0], q[1], q[2], q[3], *pose.hips_position))
+            if retargeter is not None:
+                rotations, _ = retargeter.apply(pose)
+                j = rotations[4 * hips_joint:4 * hips_joint + 4]
+                if not all(math.isfinite(v) for v in rotations):
+                    raise AvmError("non-finite joint rotation at t=%g" % pose.t)
+                print("           avatar hips joint [x y z w] = [% .4f % .4f % .4f % .4f]" % tuple(j))
+            if clip is not None:
+                clip.add(pose)
             if last_t is not None:  # a render time between the last two captures
                 mid = solver.sample(0.5 * (last_t + pose.t))
                 if not all(math.isfinite(v) for v in mid.rotations[hips]):
                     raise AvmError("non-finite sampled hips rotation at t=%g" % mid.t)
             last_t = pose.t
         print("summary: %d frame(s), largest hips rotation %.2f deg" % (len(frames), max_angle))
+        if clip is not None:
+            clip.write(args.output, 0.0, args.avatar, args.rig)
+            print("wrote %s (%d frames)" % (args.output, lib.avm_clip_frame_count(clip.handle)))
         return 0
     except (AvmError, OSError, ValueError, KeyError, TypeError) as e:
         print("error: %s" % e, file=sys.stderr)
         return 1
     finally:
-        if solver is not None:
-            solver.close()
+        for handle in (solver, retargeter, clip):
+            if handle is not None:
+                handle.close()
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 // `avatarmap convert IN -o OUT [--avatar AVATAR] [--rig auto|NAME|FILE.json] [--fps N]`:
 // landmarks, proxy poses or VRM Animation in; VRMA, animated GLB, BVH or proxy poses out.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -12,6 +13,7 @@
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "avatarmap/rig/retarget.hpp"
+#include "avatarmap/synth/synth_skeleton.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
@@ -26,11 +28,13 @@ const char* k_convert_help =
     "\n"
     "IN:  *.landmarks.jsonl (solved as by `avatarmap solve`), *.pose.jsonl or *.vrma\n"
     "OUT: *.vrma (VRM Animation), *.glb (the avatar with the motion; needs --avatar),\n"
-    "     *.bvh (the proxy skeleton, centimetres, ZXY), *.pose.jsonl\n"
+    "     *.bvh (centimetres, ZXY: the avatar's own rig with --avatar, else the proxy\n"
+    "     skeleton), *.pose.jsonl\n"
     "\n"
     "Options:\n"
     "  -o, --output PATH     output file (required; written atomically)\n"
-    "  --avatar FILE         the avatar (.vrm, .glb, .gltf) to drive (required for .glb)\n"
+    "  --avatar FILE         the avatar (.vrm, .glb, .gltf) to drive (required for .glb;\n"
+    "                        with .bvh: write its rig instead of the proxy skeleton)\n"
     "  --rig auto|NAME|FILE.json\n"
     "                        how the avatar's joints map to the proxy: auto (default) uses a\n"
     "                        VRM's own humanoid map, else the best shipped table (mixamo,\n"
@@ -109,6 +113,83 @@ std::vector<proxy_pose> resample(const std::vector<proxy_pose>& in, double fps) 
   return out;
 }
 
+// Retargets `sampled` onto `r` as every avatar output does: the performer's standing hips
+// height is a high percentile of the clip's hips heights.
+status retarget_frames(const rig& r, const rig_selection& selection,
+                       const std::vector<proxy_pose>& sampled, bool ground, bool root_motion,
+                       retargeter& rt, std::vector<rig_pose>& out) {
+  if (sampled.empty()) return status::error("no frames to retarget");
+  std::vector<float> heights;
+  for (const proxy_pose& p : sampled) heights.push_back(p.hips_position.y);
+  std::sort(heights.begin(), heights.end());
+  retarget_options ro;
+  ro.performer_hips_height = heights[heights.size() * 9 / 10];
+  ro.keep_feet_on_ground = ground;
+  ro.root_motion = root_motion;
+  status st = rt.build(r, selection.binding, ro, selection.table);
+  if (!st.ok()) return st;
+  out.assign(sampled.size(), rig_pose{});
+  for (size_t i = 0; i < sampled.size(); ++i) {
+    rt.prepare(out[i]);
+    rt.apply(sampled[i], out[i]);
+  }
+  return {};
+}
+
+void append_position(std::string& s, const std::string& name, glm::dvec3 p, bool first) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "\":[%.7g,%.7g,%.7g]", p.x, p.y, p.z);
+  s += first ? "\"" : ",\"";
+  s += name;
+  s += buf;
+}
+
+// Diagnostic (--dump-positions, used by tools/interop/check_blender.sh): every joint's world
+// position (metres, the output's world axes) per written frame, as JSON
+// {"unit":"m","fps":F,"frames":[{"name":[x,y,z],...},...]}. Rig output: every rig joint, rig
+// FK of the retargeted poses; otherwise the proxy bones on the synthetic skeleton written to
+// BVH. Joint names must need no JSON escaping (interop files only).
+status dump_positions(const std::string& path, double fps, const std::vector<proxy_pose>& sampled,
+                      const rig* r, const std::vector<rig_pose>& poses) {
+  std::string s = "{\"unit\":\"m\",\"fps\":" + std::to_string(fps) + ",\"frames\":[";
+  if (r) {
+    std::vector<glm::dmat4> world(static_cast<size_t>(r->joint_count()));
+    for (size_t f = 0; f < poses.size(); ++f) {
+      s += f ? ",{" : "{";
+      for (int j = 0; j < r->joint_count(); ++j) {
+        const transform& t = r->rest_local[j];
+        const glm::quat& q = poses[f].local_rotations[j];
+        glm::dmat4 m = glm::mat4_cast(glm::normalize(glm::dquat(q.w, q.x, q.y, q.z)));
+        m[0] *= double(t.scale.x);
+        m[1] *= double(t.scale.y);
+        m[2] *= double(t.scale.z);
+        m[3] = glm::dvec4(
+            glm::dvec3(j == poses[f].hips_joint ? poses[f].hips_translation : t.translation), 1.0);
+        world[j] = r->parents[j] < 0 ? m : world[r->parents[j]] * m;
+        append_position(s, r->names[j], glm::dvec3(world[j][3]), j == 0);
+      }
+      s += "}";
+    }
+  } else {
+    const synth_skeleton sk = make_synth_skeleton();
+    std::array<glm::vec3, k_bone_count> joints;
+    for (size_t f = 0; f < sampled.size(); ++f) {
+      s += f ? ",{" : "{";
+      joint_world_positions(sk, sampled[f], joints);
+      for (int b = 0; b < k_bone_count; ++b)
+        append_position(s, std::string(bone_name(static_cast<bone>(b))), glm::dvec3(joints[b]),
+                        b == 0);
+      s += "}";
+    }
+  }
+  s += "]}\n";
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (!file) return status::error(path + ": cannot open for writing");
+  const bool ok = std::fwrite(s.data(), 1, s.size(), file) == s.size();
+  if (std::fclose(file) != 0 || !ok) return status::error(path + ": write failed");
+  return {};
+}
+
 }  // namespace
 
 int run_convert(int argc, char** argv) {
@@ -121,6 +202,8 @@ int run_convert(int argc, char** argv) {
   a.value("--output", out_path, "-o");
   a.value("--avatar", avatar);
   a.value("--rig", rig_option);
+  std::string dump_path;  // hidden diagnostic option, see dump_positions()
+  a.value("--dump-positions", dump_path);
   double fps = 0.0;
   const bool fps_given = a.number("--fps", fps);
   const bool ground = a.flag("--ground");
@@ -199,9 +282,19 @@ int run_convert(int argc, char** argv) {
   const double out_fps = fps_given ? fps : 30.0;
   std::vector<proxy_pose> sampled = (to_pose && !fps_given) ? frames : resample(frames, out_fps);
 
-  if (to_vrma) {
+  // Avatar outputs (.glb, and .bvh with --avatar) write the retargeted rig poses.
+  const bool to_rig = to_glb || (to_bvh && !avatar.empty());
+  std::vector<rig_pose> poses;
+  if (to_rig) st = retarget_frames(r, selection, sampled, ground, root_motion, rt, poses);
+  if (!st.ok()) {
+    // reported below
+  } else if (to_vrma) {
     vrma_write_options o;
     st = write_vrma(out_path, sampled, o);
+  } else if (to_bvh && to_rig) {
+    rig_bvh_options o;
+    o.fps = out_fps;
+    st = write_rig_bvh(out_path, r, poses, o);
   } else if (to_bvh) {
     bvh_write_options o;
     o.fps = out_fps;
@@ -214,26 +307,12 @@ int run_convert(int argc, char** argv) {
     for (size_t i = 0; st.ok() && i < sampled.size(); ++i) st = w.write(sampled[i]);
     if (st.ok()) st = w.commit();
   } else {
-    // The performer's standing hips height: a high percentile of the clip's hips heights.
-    std::vector<float> heights;
-    for (const proxy_pose& p : sampled) heights.push_back(p.hips_position.y);
-    std::sort(heights.begin(), heights.end());
-    retarget_options ro;
-    ro.performer_hips_height = heights[heights.size() * 9 / 10];
-    ro.keep_feet_on_ground = ground;
-    ro.root_motion = root_motion;
-    st = rt.build(r, selection.binding, ro, selection.table);
-    if (st.ok()) {
-      std::vector<rig_pose> poses(sampled.size());
-      for (size_t i = 0; i < sampled.size(); ++i) {
-        rt.prepare(poses[i]);
-        rt.apply(sampled[i], poses[i]);
-      }
-      animated_glb_options go;
-      go.fps = out_fps;
-      st = write_animated_glb(avatar, r, poses, go, out_path);
-    }
+    animated_glb_options go;
+    go.fps = out_fps;
+    st = write_animated_glb(avatar, r, poses, go, out_path);
   }
+  if (st.ok() && !dump_path.empty() && !to_vrma && !to_pose)
+    st = dump_positions(dump_path, out_fps, sampled, to_rig ? &r : nullptr, poses);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
     return 1;

@@ -14,21 +14,8 @@
 namespace avatarmap {
 namespace {
 
-// Fixed-point text with 6 decimals ("-0.000000" normalised to "0.000000").
-void append_fixed(std::string& s, double v) {
-  char buf[64];
-  if (std::abs(v) < 5e-7) v = 0.0;
-  int len = std::snprintf(buf, sizeof buf, "%.6f", v);
-  if (len > 0) s.append(buf, static_cast<std::size_t>(len));
-}
-
-void append_vec(std::string& s, const glm::vec3& v, double scale) {
-  append_fixed(s, v.x * scale);
-  s.push_back(' ');
-  append_fixed(s, v.y * scale);
-  s.push_back(' ');
-  append_fixed(s, v.z * scale);
-}
+using export_detail::append_fixed;
+using export_detail::append_vec;
 
 bool has_children(int b) {
   for (int c = 0; c < k_bone_count; ++c)

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,25 @@ inline std::vector<proxy_pose> frames_to_write(const std::vector<proxy_pose>& fr
   if (rebase)
     for (proxy_pose& p : clean) p.t -= t0;
   return clean;
+}
+
+/// Appends `v` as fixed-point text with 6 decimals ("-0.000000" normalised to "0.000000"),
+/// the number format of both BVH writers.
+inline void append_fixed(std::string& s, double v) {
+  char buf[64];
+  if (std::abs(v) < 5e-7) v = 0.0;
+  int len = std::snprintf(buf, sizeof buf, "%.6f", v);
+  if (len > 0) s.append(buf, static_cast<std::size_t>(len));
+}
+
+/// Appends "x y z" of `v` times `scale` with append_fixed.
+template <class vec>
+inline void append_vec(std::string& s, const vec& v, double scale) {
+  append_fixed(s, double(v.x) * scale);
+  s.push_back(' ');
+  append_fixed(s, double(v.y) * scale);
+  s.push_back(' ');
+  append_fixed(s, double(v.z) * scale);
 }
 
 }  // namespace avatarmap::export_detail

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -61,6 +62,16 @@ bool glob_match(std::string_view pattern, std::string_view text) {
 }
 
 std::string quote(std::string_view s) { return "'" + std::string(s) + "'"; }
+
+// A JSON number as a float; false when it is not finite as a float (a double such as 1e300
+// must not be cast to float: that is undefined behaviour).
+bool finite_float(const json& v, float& out) {
+  const double d = v.get<double>();
+  if (!std::isfinite(d) || std::fabs(d) > static_cast<double>(std::numeric_limits<float>::max()))
+    return false;
+  out = static_cast<float>(d);
+  return true;
+}
 
 // Error builder: "<file>: <key>: <message>".
 struct context {
@@ -182,9 +193,8 @@ status parse_bone(const context& c, const std::string& key, const json& v, mappi
     if (!it->is_array() || it->size() != 3 || !(*it)[0].is_number() || !(*it)[1].is_number() ||
         !(*it)[2].is_number())
       return c.error(key + ".rest", "expected three numbers [x, y, z] (radians)");
-    for (int i = 0; i < 3; ++i) out.rest[i] = (*it)[i].get<float>();
-    if (!std::isfinite(out.rest.x) || !std::isfinite(out.rest.y) || !std::isfinite(out.rest.z))
-      return c.error(key + ".rest", "must be finite");
+    for (int i = 0; i < 3; ++i)
+      if (!finite_float((*it)[i], out.rest[i])) return c.error(key + ".rest", "must be finite");
     out.has_rest = true;
   }
   return {};
@@ -229,8 +239,7 @@ status parse_table(const context& c, const json& doc, mapping_table& t) {
   }
   if (auto it = doc.find("units_scale"); it != doc.end()) {
     if (!it->is_number()) return c.error("units_scale", "expected a number");
-    t.units_scale = it->get<float>();
-    if (!(t.units_scale > 0.f) || !std::isfinite(t.units_scale))
+    if (!finite_float(*it, t.units_scale) || !(t.units_scale > 0.f))
       return c.error("units_scale", "must be a positive finite number");
     t.has_units_scale = true;
   }
@@ -352,7 +361,7 @@ status load_mapping_json(std::string_view text, const std::string& name, mapping
   json doc;
   try {
     doc = json::parse(text.begin(), text.end());
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, out_of_range (a number like 1e400)
     return c.error("", std::string("invalid JSON: ") + e.what());
   }
   mapping_table t;
@@ -594,9 +603,9 @@ status import_sysmocap_binding(std::string_view text, mapping_table& out) {
       if (!mb.mapped()) continue;  // SysMocap ignores it too
       for (int i = 0; i < 3; ++i) {
         const char* axis = i == 0 ? "x" : i == 1 ? "y" : "z";
-        if (!v.is_object() || !v.contains(axis) || !v[axis].is_number())
-          return c.error(key, "expected {\"x\", \"y\", \"z\"} numbers (radians)");
-        mb.rest[i] = v[axis].get<float>();
+        if (!v.is_object() || !v.contains(axis) || !v[axis].is_number() ||
+            !finite_float(v[axis], mb.rest[i]))
+          return c.error(key, "expected {\"x\", \"y\", \"z\"} finite numbers (radians)");
       }
       mb.has_rest = true;
     }

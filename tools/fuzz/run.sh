@@ -13,21 +13,20 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Re
   -DAVATARMAP_BUILD_FUZZ=ON -DAVATARMAP_BUILD_TESTS=OFF -DAVATARMAP_BUILD_BENCH=OFF \
   -DAVATARMAP_BUILD_CLI=OFF -DAVATARMAP_BUILD_C_API=OFF -DAVATARMAP_BUILD_EXAMPLES=OFF \
   -DAVATARMAP_INSTALL=OFF >/dev/null
-cmake --build "$build" -j"$jobs" --target fuzz_landmark_reader fuzz_pose_reader fuzz_formula
+cmake --build "$build" -j"$jobs" --target fuzz_landmark_reader fuzz_pose_reader fuzz_formula \
+  fuzz_mapping
 
-for target in landmark pose; do
-  corpus="$build/corpus_$target"
+# fuzz TARGET CORPUS DICT MAX_LEN: runs one target on a copy of its checked-in seed corpus.
+fuzz() {
+  local corpus="$build/corpus_$1"
   mkdir -p "$corpus"
-  cp -n "$root/tools/fuzz/corpus/$target"/* "$corpus/" 2>/dev/null || true
-  echo "== fuzz_${target}_reader for ${seconds}s"
-  (cd "$build" && "./tools/fuzz/fuzz_${target}_reader" -max_total_time="$seconds" \
-     -max_len=65536 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
-     -dict="$root/tools/fuzz/jsonl.dict" "$corpus")
-done
+  cp -n "$root/tools/fuzz/corpus/$2"/* "$corpus/" 2>/dev/null || true
+  echo "== $1 for ${seconds}s"
+  (cd "$build" && "./tools/fuzz/$1" -max_total_time="$seconds" -max_len="$4" -timeout=10 \
+     -rss_limit_mb=2048 -print_final_stats=1 -dict="$root/tools/fuzz/$3" "$corpus")
+}
 
-corpus="$build/corpus_formula"
-mkdir -p "$corpus"
-cp -n "$root/tools/fuzz/corpus/formula"/* "$corpus/" 2>/dev/null || true
-echo "== fuzz_formula for ${seconds}s"
-(cd "$build" && ./tools/fuzz/fuzz_formula -max_total_time="$seconds" -max_len=512 -timeout=10 \
-   -rss_limit_mb=2048 -print_final_stats=1 -dict="$root/tools/fuzz/formula.dict" "$corpus")
+fuzz fuzz_landmark_reader landmarks jsonl.dict 65536
+fuzz fuzz_pose_reader pose jsonl.dict 65536
+fuzz fuzz_formula formula formula.dict 512
+fuzz fuzz_mapping mapping mapping.dict 8192

@@ -6,21 +6,28 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "avatarmap/avatarmap.h"
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/export/animated_glb.hpp"
+#include "avatarmap/export/bvh.hpp"
+#include "avatarmap/export/vrma.hpp"
 #include "avatarmap/io/landmark_file.hpp"
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/rig/rig.hpp"
+#include "avatarmap/rig/rig_binding.hpp"
 #include "avatarmap/skeleton/bone.hpp"
 #include "avatarmap/skeleton/expression.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
@@ -551,10 +558,101 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
 
 }  // extern "C"
 
+// ---- mapping tables ----------------------------------------------------------------------
+
+namespace {
+
+// The folder given to avm_set_mappings_folder(); function-local statics so that a call made
+// during another translation unit's static initialisation still finds them constructed.
+std::mutex& mappings_mutex() {
+  static std::mutex m;
+  return m;
+}
+std::string& mappings_folder_slot() {
+  static std::string folder;
+  return folder;
+}
+
+// $AVATARMAP_MAPPINGS when set and not empty, else the folder given to
+// avm_set_mappings_folder() ("" when none).
+std::string current_mappings_folder() {
+  if (const char* env = std::getenv("AVATARMAP_MAPPINGS"); env != nullptr && *env != '\0')
+    return env;
+  std::lock_guard<std::mutex> lock(mappings_mutex());
+  return mappings_folder_slot();
+}
+
+avm_status binding_status(am::rig_binding_failure f) {
+  switch (f) {
+    case am::rig_binding_failure::io:
+      return AVM_ERROR_IO;
+    case am::rig_binding_failure::unknown_name:
+      return AVM_ERROR_INVALID_ARGUMENT;
+    case am::rig_binding_failure::bad_table:
+    case am::rig_binding_failure::no_fit:
+      return AVM_ERROR_PARSE;
+    case am::rig_binding_failure::none:
+      break;
+  }
+  return AVM_ERROR_INTERNAL;
+}
+
+bool file_readable(const std::string& path) {
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) return false;
+  std::fclose(f);
+  return true;
+}
+
+// Loads the avatar at `avatar_path` into `out_rig` and binds it as `mapping` says (NULL =
+// "auto"). On failure returns the status and sets `msg` (naming the file).
+avm_status load_bound_avatar(const char* avatar_path, const char* mapping, am::rig& out_rig,
+                             am::rig_binding_choice& out_choice, std::string& msg) {
+  am::raw_rig raw;
+  am::status st = am::load_avatar(avatar_path, raw);
+  if (!st.ok()) {
+    msg = st.message();
+    return file_readable(avatar_path) ? AVM_ERROR_PARSE : AVM_ERROR_IO;
+  }
+  st = am::build_rig(raw, out_rig);
+  if (!st.ok()) {
+    msg = st.message();
+    return AVM_ERROR_PARSE;
+  }
+  const std::string option = mapping != nullptr ? mapping : "auto";
+  const std::string folder = current_mappings_folder();
+  st = am::select_binding(out_rig, option, folder, out_choice);
+  if (!st.ok()) {
+    msg = st.message();
+    if (out_choice.failure == am::rig_binding_failure::io && folder.empty())
+      msg = std::string(avatar_path) + ": mapping '" + option +
+            "' needs the mapping tables: no mappings folder is set (set AVATARMAP_MAPPINGS or "
+            "call avm_set_mappings_folder())";
+    return binding_status(out_choice.failure);
+  }
+  return AVM_OK;
+}
+
+}  // namespace
+
+AVATARMAP_C_API avm_status avm_set_mappings_folder(const char* folder) {
+  try {
+    std::string copy = folder != nullptr ? folder : "";
+    std::lock_guard<std::mutex> lock(mappings_mutex());
+    mappings_folder_slot().swap(copy);
+    return AVM_OK;
+  } catch (const std::bad_alloc&) {
+    return AVM_ERROR_OUT_OF_MEMORY;
+  } catch (...) {
+    return AVM_ERROR_INTERNAL;
+  }
+}
+
 // ---- retargeting ------------------------------------------------------------------------
 
 struct avm_retargeter {
   am::rig rig;
+  am::rig_binding_choice choice;  // how the joints were bound (description, table)
   am::retargeter retargeter;
   am::rig_pose pose;     // scratch: the applied pose
   am::proxy_pose proxy;  // scratch: the C pose converted
@@ -572,32 +670,23 @@ void set_error(const avm_retargeter* r, const char* msg) noexcept {
 }
 }  // namespace
 
-AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const char* mapping_path,
+AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const char* mapping,
                                                  avm_retargeter** out) {
   if (out != nullptr) *out = nullptr;
   if (avatar_path == nullptr || out == nullptr) {
-    set_create_error("avatar_path and out must not be NULL");
+    set_create_error("avm_retargeter_create: avatar_path and out must not be NULL");
     return AVM_ERROR_INVALID_ARGUMENT;
   }
   try {
-    if (mapping_path != nullptr) {
-      set_create_error(
-          "mapping tables are not supported by the C API yet: pass NULL to use the avatar's "
-          "own humanoid map (VRM)");
-      return AVM_ERROR_UNSUPPORTED;
-    }
     std::unique_ptr<avm_retargeter> r(new avm_retargeter());
-    am::raw_rig raw;
-    am::status st = am::load_avatar(avatar_path, raw);
-    if (!st.ok()) {
-      set_create_error(st.message().c_str());
-      FILE* f = std::fopen(avatar_path, "rb");
-      if (f == nullptr) return AVM_ERROR_IO;
-      std::fclose(f);
-      return AVM_ERROR_PARSE;
+    std::string msg;
+    const avm_status code = load_bound_avatar(avatar_path, mapping, r->rig, r->choice, msg);
+    if (code != AVM_OK) {
+      set_create_error(msg.c_str());
+      return code;
     }
-    st = am::build_rig(raw, r->rig);
-    if (st.ok()) st = r->retargeter.build(r->rig, r->rig.declared_humanoid);
+    am::status st = r->retargeter.build(r->rig, r->choice.binding, am::retarget_options{},
+                                        r->choice.table_or_null());
     if (!st.ok()) {
       set_create_error(st.message().c_str());
       return AVM_ERROR_PARSE;
@@ -607,13 +696,13 @@ AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const 
     *out = r.release();
     return AVM_OK;
   } catch (const std::bad_alloc&) {
-    set_create_error("out of memory");
+    set_create_error("avm_retargeter_create: out of memory");
     return AVM_ERROR_OUT_OF_MEMORY;
   } catch (const std::exception& e) {
     set_create_error(e.what());
     return AVM_ERROR_INTERNAL;
   } catch (...) {
-    set_create_error("unknown internal error");
+    set_create_error("avm_retargeter_create: unknown internal error");
     return AVM_ERROR_INTERNAL;
   }
 }
@@ -637,6 +726,10 @@ AVATARMAP_C_API int avm_retargeter_joint_parent(const avm_retargeter* retargeter
 AVATARMAP_C_API int avm_retargeter_bone_joint(const avm_retargeter* retargeter, int bone) {
   if (retargeter == nullptr || bone < 0 || bone >= am::k_bone_count) return -1;
   return retargeter->retargeter.binding()[static_cast<std::size_t>(bone)];
+}
+
+AVATARMAP_C_API const char* avm_retargeter_binding_description(const avm_retargeter* retargeter) {
+  return retargeter == nullptr ? "" : retargeter->choice.description.c_str();
 }
 
 AVATARMAP_C_API avm_status avm_retargeter_apply(avm_retargeter* retargeter, const avm_pose* pose,
@@ -677,4 +770,309 @@ AVATARMAP_C_API avm_status avm_retargeter_apply(avm_retargeter* retargeter, cons
 
 AVATARMAP_C_API const char* avm_retargeter_last_error(const avm_retargeter* retargeter) {
   return retargeter == nullptr ? "" : retargeter->last_error.c_str();
+}
+
+// ---- clips ------------------------------------------------------------------------------
+
+struct avm_clip {
+  std::vector<am::proxy_pose> frames;
+  mutable std::string last_error;
+};
+
+namespace {
+
+void set_error(const avm_clip* c, const char* msg) noexcept {
+  if (c == nullptr) return;
+  try {
+    c->last_error.assign(msg);
+  } catch (...) {
+    c->last_error.clear();
+  }
+}
+
+float clamp01(float v) { return v < 0.f ? 0.f : (v > 1.f ? 1.f : v); }
+
+// The C pose as a proxy pose, non-finite values taken as missing (see avm_clip_add).
+void sanitized_pose(const avm_pose& in, const am::proxy_pose* prev, am::proxy_pose& out) {
+  out.set_rest();
+  out.t = in.t;
+  for (int i = 0; i < 3; ++i) {
+    const float v = in.hips_position[i];
+    out.hips_position[i] =
+        std::isfinite(v) ? v : (prev != nullptr ? prev->hips_position[i] : out.hips_position[i]);
+  }
+  for (int b = 0; b < am::k_bone_count; ++b) {
+    const auto bi = static_cast<std::size_t>(b);
+    const glm::quat q = am::load_xyzw(in.rotations[b]);
+    const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+    const bool good = std::isfinite(n2) && n2 > 1e-12f;
+    if (good) {
+      out.rotations[bi] = q * (1.f / std::sqrt(n2));
+      const float c = in.confidence[b];
+      out.confidence[bi] = std::isfinite(c) ? clamp01(c) : 0.f;
+    } else {
+      out.rotations[bi] = prev != nullptr ? prev->rotations[bi] : am::identity_quat();
+      out.confidence[bi] = 0.f;
+    }
+  }
+  for (int e = 0; e < am::k_expression_count; ++e) {
+    const auto ei = static_cast<std::size_t>(e);
+    const float w = in.expressions[e];
+    out.expressions[ei] =
+        std::isfinite(w) ? clamp01(w) : (prev != nullptr ? prev->expressions[ei] : 0.f);
+  }
+}
+
+// Frames at a fixed rate from the first frame's time, slerped between the given frames;
+// times start at 0 (as the CLI's `convert` does).
+std::vector<am::proxy_pose> resample(const std::vector<am::proxy_pose>& in, double fps) {
+  std::vector<am::proxy_pose> out;
+  if (in.empty()) return out;
+  am::pose_resampler resampler;
+  const double t0 = in.front().t, t1 = in.back().t;
+  std::size_t next = 0;
+  am::proxy_pose p;
+  for (long k = 0;; ++k) {
+    const double t = t0 + static_cast<double>(k) / fps;
+    if (t > t1 + 1e-4) break;  // tolerate times that went through float
+    while (next < in.size() && in[next].t <= t + 1e-9) resampler.push(in[next++]);
+    if (next < in.size()) resampler.push(in[next]);  // the frame after t, to interpolate to
+    if (!resampler.sample(t, p)) break;
+    p.t = t - t0;
+    out.push_back(p);
+  }
+  return out;
+}
+
+bool ends_with_nocase(const std::string& s, const char* suffix) {
+  const std::size_t n = std::strlen(suffix);
+  if (s.size() < n) return false;
+  for (std::size_t i = 0; i < n; ++i) {
+    char c = s[s.size() - n + i];
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+    if (c != suffix[i]) return false;
+  }
+  return true;
+}
+
+// "PATH: message" unless the message already names PATH.
+std::string naming(const std::string& path, const std::string& msg) {
+  return msg.find(path) != std::string::npos ? msg : path + ": " + msg;
+}
+
+constexpr double k_default_rig_fps = 30.0;
+constexpr double k_max_fps = 1000.0;
+
+// An avatar with a clip retargeted onto it (large: kept on the heap).
+struct avatar_motion {
+  am::rig rig;
+  am::rig_binding_choice choice;
+  am::retargeter retargeter;
+  std::vector<am::rig_pose> poses;
+};
+
+// Loads and binds the avatar, resamples `frames` at `fps` and retargets them into out.poses
+// (the performer's standing hips height: a high percentile of the clip's hips heights, as the
+// CLI's `convert` takes it). On failure returns the status and sets `msg`.
+avm_status retarget_clip(const std::vector<am::proxy_pose>& frames, double fps,
+                         const char* avatar_path, const char* mapping, avatar_motion& out,
+                         std::string& msg) {
+  const avm_status code = load_bound_avatar(avatar_path, mapping, out.rig, out.choice, msg);
+  if (code != AVM_OK) return code;
+  const std::vector<am::proxy_pose> sampled = resample(frames, fps);
+  if (sampled.empty()) {
+    msg = "avm_clip_write: resampling gave no frames";
+    return AVM_ERROR_INTERNAL;
+  }
+  std::vector<float> heights;
+  heights.reserve(sampled.size());
+  for (const am::proxy_pose& p : sampled) heights.push_back(p.hips_position.y);
+  std::sort(heights.begin(), heights.end());
+  am::retarget_options ro;
+  const float h = heights[heights.size() * 9 / 10];
+  if (std::isfinite(h) && h > 0.f) ro.performer_hips_height = h;
+  am::status st = out.retargeter.build(out.rig, out.choice.binding, ro, out.choice.table_or_null());
+  if (!st.ok()) {
+    msg = naming(avatar_path, st.message());
+    return AVM_ERROR_PARSE;
+  }
+  out.poses.resize(sampled.size());
+  for (std::size_t i = 0; i < sampled.size(); ++i) {
+    out.retargeter.prepare(out.poses[i]);
+    out.retargeter.apply(sampled[i], out.poses[i]);
+  }
+  return AVM_OK;
+}
+
+avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::string& path,
+                      double fps, const char* avatar_path, const char* mapping, std::string& msg) {
+  enum class format { vrma, bvh, pose, glb } fmt;
+  if (ends_with_nocase(path, ".pose.jsonl")) {
+    fmt = format::pose;
+  } else if (ends_with_nocase(path, ".vrma")) {
+    fmt = format::vrma;
+  } else if (ends_with_nocase(path, ".bvh")) {
+    fmt = format::bvh;
+  } else if (ends_with_nocase(path, ".glb")) {
+    fmt = format::glb;
+  } else {
+    msg = path + ": unknown output format (the name must end in .vrma, .bvh, .glb or .pose.jsonl)";
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  if (!(std::isfinite(fps) && fps >= 0.0 && fps <= k_max_fps)) {
+    msg = path + ": fps must be 0 (the frames' own times) or in (0, 1000], got " +
+          std::to_string(fps);
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  if (frames.empty()) {
+    msg = path + ": the clip has no frames (add some with avm_clip_add())";
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  if (fmt == format::glb && avatar_path == nullptr) {
+    msg = path + ": .glb output needs avatar_path (the avatar to animate)";
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+
+  am::status st;
+  switch (fmt) {
+    case format::vrma: {
+      am::vrma_write_options o;
+      st = fps > 0.0 ? am::write_vrma(path, resample(frames, fps), o)
+                     : am::write_vrma(path, frames, o);
+      break;
+    }
+    case format::bvh: {
+      if (avatar_path != nullptr) {
+        am::rig_bvh_options o;
+        o.fps = fps > 0.0 ? fps : k_default_rig_fps;
+        auto a = std::make_unique<avatar_motion>();
+        const avm_status code = retarget_clip(frames, o.fps, avatar_path, mapping, *a, msg);
+        if (code != AVM_OK) return code;
+        st = am::write_rig_bvh(path, a->rig, a->poses, o);
+        break;
+      }
+      am::bvh_write_options o;
+      o.fps = fps;
+      st = fps > 0.0 ? am::write_bvh(path, resample(frames, fps), o)
+                     : am::write_bvh(path, frames, o);
+      break;
+    }
+    case format::pose: {
+      am::pose_writer w;
+      am::pose_file_header h;
+      h.present = true;
+      h.fps = fps;
+      const std::vector<am::proxy_pose> resampled =
+          fps > 0.0 ? resample(frames, fps) : std::vector<am::proxy_pose>();
+      const std::vector<am::proxy_pose>& out = fps > 0.0 ? resampled : frames;
+      st = w.open(path, h);
+      for (std::size_t i = 0; st.ok() && i < out.size(); ++i) st = w.write(out[i]);
+      if (st.ok()) st = w.commit();
+      break;
+    }
+    case format::glb: {
+      am::animated_glb_options o;
+      o.fps = fps > 0.0 ? fps : k_default_rig_fps;
+      auto a = std::make_unique<avatar_motion>();
+      const avm_status code = retarget_clip(frames, o.fps, avatar_path, mapping, *a, msg);
+      if (code != AVM_OK) return code;
+      st = am::write_animated_glb(avatar_path, a->rig, a->poses, o, path);
+      break;
+    }
+  }
+  if (!st.ok()) {
+    msg = naming(path, st.message());
+    return AVM_ERROR_IO;
+  }
+  return AVM_OK;
+}
+
+}  // namespace
+
+AVATARMAP_C_API avm_status avm_clip_create(avm_clip** out) {
+  set_create_error("");
+  if (out == nullptr) {
+    set_create_error("avm_clip_create: out is NULL");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  *out = nullptr;
+  try {
+    *out = new avm_clip();
+    return AVM_OK;
+  } catch (const std::bad_alloc&) {
+    set_create_error("avm_clip_create: out of memory");
+    return AVM_ERROR_OUT_OF_MEMORY;
+  } catch (...) {
+    set_create_error("avm_clip_create: unknown internal error");
+    return AVM_ERROR_INTERNAL;
+  }
+}
+
+AVATARMAP_C_API void avm_clip_destroy(avm_clip* clip) { delete clip; }
+
+AVATARMAP_C_API avm_status avm_clip_add(avm_clip* clip, const avm_pose* pose) {
+  if (clip == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  clip->last_error.clear();
+  if (pose == nullptr) {
+    set_error(clip, "avm_clip_add: pose is NULL");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  if (!std::isfinite(pose->t)) {
+    set_error(clip, "avm_clip_add: pose->t must be finite");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  try {
+    const am::proxy_pose* prev = clip->frames.empty() ? nullptr : &clip->frames.back();
+    if (prev != nullptr && !(pose->t > prev->t)) {
+      const std::string msg = "avm_clip_add: pose->t (" + std::to_string(pose->t) +
+                              ") must be after the previous frame's (" + std::to_string(prev->t) +
+                              ")";
+      set_error(clip, msg.c_str());
+      return AVM_ERROR_INVALID_ARGUMENT;
+    }
+    am::proxy_pose p;
+    sanitized_pose(*pose, prev, p);
+    clip->frames.push_back(p);  // may reallocate: `prev` is not used after this
+    return AVM_OK;
+  } catch (const std::bad_alloc&) {
+    set_error(clip, "avm_clip_add: out of memory");
+    return AVM_ERROR_OUT_OF_MEMORY;
+  } catch (...) {
+    set_error(clip, "avm_clip_add: unknown internal error");
+    return AVM_ERROR_INTERNAL;
+  }
+}
+
+AVATARMAP_C_API int avm_clip_frame_count(const avm_clip* clip) {
+  return clip == nullptr ? 0 : static_cast<int>(clip->frames.size());
+}
+
+AVATARMAP_C_API avm_status avm_clip_write(avm_clip* clip, const char* path, double fps,
+                                          const char* avatar_path, const char* mapping, char* err,
+                                          size_t err_size) {
+  copy_message(err, err_size, "");
+  if (clip != nullptr) clip->last_error.clear();
+  auto report = [&](avm_status code, const char* msg) {
+    copy_message(err, err_size, msg);
+    set_error(clip, msg);
+    return code;
+  };
+  if (clip == nullptr || path == nullptr)
+    return report(AVM_ERROR_INVALID_ARGUMENT, "avm_clip_write: clip and path must not be NULL");
+  try {
+    std::string msg;
+    const avm_status code = write_clip(clip->frames, path, fps, avatar_path, mapping, msg);
+    if (code != AVM_OK) return report(code, msg.c_str());
+    return AVM_OK;
+  } catch (const std::bad_alloc&) {
+    return report(AVM_ERROR_OUT_OF_MEMORY, "avm_clip_write: out of memory");
+  } catch (const std::exception& e) {
+    return report(AVM_ERROR_INTERNAL, e.what());
+  } catch (...) {
+    return report(AVM_ERROR_INTERNAL, "avm_clip_write: unknown internal error");
+  }
+}
+
+AVATARMAP_C_API const char* avm_clip_last_error(const avm_clip* clip) {
+  return clip == nullptr ? "" : clip->last_error.c_str();
 }

@@ -1,4 +1,5 @@
-// Biovision Hierarchy (.bvh): writing proxy poses on the synthetic skeleton, and a minimal
+// Biovision Hierarchy (.bvh): writing proxy poses on the synthetic skeleton or retargeted poses
+// on an avatar's own rig, and a minimal
 // reader (hierarchy + motion values) for round trips and for checking third-party clips.
 // Conventions: docs/export.md.
 #pragma once
@@ -10,6 +11,8 @@
 #include <vector>
 
 #include "avatarmap/core/status.hpp"
+#include "avatarmap/rig/retarget.hpp"
+#include "avatarmap/rig/rig.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "avatarmap/synth/synth_skeleton.hpp"
 
@@ -48,6 +51,45 @@ struct bvh_write_options {
 /// fps is negative or not finite, height is not positive, or the file cannot be written.
 status write_bvh(const std::string& path, const std::vector<proxy_pose>& frames,
                  const bvh_write_options& options = {});
+
+struct rig_bvh_options {
+  /// Frames are taken as sampled at this rate from t = 0 (Frame Time = 1 / fps); > 0.
+  double fps = 30.0;
+  /// Length unit of OFFSETs and root positions (the rig's world units are taken as metres,
+  /// as glTF's are: a centimetre rig under a 0.01 scale node is metres in world space).
+  bvh_units units = bvh_units::centimetres;
+};
+
+/// Writes retargeted poses of `r` (rig_pose, as retargeter::apply makes them) as a BVH file at
+/// `path`, with the rig's own joints, names and proportions.
+///
+/// HIERARCHY: the subtree of the hips joint (frames[0].hips_joint), rig order (parents
+/// first). Joints that are not the hips or below it (the armature root, meshes, a Mixamo
+/// scale node) are dropped; their transforms are folded into the root: ROOT = the hips with
+/// OFFSET 0 0 0 (as write_bvh: readers that add the root OFFSET to the position channels and
+/// readers that do not then agree) and position channels = its posed world position.
+/// BVH cannot store rest rotations, so the written rest pose has every joint frame aligned
+/// with the world axes: a joint's OFFSET is its world rest position minus its parent's
+/// (world axes, every ancestor's scale applied, in `units`), and its channels carry
+///   R_bvh = D_parent⁻¹ · D_joint,  D = rotation of W_posed · W_rest⁻¹
+/// (D: the joint's world rotation away from rest; the root's R_bvh is its D). Then the BVH's
+/// forward kinematics reproduces every joint's world position exactly (up to printing); the
+/// bones' own axes and rest rotations are lost, as in any BVH. Names: whitespace becomes '_',
+/// an empty name "joint<i>", a repeated name gets "_<i>" appended (i = rig joint index).
+/// Channels: ROOT Xposition Yposition Zposition Zrotation Xrotation Yrotation, JOINTs
+/// Zrotation Xrotation Yrotation (R = Rz · Rx · Ry, euler_order::zxy), degrees with 6
+/// decimals. Leaves get an End Site continuing their bone: half their OFFSET (a zero-length
+/// leaf gets a zero End Site). World axes are the rig's (glTF: Y up).
+///
+/// Exact for rigs whose scales are uniform (any value, e.g. 0.01); a non-uniform scale on a
+/// moving joint's ancestors makes D non-orthogonal and its rotation part is used. Non-finite
+/// rotations or hips translation are replaced by the previous frame's (rest for the first).
+/// The file is written to a temporary file beside `path`, then renamed over it.
+/// Fails when `frames` is empty, a frame's hips_joint is out of range or differs from the
+/// first's, a frame's local_rotations do not hold one rotation per joint, fps is not positive
+/// and finite, or the file cannot be written. Never throws.
+status write_rig_bvh(const std::string& path, const rig& r, const std::vector<rig_pose>& frames,
+                     const rig_bvh_options& options = {});
 
 enum class bvh_channel : std::uint8_t {
   x_position,

@@ -7,8 +7,9 @@
  *   - Every function returns an avm_status, a plain value or nothing; no function throws,
  *     aborts or calls exit(). A NULL pointer where an object is required gives
  *     AVM_ERROR_INVALID_ARGUMENT, never a crash.
- *   - Handles are typed and opaque (avm_solver). A handle is created by avm_solver_create(),
- *     owned by the caller and freed by avm_solver_destroy(); destroying NULL does nothing.
+ *   - Handles are typed and opaque (avm_solver, avm_retargeter, avm_clip). A handle is
+ *     created by its *_create() function, owned by the caller and freed by its *_destroy();
+ *     destroying NULL does nothing.
  *   - The library never hands out memory the caller must free. Strings it returns are either
  *     static (valid for the life of the process) or owned by a handle (valid until the next
  *     call on that handle or its destruction) as stated on each function.
@@ -362,6 +363,29 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
                                           const avm_solver_options* options, char* err,
                                           size_t err_size);
 
+/* ---- mapping tables ------------------------------------------------------------------ */
+
+/* Rigs that declare no humanoid map (plain glTF/GLB: Mixamo, Unity, Unreal, Character
+ * Creator, ...) are bound by mapping tables (docs/mappings.md): JSON files that list each
+ * family's joint names. Wherever a function takes a `mapping` argument it means:
+ *   NULL or "auto"  the humanoid map the avatar declares (VRM 0.x / 1.0), else the
+ *                   best-matching table of the mappings folder (below);
+ *   "NAME"          the table of the mappings folder whose "name" is NAME ("mixamo",
+ *                   "unity_humanoid", "ue5_mannequin", "vrm1", ...);
+ *   "PATH.json"     the table in that file (any name ending in ".json"); its per-bone
+ *                   formulas, if any, apply.
+ * The mappings folder is $AVATARMAP_MAPPINGS when that is set and not empty, else the folder
+ * given to avm_set_mappings_folder(); it is read (all of its *.json but schema.json) by each
+ * call that needs a table of it. The installed tables are in share/avatarmap/mappings. */
+
+/* Sets the process-wide mappings folder used when $AVATARMAP_MAPPINGS is unset or empty.
+ * The string is copied; NULL or "" forgets the folder. Calls that start afterwards use the
+ * new folder; calls already running keep the one they read.
+ * Failures: AVM_ERROR_OUT_OF_MEMORY (the previous folder is kept). The folder is not checked
+ * here: a missing folder is reported by the call that needs it.
+ * Thread-safe (may be called at any time from any thread). */
+AVATARMAP_C_API avm_status avm_set_mappings_folder(const char* folder);
+
 /* ---- retargeting onto an avatar ------------------------------------------------------ */
 
 /* A rig loaded from an avatar file (glTF/GLB, VRM 0.x, VRM 1.0) with its proxy-bone binding,
@@ -369,17 +393,25 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
  * Typed opaque handle; one thread at a time per handle; different handles are independent. */
 typedef struct avm_retargeter avm_retargeter;
 
-/* Loads `avatar_path` and binds its joints to the proxy bones. `mapping_path` NULL uses the
- * humanoid map the file declares (VRM); rigs without one need a mapping table (coming with
- * the mapping tables: until then AVM_ERROR_UNSUPPORTED). On failure *out is NULL and
- * avm_last_create_error() (thread-local, valid until the next create on this thread) says why.
- * Failures: AVM_ERROR_INVALID_ARGUMENT (NULL arguments), AVM_ERROR_IO (cannot read),
- *   AVM_ERROR_PARSE (not a valid avatar; no hips bound), AVM_ERROR_UNSUPPORTED,
- *   AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL. */
-AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const char* mapping_path,
+/* Loads `avatar_path` and binds its joints to the proxy bones as `mapping` says (see "mapping
+ * tables" above; NULL = "auto"). Both strings are only read during the call. On success *out
+ * is a new handle owned by the caller (free it with avm_retargeter_destroy()). On failure
+ * *out is NULL (when out is not NULL) and avm_last_create_error() (thread-local, valid until
+ * the next create on this thread) says why, naming the file (avatar or table) and, when a
+ * table does not fit, the required bones the rig lacks.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (avatar_path or out NULL; `mapping` names no table of
+ *     the mappings folder: the message lists the names),
+ *   AVM_ERROR_IO (the avatar, the .json table or the mappings folder cannot be read, or no
+ *     mappings folder is set when one is needed),
+ *   AVM_ERROR_PARSE (not a valid avatar; a malformed table; the table, or with "auto" every
+ *     table, lacks bones the rig needs; no hips bound),
+ *   AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL.
+ * Thread-safe (reads files only). */
+AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const char* mapping,
                                                  avm_retargeter** out);
 
-/* Destroys a retargeter; NULL is a no-op. */
+/* Destroys a retargeter and the strings it owns; NULL is a no-op. The handle must not be in
+ * use by another thread. */
 AVATARMAP_C_API void avm_retargeter_destroy(avm_retargeter* retargeter);
 
 /* Number of joints of the rig (0 when retargeter is NULL). Joints are in parent-first order. */
@@ -395,15 +427,92 @@ AVATARMAP_C_API int avm_retargeter_joint_parent(const avm_retargeter* retargeter
 /* Joint driven by proxy bone `bone` (an avm_bone), or -1 when the rig has none. */
 AVATARMAP_C_API int avm_retargeter_bone_joint(const avm_retargeter* retargeter, int bone);
 
+/* How the joints were bound, for the user: e.g. "VRM 1.0 humanoid declared by the file (53
+ * bones)", "detected mixamo: matched 52/52 bones (prefix 'mixamorig:')" or "table NAME
+ * (PATH.json): matched ...". Owned by the handle, valid for its lifetime; "" when retargeter
+ * is NULL. Cannot fail; may be called from several threads at once. */
+AVATARMAP_C_API const char* avm_retargeter_binding_description(const avm_retargeter* retargeter);
+
 /* Applies `pose` and writes every joint's local rotation {x, y, z, w} to out_rotations
  * (4 * joint_count floats, caller-owned) and the hips joint's local translation (in its
  * parent's units) to out_hips_translation (3 floats; may be NULL). Allocation-free.
+ * Non-finite (or zero) rotations are taken as identity, non-finite positions as 0.
  * Failures: AVM_ERROR_INVALID_ARGUMENT (NULL arguments), AVM_ERROR_INTERNAL. */
 AVATARMAP_C_API avm_status avm_retargeter_apply(avm_retargeter* retargeter, const avm_pose* pose,
                                                 float* out_rotations, float* out_hips_translation);
 
 /* Message of the last failed call on `retargeter` ("" when none), owned by the handle. */
 AVATARMAP_C_API const char* avm_retargeter_last_error(const avm_retargeter* retargeter);
+
+/* ---- clips: writing animation files -------------------------------------------------- */
+
+/* A clip: proxy poses collected in time order (e.g. from avm_solver_sample() at a fixed
+ * rate) and written as an animation file. Typed opaque handle (about 1.2 kB per frame); one
+ * thread at a time per handle; different handles are independent. */
+typedef struct avm_clip avm_clip;
+
+/* Creates an empty clip. On success *out is a new handle owned by the caller (free it with
+ * avm_clip_destroy()); on failure *out is NULL (when out is not NULL) and
+ * avm_last_create_error() says why.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (out NULL), AVM_ERROR_OUT_OF_MEMORY. Thread-safe. */
+AVATARMAP_C_API avm_status avm_clip_create(avm_clip** out);
+
+/* Frees a clip and its frames; NULL does nothing. The handle must not be in use by another
+ * thread. */
+AVATARMAP_C_API void avm_clip_destroy(avm_clip* clip);
+
+/* Appends a copy of `pose` (only read during the call). pose->t must be finite and greater
+ * than the previous frame's. Non-finite values are taken as missing: a rotation with a
+ * non-finite component (or of zero length) becomes the previous frame's (identity for the
+ * first frame) with confidence 0, a non-finite hips position the previous one (0, 0.95, 0 for
+ * the first), a non-finite expression weight the previous one (0); rotations are normalised,
+ * weights and confidences clamped to [0, 1].
+ * Failures (the clip is unchanged): AVM_ERROR_INVALID_ARGUMENT (clip or pose NULL, t not
+ *   finite or not after the previous frame's), AVM_ERROR_OUT_OF_MEMORY.
+ *   avm_clip_last_error() says which. */
+AVATARMAP_C_API avm_status avm_clip_add(avm_clip* clip, const avm_pose* pose);
+
+/* Number of frames added so far (0 when clip is NULL). */
+AVATARMAP_C_API int avm_clip_frame_count(const avm_clip* clip);
+
+/* Writes the clip to `path`, the format chosen by its extension (case-insensitive):
+ *   .vrma        VRM Animation 1.0 (a GLB) on the VRM humanoid; avatar_path is ignored;
+ *   .bvh         BVH, centimetres, ZXY: with avatar_path NULL, of the proxy skeleton (55 VRM
+ *                bones); else of the avatar's own rig (its joints, names and proportions;
+ *                the hips' subtree), the clip retargeted onto it as for .glb;
+ *   .pose.jsonl  avatarmap proxy poses (REFERENCE §3); avatar_path is ignored;
+ *   .glb         the avatar at avatar_path (required; .vrm, .glb or .gltf) with the clip as a
+ *                glTF animation of its joints, bound as `mapping` says (see "mapping tables";
+ *                NULL = "auto"); meshes, materials and extensions are kept.
+ * `fps` > 0 (at most 1000) resamples the clip at that rate from its first frame (slerp on the
+ * shortest arc, linear for positions and weights); 0 keeps the frames' own times (.vrma keys
+ * at those times, the proxy .bvh plays them at their mean spacing, .pose.jsonl writes them as
+ * they are), except with an avatar (.glb, .bvh of the rig), which needs a fixed rate and is
+ * resampled at 30 fps. Times are written from 0 (the first frame's t is subtracted), except
+ * in .pose.jsonl at fps 0.
+ * The file is written atomically (a temporary file beside `path` renamed over it), so on
+ * failure an existing file at `path` is untouched. The clip is not changed: it may be written
+ * again, e.g. in another format.
+ * When `err` is not NULL and err_size > 0, a NUL-terminated message (truncated to fit) is
+ * written there: "" on success, else what failed, naming the file; avm_clip_last_error() gives
+ * the same message.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (clip or path NULL, the clip has no frames, fps
+ *     negative, above 1000 or not finite, an unknown extension, .glb without avatar_path,
+ *     `mapping` names no table),
+ *   AVM_ERROR_IO (cannot write `path`; the avatar, table or mappings folder cannot be read,
+ *     or no mappings folder is set when one is needed),
+ *   AVM_ERROR_PARSE (the avatar or a table is malformed, or does not fit the avatar; no hips
+ *     bound),
+ *   AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL.
+ * One thread at a time per clip; writing different files from different clips at once is
+ * safe. */
+AVATARMAP_C_API avm_status avm_clip_write(avm_clip* clip, const char* path, double fps,
+                                          const char* avatar_path, const char* mapping, char* err,
+                                          size_t err_size);
+
+/* Message of the last failed call on `clip` ("" after a successful call, or when clip is
+ * NULL). Owned by the clip, valid until the next call on it or its destruction. */
+AVATARMAP_C_API const char* avm_clip_last_error(const avm_clip* clip);
 
 #ifdef __cplusplus
 } /* extern "C" */
