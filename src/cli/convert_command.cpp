@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,9 @@ const char* k_convert_help =
     "                        unity_humanoid, ue4_mannequin, ue5_mannequin, character_creator,\n"
     "                        ...); NAME picks a shipped table; FILE.json a table of yours\n"
     "  --fps N               output frame rate (default 30; .pose.jsonl: the input's frames)\n"
+    "  --bind BONE=JOINT     bind a proxy bone (VRM 1.0 name) to an avatar joint, or to\n"
+    "                        none; repeatable; overrides --rig, and alone drives a rig no\n"
+    "                        table fits\n"
     "  --ground              keep the avatar's lowest foot on the floor every frame\n"
     "  --no-root-motion      keep the hips where they are at rest\n"
     "  --mirror, --image-size WxH, --filter euro|landmarks|both|none\n"
@@ -80,7 +84,7 @@ status load_motion(const std::string& in, const solve_job& solve, std::vector<pr
   if (ends_with(in, ".jsonl") || in == "-") {
     solve_job job = solve;
     job.input = in;
-    job.progress = progress_mode::off;
+    job.progress = progress_mode::automatic;  // a progress line on a terminal
     job.sink = [&](const proxy_pose& p) {
       out.push_back(p);
       return status{};
@@ -202,6 +206,8 @@ int run_convert(int argc, char** argv) {
   a.value("--output", out_path, "-o");
   a.value("--avatar", avatar);
   a.value("--rig", rig_option);
+  std::vector<std::string> binds;  // --bind BONE=JOINT, repeatable
+  while (a.value("--bind", value)) binds.push_back(value);
   std::string dump_path;  // hidden diagnostic option, see dump_positions()
   a.value("--dump-positions", dump_path);
   double fps = 0.0;
@@ -261,11 +267,46 @@ int run_convert(int argc, char** argv) {
   if (!avatar.empty()) {
     status st = load_avatar(avatar, raw);
     if (st.ok()) st = build_rig(raw, r);
-    if (st.ok()) st = select_rig_binding(r, rig_option, selection);
+    if (st.ok()) {
+      st = select_rig_binding(r, rig_option, selection);
+      // A rig no table fits can still be driven by explicit --bind options alone.
+      if (!st.ok() && !binds.empty() && rig_option == "auto") {
+        selection.table = nullptr;
+        selection.binding.fill(-1);
+        selection.description = "bound by --bind only (no table fits)";
+        st = status{};
+      }
+    }
     if (!st.ok()) {
       std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
       return 1;
     }
+    for (const std::string& b : binds) {
+      const size_t eq = b.find('=');
+      const auto bone_id = eq == std::string::npos ? std::nullopt : bone_from_name(b.substr(0, eq));
+      if (!bone_id) {
+        std::fprintf(stderr,
+                     "avatarmap convert: --bind wants BONE=JOINT with a VRM 1.0 bone name "
+                     "(hips, leftUpperArm, ...), got '%s'\n",
+                     b.c_str());
+        return 2;
+      }
+      const std::string joint_name = b.substr(eq + 1);
+      const int joint = joint_name == "none" ? -1 : r.find(joint_name);
+      if (joint_name != "none" && joint < 0) {
+        std::fprintf(stderr,
+                     "avatarmap convert: --bind %s: the avatar has no joint '%s' (see `avatarmap "
+                     "inspect %s`)\n",
+                     b.c_str(), joint_name.c_str(), avatar.c_str());
+        return 1;
+      }
+      // A joint drives one bone: taking it from another bone unbinds that one.
+      for (int& j : selection.binding)
+        if (joint >= 0 && j == joint) j = -1;
+      selection.binding[idx(*bone_id)] = joint;
+    }
+    if (!binds.empty())
+      selection.description += "; " + std::to_string(binds.size()) + " binding(s) from --bind";
   }
 
   std::vector<proxy_pose> frames;

@@ -164,7 +164,7 @@ status check_duplicates(const context& c, const std::string& bones_key, const ma
 
 status parse_bone(const context& c, const std::string& key, const json& v, mapping_bone& out) {
   if (!v.is_object()) return c.error(key, "expected an object {\"rig\": ...}");
-  if (status s = check_keys(c, key, v, {"rig", "order", "f", "rest"}); !s) return s;
+  if (status s = check_keys(c, key, v, {"rig", "order", "target_order", "f", "rest"}); !s) return s;
   auto rig_it = v.find("rig");
   if (rig_it == v.end()) return c.error(key, "missing \"rig\" (the rig joint name)");
   if (rig_it->is_string()) {
@@ -179,6 +179,9 @@ status parse_bone(const context& c, const std::string& key, const json& v, mappi
   }
   if (auto it = v.find("order"); it != v.end())
     if (status s = parse_order(c, key + ".order", *it, out.order); !s) return s;
+  out.target_order = out.order;
+  if (auto it = v.find("target_order"); it != v.end())
+    if (status s = parse_order(c, key + ".target_order", *it, out.target_order); !s) return s;
   if (auto it = v.find("f"); it != v.end()) {
     if (!it->is_array() || it->size() != 3)
       return c.error(key + ".f", "expected three formulas [fx, fy, fz]");
@@ -645,6 +648,8 @@ std::string mapping_to_json(const mapping_table& t) {
       e["rig"] = mb.rig_names;
     if (mb.has_formulas || mb.order != euler_order::xyz)
       e["order"] = std::string(euler_order_name(mb.order));
+    if (mb.target_order != mb.order)
+      e["target_order"] = std::string(euler_order_name(mb.target_order));
     if (mb.has_formulas) e["f"] = {mb.f_text[0], mb.f_text[1], mb.f_text[2]};
     if (mb.has_rest) e["rest"] = {mb.rest.x, mb.rest.y, mb.rest.z};
     bones[std::string(bone_name(static_cast<bone>(b)))] = e;

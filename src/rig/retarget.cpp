@@ -142,8 +142,13 @@ status retargeter::build(const rig& r, const bone_binding& binding, const retarg
       const mapping_bone& mb = table->bones[b];
       const int j = binding[b];
       if (j < 0 || !mb.has_formulas) continue;
-      formula_bone fb{j, b, mb.order, mb.f,
-                      mb.has_rest ? mb.rest : euler_from_quat(r.rest_local[j].rotation, mb.order)};
+      formula_bone fb{
+          j,
+          b,
+          mb.order,
+          mb.target_order,
+          mb.f,
+          mb.has_rest ? mb.rest : euler_from_quat(r.rest_local[j].rotation, mb.target_order)};
       formula_of_joint_[j] = static_cast<int>(formula_bones_.size());
       formula_bones_.push_back(fb);
     }
@@ -178,7 +183,7 @@ void retargeter::apply(const proxy_pose& pose, rig_pose& out) const {
                           fb.rest.y + fb.f[1].eval(e.x, e.y, e.z),
                           fb.rest.z + fb.f[2].eval(e.x, e.y, e.z));
       out.local_rotations[j] =
-          is_finite(sum) ? quat_from_euler(sum, fb.order) : r.rest_local[j].rotation;
+          is_finite(sum) ? quat_from_euler(sum, fb.target_order) : r.rest_local[j].rotation;
       world_[j] = parent_world * out.local_rotations[j];
     } else if (b >= 0) {
       // Unit quaternions stay unit through these products to float precision; the one

@@ -171,6 +171,15 @@ case $case_name in
       run 0 convert in.landmarks.jsonl -o robot.bvh --avatar "$AVATARMAP_TEST_DATA/avatars/vrm1_debug_robot.vrm"
       expect_in robot.bvh "HIERARCHY"
       expect_in robot.bvh "Frames: 60"
+      # A rig no table fits, driven by --bind alone; bad --bind values.
+      fig="$AVATARMAP_TEST_DATA/avatars/gltf_rigged_figure.glb"
+      run 0 convert in.landmarks.jsonl -o figure.glb --avatar "$fig" --bind hips=torso_joint_1 \
+        --bind spine=torso_joint_2 --bind leftUpperArm=arm_joint_L_1 --bind leftLowerArm=arm_joint_L_2
+      expect_in err.txt "4 binding(s) from --bind"
+      run 1 convert in.landmarks.jsonl -o f2.glb --avatar "$fig" --bind hips=nope
+      expect_in err.txt "no joint 'nope'"
+      run 2 convert in.landmarks.jsonl -o f2.glb --avatar "$fig" --bind tail=torso_joint_1
+      expect_in err.txt "VRM 1.0 bone name"
       run 1 convert in.landmarks.jsonl -o man.glb --avatar "$AVATARMAP_TEST_DATA/avatars/gltf_cesium_man.glb"
       expect_in err.txt "no mapping table fits"
       run 1 convert in.landmarks.jsonl -o v.glb --rig nonexistent --avatar "$AVATARMAP_TEST_DATA/avatars/gltf_cesium_man.glb"

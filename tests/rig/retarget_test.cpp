@@ -345,3 +345,44 @@ TEST(Retarget, TableFormulasApplySysMocapSemantics) {
 
 }  // namespace
 }  // namespace avatarmap
+
+namespace avatarmap {
+namespace {
+
+// "target_order": the proxy's angles are read in `order`, the rig's composed in another.
+TEST(Retarget, TableFormulasWithATargetOrder) {
+  raw_rig raw;
+  for (int i = 0; i < 2; ++i) {
+    raw_rig::node n;
+    n.name = i == 0 ? "Hips" : "Arm";
+    n.parent = i - 1;
+    n.rest.translation = glm::vec3(0.f, 1.f, 0.f);
+    raw.nodes.push_back(n);
+  }
+  rig r;
+  ASSERT_TRUE(build_rig(raw, r).ok());
+  mapping_table table;
+  ASSERT_TRUE(load_mapping_json(R"({"format_version": 1, "name": "t", "bones": {
+      "hips": {"rig": "Hips"},
+      "leftUpperArm": {"rig": "Arm", "order": "ZXY", "target_order": "XYZ",
+                       "f": ["z", "-x", "y"]}}})",
+                                "t", table)
+                  .ok());
+  bone_binding binding;
+  binding.fill(-1);
+  binding[idx(bone::hips)] = 0;
+  binding[idx(bone::left_upper_arm)] = 1;
+  retargeter rt;
+  ASSERT_TRUE(rt.build(r, binding, {}, &table).ok());
+  rig_pose out;
+  rt.prepare(out);
+  proxy_pose p;
+  p[bone::left_upper_arm] = quat_from_euler({0.3f, 0.2f, -0.5f}, euler_order::zxy);
+  rt.apply(p, out);
+  const glm::vec3 e = euler_from_quat(p[bone::left_upper_arm], euler_order::zxy);
+  const glm::quat want = quat_from_euler(glm::vec3(e.z, -e.x, e.y), euler_order::xyz);
+  EXPECT_LT(angle_between(out.local_rotations[1], want), 1e-5f);
+}
+
+}  // namespace
+}  // namespace avatarmap

@@ -42,13 +42,17 @@ struct mapping_bone {
   /// z) in this order, and the formulas' results are composed in this order (SysMocap's
   /// "order"; default XYZ, three.js's and SysMocap's default).
   euler_order order = euler_order::xyz;
+  /// Euler order the formulas' results (added to the rest angles) are composed in, for rigs
+  /// whose bone axes call for another order than the proxy's ("target_order"; default:
+  /// `order`, as SysMocap does).
+  euler_order target_order = euler_order::xyz;
   /// True when the file gives "f": the formulas replace the default rest-aware conversion.
   bool has_formulas = false;
   /// fx, fy, fz: compiled formulas (empty unless has_formulas).
   std::array<formula, 3> f;
   /// The formulas' source text (for messages and export).
   std::array<std::string, 3> f_text;
-  /// True when "rest" is given: Euler angles (radians, in `order`) replacing the rig bone's
+  /// True when "rest" is given: Euler angles (radians, in `target_order`) replacing the rig bone's
   /// own rest rotation as the base the formulas' results are added to (SysMocap's "init").
   bool has_rest = false;
   glm::vec3 rest{0.f};

@@ -90,7 +90,8 @@ class retargeter {
   struct formula_bone {
     int joint;
     int bone;
-    euler_order order;
+    euler_order order;         // the proxy's angles are read in this order
+    euler_order target_order;  // the rig's angles (rest + f) are composed in this order
     std::array<formula, 3> f;
     glm::vec3 rest;  // Euler angles (radians, in `order`) the results are added to
   };
