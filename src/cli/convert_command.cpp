@@ -16,6 +16,7 @@
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/synth/synth_skeleton.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
+#include "avatarmap/time/resample_clip.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/rig_select.hpp"
@@ -94,27 +95,6 @@ status load_motion(const std::string& in, const solve_job& solve, std::vector<pr
   }
   return status::error(in +
                        ": unknown input type (give *.landmarks.jsonl, *.pose.jsonl or *.vrma)");
-}
-
-// Frames at a fixed rate from t = first frame's time, slerped between the input frames.
-std::vector<proxy_pose> resample(const std::vector<proxy_pose>& in, double fps) {
-  std::vector<proxy_pose> out;
-  if (in.empty()) return out;
-  pose_resampler resampler;
-  const double t0 = in.front().t, t1 = in.back().t;
-  size_t next = 0;
-  proxy_pose p;
-  for (long k = 0;; ++k) {
-    const double t = t0 + double(k) / fps;
-    if (t > t1 + 1e-4) break;  // times read from files are floats
-    while (next < in.size() && in[next].t <= t + 1e-9) resampler.push(in[next++]);
-    if (next < in.size()) resampler.push(in[next]);  // the frame after t, to interpolate to
-    if (!resampler.sample(t, p)) break;
-    p.t = t - t0;
-    out.push_back(p);
-    // The look-ahead frame is pushed again (same time: it replaces itself) on the next step.
-  }
-  return out;
 }
 
 // Retargets `sampled` onto `r` as every avatar output does: the performer's standing hips
@@ -321,7 +301,8 @@ int run_convert(int argc, char** argv) {
     return 1;
   }
   const double out_fps = fps_given ? fps : 30.0;
-  std::vector<proxy_pose> sampled = (to_pose && !fps_given) ? frames : resample(frames, out_fps);
+  std::vector<proxy_pose> sampled =
+      (to_pose && !fps_given) ? frames : resample_clip(frames, out_fps, true);
 
   // Avatar outputs (.glb, and .bvh with --avatar) write the retargeted rig poses.
   const bool to_rig = to_glb || (to_bvh && !avatar.empty());

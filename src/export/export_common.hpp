@@ -11,6 +11,7 @@
 #include "avatarmap/core/rotation.hpp"
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
+#include "avatarmap/time/resample_clip.hpp"
 
 namespace avatarmap::export_detail {
 
@@ -59,36 +60,8 @@ inline std::vector<proxy_pose> frames_to_write(const std::vector<proxy_pose>& fr
   std::vector<proxy_pose> clean(frames.size());
   for (std::size_t i = 0; i < frames.size(); ++i)
     clean_frame(frames[i], i ? &clean[i - 1] : nullptr, clean[i]);
-  double t0 = frames.front().t;
-  if (fps > 0.0) {
-    double span = frames.back().t - t0;
-    auto count = static_cast<std::size_t>(std::floor(span * fps + 1e-6)) + 1;
-    std::vector<proxy_pose> out(count);
-    std::size_t seg = 0;
-    for (std::size_t k = 0; k < count; ++k) {
-      double t = t0 + static_cast<double>(k) / fps;
-      while (seg + 1 < clean.size() && clean[seg + 1].t <= t) ++seg;
-      proxy_pose& o = out[k];
-      if (seg + 1 >= clean.size()) {
-        o = clean.back();
-      } else {
-        const proxy_pose& a = clean[seg];
-        const proxy_pose& b = clean[seg + 1];
-        auto u = static_cast<float>((t - a.t) / (b.t - a.t));
-        u = std::clamp(u, 0.f, 1.f);
-        o = a;
-        for (int i = 0; i < k_bone_count; ++i) {
-          o.rotations[i] = slerp_shortest(a.rotations[i], b.rotations[i], u);
-          o.confidence[i] = std::min(a.confidence[i], b.confidence[i]);
-        }
-        o.hips_position = a.hips_position + (b.hips_position - a.hips_position) * u;
-        for (int e = 0; e < k_expression_count; ++e)
-          o.expressions[e] = a.expressions[e] + (b.expressions[e] - a.expressions[e]) * u;
-      }
-      o.t = rebase ? static_cast<double>(k) / fps : t;
-    }
-    return out;
-  }
+  if (fps > 0.0) return resample_clip(clean, fps, rebase);
+  const double t0 = frames.front().t;
   if (rebase)
     for (proxy_pose& p : clean) p.t -= t0;
   return clean;

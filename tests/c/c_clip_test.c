@@ -9,22 +9,12 @@
 #include <string.h>
 
 #include "avatarmap/avatarmap.h"
+#include "check.h"
 #include "mixamo_fixture.h"
 
 #ifndef AVM_TEST_MAPPINGS_DIR
 #error "AVM_TEST_MAPPINGS_DIR must name the mappings folder"
 #endif
-
-static int g_passed = 0, g_failed = 0;
-#define CHECK(cond)                                                            \
-  do {                                                                         \
-    if (cond) {                                                                \
-      ++g_passed;                                                              \
-    } else {                                                                   \
-      ++g_failed;                                                              \
-      fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond); \
-    }                                                                          \
-  } while (0)
 
 static int contains(const char* s, const char* part) {
   return s != NULL && strstr(s, part) != NULL;

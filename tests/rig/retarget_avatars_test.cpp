@@ -13,6 +13,7 @@
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/synth/random_pose.hpp"
+#include "support/rig_fk.hpp"
 #include "support/test_data.hpp"
 
 namespace avatarmap {
@@ -20,23 +21,7 @@ namespace {
 
 constexpr float k_deg = k_pi / 180.f;
 
-std::vector<glm::vec3> posed_positions(const rig& r, const rig_pose& pose) {
-  std::vector<glm::mat4> world(static_cast<size_t>(r.joint_count()));
-  std::vector<glm::vec3> out(world.size());
-  for (int j = 0; j < r.joint_count(); ++j) {
-    transform t = r.rest_local[j];
-    t.rotation = pose.local_rotations[j];
-    if (j == pose.hips_joint) t.translation = pose.hips_translation;
-    glm::mat4 m = glm::mat4_cast(t.rotation);
-    m[0] *= t.scale.x;
-    m[1] *= t.scale.y;
-    m[2] *= t.scale.z;
-    m[3] = glm::vec4(t.translation, 1.f);
-    world[j] = r.parents[j] < 0 ? m : world[r.parents[j]] * m;
-    out[j] = glm::vec3(world[j][3]);
-  }
-  return out;
-}
+using test::posed_positions;
 
 class RetargetAvatars : public ::testing::TestWithParam<const char*> {};
 

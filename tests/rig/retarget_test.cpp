@@ -13,6 +13,7 @@
 #include "avatarmap/core/rotation.hpp"
 #include "avatarmap/synth/random_pose.hpp"
 #include "avatarmap/synth/synth_skeleton.hpp"
+#include "support/rig_fk.hpp"
 
 namespace avatarmap {
 namespace {
@@ -160,24 +161,7 @@ bone_binding to_rig_binding(const rig& r, const bone_binding& raw_binding) {
   return out;
 }
 
-// World joint positions of a posed rig (rest translations, posed rotations, scales).
-std::vector<glm::vec3> posed_positions(const rig& r, const rig_pose& pose) {
-  std::vector<glm::mat4> world(static_cast<size_t>(r.joint_count()));
-  std::vector<glm::vec3> out(world.size());
-  for (int j = 0; j < r.joint_count(); ++j) {
-    transform t = r.rest_local[j];
-    t.rotation = pose.local_rotations[j];
-    if (j == pose.hips_joint) t.translation = pose.hips_translation;
-    glm::mat4 m = glm::mat4_cast(t.rotation);
-    m[0] *= t.scale.x;
-    m[1] *= t.scale.y;
-    m[2] *= t.scale.z;
-    m[3] = glm::vec4(t.translation, 1.f);
-    world[j] = r.parents[j] < 0 ? m : world[r.parents[j]] * m;
-    out[j] = glm::vec3(world[j][3]);
-  }
-  return out;
-}
+using test::posed_positions;
 
 struct direction_errors {
   double sum = 0, max = 0;

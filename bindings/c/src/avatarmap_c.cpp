@@ -35,6 +35,7 @@
 #include "avatarmap/solve/solver_options.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
+#include "avatarmap/time/resample_clip.hpp"
 #include "avatarmap/version.hpp"
 
 namespace am = avatarmap;
@@ -823,27 +824,6 @@ void sanitized_pose(const avm_pose& in, const am::proxy_pose* prev, am::proxy_po
   }
 }
 
-// Frames at a fixed rate from the first frame's time, slerped between the given frames;
-// times start at 0 (as the CLI's `convert` does).
-std::vector<am::proxy_pose> resample(const std::vector<am::proxy_pose>& in, double fps) {
-  std::vector<am::proxy_pose> out;
-  if (in.empty()) return out;
-  am::pose_resampler resampler;
-  const double t0 = in.front().t, t1 = in.back().t;
-  std::size_t next = 0;
-  am::proxy_pose p;
-  for (long k = 0;; ++k) {
-    const double t = t0 + static_cast<double>(k) / fps;
-    if (t > t1 + 1e-4) break;  // tolerate times that went through float
-    while (next < in.size() && in[next].t <= t + 1e-9) resampler.push(in[next++]);
-    if (next < in.size()) resampler.push(in[next]);  // the frame after t, to interpolate to
-    if (!resampler.sample(t, p)) break;
-    p.t = t - t0;
-    out.push_back(p);
-  }
-  return out;
-}
-
 bool ends_with_nocase(const std::string& s, const char* suffix) {
   const std::size_t n = std::strlen(suffix);
   if (s.size() < n) return false;
@@ -879,7 +859,7 @@ avm_status retarget_clip(const std::vector<am::proxy_pose>& frames, double fps,
                          std::string& msg) {
   const avm_status code = load_bound_avatar(avatar_path, mapping, out.rig, out.choice, msg);
   if (code != AVM_OK) return code;
-  const std::vector<am::proxy_pose> sampled = resample(frames, fps);
+  const std::vector<am::proxy_pose> sampled = am::resample_clip(frames, fps, true);
   if (sampled.empty()) {
     msg = "avm_clip_write: resampling gave no frames";
     return AVM_ERROR_INTERNAL;
@@ -937,7 +917,7 @@ avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::stri
   switch (fmt) {
     case format::vrma: {
       am::vrma_write_options o;
-      st = fps > 0.0 ? am::write_vrma(path, resample(frames, fps), o)
+      st = fps > 0.0 ? am::write_vrma(path, am::resample_clip(frames, fps, true), o)
                      : am::write_vrma(path, frames, o);
       break;
     }
@@ -953,7 +933,7 @@ avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::stri
       }
       am::bvh_write_options o;
       o.fps = fps;
-      st = fps > 0.0 ? am::write_bvh(path, resample(frames, fps), o)
+      st = fps > 0.0 ? am::write_bvh(path, am::resample_clip(frames, fps, true), o)
                      : am::write_bvh(path, frames, o);
       break;
     }
@@ -963,7 +943,7 @@ avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::stri
       h.present = true;
       h.fps = fps;
       const std::vector<am::proxy_pose> resampled =
-          fps > 0.0 ? resample(frames, fps) : std::vector<am::proxy_pose>();
+          fps > 0.0 ? am::resample_clip(frames, fps, true) : std::vector<am::proxy_pose>();
       const std::vector<am::proxy_pose>& out = fps > 0.0 ? resampled : frames;
       st = w.open(path, h);
       for (std::size_t i = 0; st.ok() && i < out.size(); ++i) st = w.write(out[i]);
