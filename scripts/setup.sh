@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config
           libglm-dev libeigen3-dev nlohmann-json3-dev libtinygltf-dev
           libgtest-dev libgmock-dev libbenchmark-dev libstb-dev python3
+          libavformat-dev libavcodec-dev libavutil-dev libswscale-dev
           python3-onnx python3-numpy)  # python3-onnx: the tflite -> ONNX converter (tools/convert)
 # The fuzz run (scripts/test.sh) needs clang with its sanitizer runtime.
 if [ "${AVATARMAP_SKIP_FUZZ:-0}" != 1 ]; then

@@ -2,6 +2,9 @@
 #include "avatarmap/capture/estimator.hpp"
 
 #include "avatarmap/capture/replay_estimator.hpp"
+#ifdef AVATARMAP_HAVE_ONNX
+#include "capture/onnx/onnx_estimator.hpp"
+#endif
 
 namespace avatarmap {
 
@@ -55,6 +58,10 @@ status create_replay(const estimator_options& options, std::unique_ptr<estimator
 
 constexpr estimator_backend k_backends[] = {
     {"replay", "plays a recorded *.landmarks.jsonl file (always built)", &create_replay},
+#ifdef AVATARMAP_HAVE_ONNX
+    {"onnx", "MediaPipe's models under ONNX Runtime; source: the models folder (body only)",
+     &create_onnx_estimator},
+#endif
 };
 }  // namespace
 

@@ -58,8 +58,6 @@ struct prepared_frame {
   float focal = 1.f;  // pixels, from the horizontal field of view
 };
 
-glm::vec3 to_vec(const landmark& l) { return glm::vec3(l.x, l.y, l.z); }
-
 void prepare_body(const landmark_frame& in, const solver_options& o, prepared_frame& f) {
   body_points& b = f.body;
   b.valid = false;

@@ -1,0 +1,378 @@
+// pose_pipeline: MediaPipe's pose graph around pose_detection and pose_landmark under ONNX
+// Runtime. Mirrors pose_landmark_cpu.pbtxt: PoseDetectionCpu -> PoseDetectionToRoi ->
+// PoseLandmarkByRoiCpu -> PoseLandmarksToRoi (tracking), without the smoothing filters. The
+// heatmap refinement runs only when the landmark model keeps its heatmap output.
+#include "avatarmap/capture/pose_pipeline.hpp"
+
+#include <onnxruntime_cxx_api.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace avatarmap {
+
+namespace {
+
+constexpr int k_detector_size = 224;
+constexpr int k_landmark_size = 256;
+constexpr int k_landmark_points = 39;  // 33 landmarks + 6 auxiliary points
+constexpr int k_aux_first = 33;        // auxiliary points 33 and 34 align the next region
+constexpr int k_heatmap_size = 64;     // optional heatmap output [1, 64, 64, 39]
+constexpr int k_refine_kernel = 7;     // RefineLandmarksFromHeatmap kernel_size
+constexpr float k_min_confidence_to_refine = 0.5f;
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+float sigmoid(float x) { return 1.f / (1.f + std::exp(-x)); }
+
+Ort::Env& ort_env() {
+  static Ort::Env env(ORT_LOGGING_LEVEL_WARNING, "avatarmap_pose");
+  return env;
+}
+
+const char* complexity_name(pose_model_complexity c) {
+  switch (c) {
+    case pose_model_complexity::lite:
+      return "lite";
+    case pose_model_complexity::heavy:
+      return "heavy";
+    default:
+      return "full";
+  }
+}
+
+// One ORT session with its input and (a chosen subset of) outputs bound to buffers owned
+// here, so Run() writes straight into them.
+struct bound_model {
+  std::unique_ptr<Ort::Session> session;
+  std::string input_name;
+  std::vector<std::string> output_names;  // chosen outputs only, in buffer order
+  std::vector<const char*> output_name_ptrs;
+  std::vector<float> input;
+  std::vector<std::vector<float>> outputs;
+  std::vector<Ort::Value> output_values;
+  Ort::Value input_value{nullptr};
+
+  // Loads `path` and binds the outputs whose element counts are `counts` (each must match
+  // exactly one output). Throws Ort::Exception; returns a message on a shape mismatch.
+  // `optional` outputs are bound when present (their buffers then follow the required ones);
+  // optional_found tells which were.
+  std::string load(const std::string& path, const Ort::SessionOptions& so,
+                   const std::vector<int64_t>& input_shape, const std::vector<int64_t>& counts,
+                   const std::vector<int64_t>& optional = {},
+                   std::vector<bool>* optional_found = nullptr) {
+    session = std::make_unique<Ort::Session>(ort_env(), path.c_str(), so);
+    Ort::AllocatorWithDefaultOptions alloc;
+    if (session->GetInputCount() != 1) return path + ": expected one input";
+    input_name = session->GetInputNameAllocated(0, alloc).get();
+    std::vector<int64_t> in_shape =
+        session->GetInputTypeInfo(0).GetTensorTypeAndShapeInfo().GetShape();
+    if (in_shape != input_shape) return path + ": unexpected input shape";
+    const Ort::MemoryInfo mem = Ort::MemoryInfo::CreateCpu(OrtArenaAllocator, OrtMemTypeDefault);
+    size_t in_count = 1;
+    for (int64_t d : input_shape) in_count *= static_cast<size_t>(d);
+    input.assign(in_count, 0.f);
+    input_value = Ort::Value::CreateTensor<float>(mem, input.data(), input.size(),
+                                                  input_shape.data(), input_shape.size());
+    std::vector<int64_t> all = counts;
+    all.insert(all.end(), optional.begin(), optional.end());
+    if (optional_found) optional_found->assign(optional.size(), false);
+    for (size_t w = 0; w < all.size(); ++w) {
+      const int64_t want = all[w];
+      const bool is_optional = w >= counts.size();
+      int found = -1;
+      std::vector<int64_t> shape;
+      for (size_t i = 0; i < session->GetOutputCount(); ++i) {
+        std::vector<int64_t> s =
+            session->GetOutputTypeInfo(i).GetTensorTypeAndShapeInfo().GetShape();
+        int64_t n = 1;
+        for (int64_t d : s) n *= d;
+        if (n == want) {
+          if (found >= 0) return path + ": two outputs with " + std::to_string(want) + " values";
+          found = static_cast<int>(i);
+          shape = s;
+        }
+      }
+      if (found < 0) {
+        if (is_optional) continue;
+        return path + ": no output with " + std::to_string(want) + " values";
+      }
+      if (is_optional) (*optional_found)[w - counts.size()] = true;
+      output_names.push_back(session->GetOutputNameAllocated(found, alloc).get());
+      outputs.emplace_back(static_cast<size_t>(want), 0.f);
+      output_values.push_back(Ort::Value::CreateTensor<float>(
+          mem, outputs.back().data(), outputs.back().size(), shape.data(), shape.size()));
+    }
+    for (const std::string& n : output_names) output_name_ptrs.push_back(n.c_str());
+    return {};
+  }
+
+  void run() {
+    const char* in = input_name.c_str();
+    session->Run(Ort::RunOptions{nullptr}, &in, &input_value, 1, output_name_ptrs.data(),
+                 output_values.data(), output_values.size());
+  }
+};
+
+}  // namespace
+
+// MediaPipe's RefineLandmarksFromHeatmapCalculator on one point: replaces (x, y) (tensor
+// pixels) by the confidence-weighted mean cell of a 7x7 window of the heatmap around it when
+// the window's highest confidence reaches 0.5. The window shrinks at the heatmap's edges.
+void refine_from_heatmap(const float* heatmap, int channel, float& x, float& y) {
+  const int n = k_heatmap_size;
+  const int col = static_cast<int>(x / k_landmark_size * n);
+  const int row = static_cast<int>(y / k_landmark_size * n);
+  if (!(x >= 0.f) || !(y >= 0.f) || col >= n || row >= n) return;
+  const int off = (k_refine_kernel - 1) / 2;
+  float sum = 0.f, wc = 0.f, wr = 0.f, mx = 0.f;
+  for (int r = std::max(0, row - off); r < std::min(n, row + off + 1); ++r) {
+    for (int c = std::max(0, col - off); c < std::min(n, col + off + 1); ++c) {
+      const float v =
+          sigmoid(heatmap[(static_cast<size_t>(r) * n + c) * k_landmark_points + channel]);
+      sum += v;
+      mx = std::max(mx, v);
+      wc += c * v;
+      wr += r * v;
+    }
+  }
+  if (mx >= k_min_confidence_to_refine && sum > 0.f) {
+    x = wc / n / sum * k_landmark_size;
+    y = wr / n / sum * k_landmark_size;
+  }
+}
+
+struct pose_pipeline::impl {
+  bool has_heatmap = false;
+  pose_pipeline_options options;
+  bound_model detector;  // outputs: boxes [2254 x 12], scores [2254]
+  bound_model landmark;  // outputs: landmarks [195], presence [1], world [117]
+  std::vector<ssd_anchor> anchors;
+  detection_decode_options decode;
+  std::vector<detection> decoded;
+  std::vector<detection> kept;
+  std::vector<int> scratch;
+  crop_options detector_crop;
+  crop_options landmark_crop;
+
+  bool has_roi = false;
+  normalized_rect roi;  // tracked region for the next frame
+  normalized_rect used_roi;
+  float presence = 0.f;
+  bool ran_detector = false;
+  pose_timings timings;
+  std::string error;
+
+  // Runs the detector on the whole image; false when nobody is found.
+  bool detect(const image_view& image, normalized_rect& out_roi) {
+    const auto t0 = std::chrono::steady_clock::now();
+    crop_transform tr;
+    image_crop_job job;
+    job.image = image;
+    job.roi = normalized_rect{};  // the whole image, letterboxed
+    job.options = detector_crop;
+    job.output = detector.input.data();
+    job.output_size = detector.input.size();
+    job.out_transform = &tr;
+    if (!job.run()) {
+      error = "pose detector: the image could not be cropped";
+      return false;
+    }
+    const auto ti = std::chrono::steady_clock::now();
+    detector.run();
+    timings.detector_inference_ms = ms_since(ti);
+    decode_detections(detector.outputs[0].data(), detector.outputs[1].data(), anchors.data(),
+                      decode, decoded);
+    weighted_non_max_suppression(decoded, options.nms_iou_threshold, 1, kept, scratch);
+    timings.detector_ms = ms_since(t0);
+    if (kept.empty()) return false;
+    // Detection letterbox removal: detector-input fractions -> tensor pixels -> image.
+    detection d = kept[0];
+    for (int k = 0; k < d.keypoint_count; ++k) {
+      crop_point p = project_to_image(
+          tr, {d.keypoints[2 * k] * k_detector_size, d.keypoints[2 * k + 1] * k_detector_size, 0});
+      d.keypoints[2 * k] = p.x;
+      d.keypoints[2 * k + 1] = p.y;
+    }
+    out_roi = pose_detection_to_roi(d, image.width, image.height);
+    return true;
+  }
+
+  // Runs the landmark model on `r`; false when the pose is not present.
+  bool landmarks(const image_view& image, const normalized_rect& r, landmark_frame& out) {
+    const auto t0 = std::chrono::steady_clock::now();
+    crop_transform tr;
+    image_crop_job job;
+    job.image = image;
+    job.roi = r;
+    job.options = landmark_crop;
+    job.output = landmark.input.data();
+    job.output_size = landmark.input.size();
+    job.out_transform = &tr;
+    if (!job.run()) {
+      error = "pose landmarks: the region could not be cropped";
+      return false;
+    }
+    const auto ti = std::chrono::steady_clock::now();
+    landmark.run();
+    timings.landmark_inference_ms = ms_since(ti);
+    const float* raw = landmark.outputs[0].data();
+    const float* world = landmark.outputs[2].data();
+    presence = landmark.outputs[1][0];
+    if (!(presence >= options.min_presence)) {
+      timings.landmark_ms = ms_since(t0);
+      return false;
+    }
+    for (int i = 0; i < k_pose_landmark_count; ++i) {
+      const float* p = raw + i * 5;
+      float px = p[0], py = p[1];
+      if (has_heatmap) refine_from_heatmap(landmark.outputs[3].data(), i, px, py);
+      const crop_point q = project_to_image(tr, {px, py, p[2]});
+      avatarmap::landmark& l = out.pose[i];
+      l.x = q.x;
+      l.y = q.y;
+      l.z = q.z;
+      l.visibility = sigmoid(p[3]);
+      l.presence = sigmoid(p[4]);
+    }
+    // WorldLandmarkProjection: the world points come in the region's frame; rotate them
+    // back by the region's rotation (about z, metres unchanged).
+    const float c = std::cos(r.rotation), s = std::sin(r.rotation);
+    for (int i = 0; i < k_pose_landmark_count; ++i) {
+      const float* p = world + i * 3;
+      avatarmap::landmark& l = out.pose_world[i];
+      l.x = c * p[0] - s * p[1];
+      l.y = s * p[0] + c * p[1];
+      l.z = p[2];
+      l.visibility = out.pose[i].visibility;
+      l.presence = out.pose[i].presence;
+    }
+    // PoseLandmarksToRoi: the next region from auxiliary points 33 (centre) and 34 (scale).
+    const float* a0 = raw + k_aux_first * 5;
+    const float* a1 = raw + (k_aux_first + 1) * 5;
+    float a0x = a0[0], a0y = a0[1], a1x = a1[0], a1y = a1[1];
+    if (has_heatmap) {
+      refine_from_heatmap(landmark.outputs[3].data(), k_aux_first, a0x, a0y);
+      refine_from_heatmap(landmark.outputs[3].data(), k_aux_first + 1, a1x, a1y);
+    }
+    const crop_point c0 = project_to_image(tr, {a0x, a0y, 0.f});
+    const crop_point c1 = project_to_image(tr, {a1x, a1y, 0.f});
+    roi = roi_from_alignment_points(c0.x, c0.y, c1.x, c1.y, image.width, image.height);
+    has_roi = true;
+    timings.landmark_ms = ms_since(t0);
+    return true;
+  }
+};
+
+pose_pipeline::pose_pipeline(std::unique_ptr<impl> p) : impl_(std::move(p)) {}
+pose_pipeline::~pose_pipeline() = default;
+
+status pose_pipeline::create(const pose_pipeline_options& options,
+                             std::unique_ptr<pose_pipeline>& out) {
+  out.reset();
+  if (options.intra_op_threads < 1)
+    return status::error("pose_pipeline: intra_op_threads must be >= 1");
+  if (!(options.min_detection_score > 0.f && options.min_detection_score < 1.f))
+    return status::error("pose_pipeline: min_detection_score must be in (0, 1)");
+  if (!(options.nms_iou_threshold > 0.f && options.nms_iou_threshold <= 1.f))
+    return status::error("pose_pipeline: nms_iou_threshold must be in (0, 1]");
+  if (!(options.min_presence >= 0.f && options.min_presence <= 1.f))
+    return status::error("pose_pipeline: min_presence must be in [0, 1]");
+  const std::string dir = options.models_dir.empty() ? "." : options.models_dir;
+  const std::string det_path = dir + "/pose_detection.onnx";
+  const std::string lm_path =
+      dir + "/pose_landmark_" + complexity_name(options.complexity) + ".onnx";
+  for (const std::string& p : {det_path, lm_path})
+    if (!std::ifstream(p).good())
+      return status::error("pose_pipeline: cannot open " + p +
+                           " (convert it with tools/convert/tflite2onnx.py, docs/convert.md)");
+
+  std::unique_ptr<impl> m(new impl());
+  m->options = options;
+  try {
+    Ort::SessionOptions so;
+    so.SetIntraOpNumThreads(options.intra_op_threads);
+    so.SetInterOpNumThreads(1);
+    so.SetExecutionMode(ExecutionMode::ORT_SEQUENTIAL);
+    so.SetGraphOptimizationLevel(GraphOptimizationLevel::ORT_ENABLE_ALL);
+    so.AddConfigEntry("session.intra_op.allow_spinning", options.allow_spinning ? "1" : "0");
+    std::string e =
+        m->detector.load(det_path, so, {1, k_detector_size, k_detector_size, 3}, {2254 * 12, 2254});
+    if (e.empty()) {
+      std::vector<bool> found;
+      e = m->landmark.load(lm_path, so, {1, k_landmark_size, k_landmark_size, 3},
+                           {k_landmark_points * 5, 1, k_landmark_points * 3},
+                           {k_heatmap_size * k_heatmap_size * k_landmark_points}, &found);
+      m->has_heatmap = !found.empty() && found[0];
+    }
+    if (!e.empty()) return status::error("pose_pipeline: " + e);
+  } catch (const Ort::Exception& ex) {
+    return status::error("pose_pipeline: ONNX Runtime: " + std::string(ex.what()));
+  }
+  generate_ssd_anchors(pose_detection_anchor_options(), m->anchors);
+  m->decode.min_score_thresh = options.min_detection_score;
+  m->decoded.reserve(m->anchors.size());
+  m->kept.reserve(m->anchors.size());
+  m->scratch.reserve(m->anchors.size());
+  m->detector_crop.output_width = m->detector_crop.output_height = k_detector_size;
+  m->detector_crop.range_min = -1.f;
+  m->detector_crop.range_max = 1.f;
+  m->detector_crop.border = crop_border::zero;
+  m->landmark_crop.output_width = m->landmark_crop.output_height = k_landmark_size;
+  m->landmark_crop.range_min = 0.f;
+  m->landmark_crop.range_max = 1.f;
+  m->landmark_crop.border = crop_border::replicate;
+  out.reset(new pose_pipeline(std::move(m)));
+  return {};
+}
+
+pose_result pose_pipeline::process(const image_view& image, landmark_frame& out) {
+  impl& m = *impl_;
+  m.timings = {};
+  m.error.clear();
+  m.ran_detector = false;
+  m.presence = 0.f;
+  out.set(frame_part::pose, false);
+  out.set(frame_part::pose_world, false);
+  if (image.data == nullptr || image.width <= 0 || image.height <= 0) {
+    m.error = "pose_pipeline: empty image";
+    return pose_result::error;
+  }
+  try {
+    normalized_rect r = m.roi;
+    if (!m.has_roi || m.options.static_images) {
+      m.ran_detector = true;
+      m.has_roi = false;
+      if (!m.detect(image, r)) return m.error.empty() ? pose_result::not_found : pose_result::error;
+    }
+    m.used_roi = r;
+    if (!m.landmarks(image, r, out)) {
+      m.has_roi = false;  // lost: the next frame runs the detector
+      return m.error.empty() ? pose_result::not_found : pose_result::error;
+    }
+  } catch (const Ort::Exception& ex) {
+    m.has_roi = false;
+    m.error = std::string("pose_pipeline: ONNX Runtime: ") + ex.what();
+    return pose_result::error;
+  }
+  out.set(frame_part::pose, true);
+  out.set(frame_part::pose_world, true);
+  return pose_result::found;
+}
+
+void pose_pipeline::reset() { impl_->has_roi = false; }
+const normalized_rect& pose_pipeline::last_roi() const { return impl_->used_roi; }
+bool pose_pipeline::tracking() const { return impl_->has_roi; }
+float pose_pipeline::last_presence() const { return impl_->presence; }
+bool pose_pipeline::last_ran_detector() const { return impl_->ran_detector; }
+const pose_timings& pose_pipeline::last_timings() const { return impl_->timings; }
+bool pose_pipeline::refines_from_heatmap() const { return impl_->has_heatmap; }
+const std::string& pose_pipeline::last_error() const { return impl_->error; }
+
+}  // namespace avatarmap

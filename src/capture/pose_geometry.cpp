@@ -1,0 +1,245 @@
+// The geometry of MediaPipe's pose graph: SSD anchors, detection decoding, weighted NMS and
+// alignment-point regions of interest (declared in pose_pipeline.hpp; needs no ONNX Runtime).
+#include <algorithm>
+#include <cmath>
+
+#include "avatarmap/capture/pose_pipeline.hpp"
+
+namespace avatarmap {
+
+namespace {
+
+constexpr double k_pi = 3.14159265358979323846;
+
+float anchor_scale(float min_scale, float max_scale, int index, int count) {
+  if (count == 1) return (min_scale + max_scale) * 0.5f;
+  return min_scale +
+         (max_scale - min_scale) * static_cast<float>(index) / static_cast<float>(count - 1);
+}
+
+float sigmoid(float x) { return 1.f / (1.f + std::exp(-x)); }
+
+}  // namespace
+
+ssd_anchor_options pose_detection_anchor_options() { return ssd_anchor_options{}; }
+
+bool generate_ssd_anchors(const ssd_anchor_options& o, std::vector<ssd_anchor>& out) {
+  out.clear();
+  const int n = o.num_layers;
+  if (n <= 0 || static_cast<int>(o.strides.size()) < n || o.aspect_ratios.empty() ||
+      o.input_width <= 0 || o.input_height <= 0)
+    return false;
+  const bool explicit_maps = !o.feature_map_width.empty() || !o.feature_map_height.empty();
+  if (explicit_maps && (static_cast<int>(o.feature_map_width.size()) < n ||
+                        static_cast<int>(o.feature_map_height.size()) < n))
+    return false;
+  for (int i = 0; i < n; ++i)
+    if (o.strides[i] <= 0) return false;
+
+  std::vector<float> widths, heights, aspects, scales;
+  int layer = 0;
+  while (layer < n) {
+    widths.clear();
+    heights.clear();
+    aspects.clear();
+    scales.clear();
+    // Consecutive layers with the same stride share one feature map.
+    int last = layer;
+    while (last < n && o.strides[last] == o.strides[layer]) {
+      const float scale = anchor_scale(o.min_scale, o.max_scale, last, n);
+      if (last == 0 && o.reduce_boxes_in_lowest_layer) {
+        aspects.insert(aspects.end(), {1.0f, 2.0f, 0.5f});
+        scales.insert(scales.end(), {0.1f, scale, scale});
+      } else {
+        for (float a : o.aspect_ratios) {
+          aspects.push_back(a);
+          scales.push_back(scale);
+        }
+        if (o.interpolated_scale_aspect_ratio > 0.f) {
+          const float next =
+              last == n - 1 ? 1.0f : anchor_scale(o.min_scale, o.max_scale, last + 1, n);
+          scales.push_back(std::sqrt(scale * next));
+          aspects.push_back(o.interpolated_scale_aspect_ratio);
+        }
+      }
+      ++last;
+    }
+    for (size_t i = 0; i < aspects.size(); ++i) {
+      const float r = std::sqrt(aspects[i]);
+      heights.push_back(scales[i] / r);
+      widths.push_back(scales[i] * r);
+    }
+    int map_w, map_h;
+    if (explicit_maps) {
+      map_w = o.feature_map_width[layer];
+      map_h = o.feature_map_height[layer];
+    } else {
+      const int stride = o.strides[layer];
+      map_w = static_cast<int>(std::ceil(static_cast<float>(o.input_width) / stride));
+      map_h = static_cast<int>(std::ceil(static_cast<float>(o.input_height) / stride));
+    }
+    for (int y = 0; y < map_h; ++y) {
+      for (int x = 0; x < map_w; ++x) {
+        for (size_t k = 0; k < aspects.size(); ++k) {
+          ssd_anchor a;
+          a.x_center = (static_cast<float>(x) + o.anchor_offset_x) / static_cast<float>(map_w);
+          a.y_center = (static_cast<float>(y) + o.anchor_offset_y) / static_cast<float>(map_h);
+          if (!o.fixed_anchor_size) {
+            a.width = widths[k];
+            a.height = heights[k];
+          }
+          out.push_back(a);
+        }
+      }
+    }
+    layer = last;
+  }
+  return true;
+}
+
+int decode_detections(const float* raw_boxes, const float* raw_scores, const ssd_anchor* anchors,
+                      const detection_decode_options& o, std::vector<detection>& out) {
+  out.clear();
+  const int kp_count = std::min(o.num_keypoints, k_detection_max_keypoints);
+  for (int i = 0; i < o.num_boxes; ++i) {
+    float score = raw_scores[i];
+    if (o.sigmoid_score) {
+      if (o.score_clipping_thresh > 0.f)
+        score = std::clamp(score, -o.score_clipping_thresh, o.score_clipping_thresh);
+      score = sigmoid(score);
+    }
+    // NaN scores fail this test too, so non-finite outputs never become detections.
+    if (!(score >= o.min_score_thresh)) continue;
+
+    const float* r = raw_boxes + static_cast<size_t>(i) * o.num_coords;
+    const ssd_anchor& a = anchors[i];
+    const float* b = r + o.box_coord_offset;
+    float bx = b[0], by = b[1], bw = b[2], bh = b[3];
+    if (!o.reverse_output_order) {
+      bx = b[1];
+      by = b[0];
+      bw = b[3];
+      bh = b[2];
+    }
+    const float xc = bx / o.x_scale * a.width + a.x_center;
+    const float yc = by / o.y_scale * a.height + a.y_center;
+    const float w = bw / o.w_scale * a.width;
+    const float h = bh / o.h_scale * a.height;
+
+    detection d;
+    d.score = score;
+    d.xmin = xc - w * 0.5f;
+    d.ymin = yc - h * 0.5f;
+    d.width = w;
+    d.height = h;
+    d.keypoint_count = kp_count;
+    for (int k = 0; k < kp_count; ++k) {
+      const float* p = r + o.keypoint_coord_offset + k * o.num_values_per_keypoint;
+      float px = p[0], py = p[1];
+      if (!o.reverse_output_order) std::swap(px, py);
+      d.keypoints[2 * k] = px / o.x_scale * a.width + a.x_center;
+      d.keypoints[2 * k + 1] = py / o.y_scale * a.height + a.y_center;
+    }
+    out.push_back(d);
+  }
+  return static_cast<int>(out.size());
+}
+
+float detection_iou(const detection& a, const detection& b) {
+  const float ix0 = std::max(a.xmin, b.xmin);
+  const float iy0 = std::max(a.ymin, b.ymin);
+  const float ix1 = std::min(a.xmin + a.width, b.xmin + b.width);
+  const float iy1 = std::min(a.ymin + a.height, b.ymin + b.height);
+  if (!(ix1 > ix0 && iy1 > iy0)) return 0.f;
+  const float inter = (ix1 - ix0) * (iy1 - iy0);
+  const float uni = a.width * a.height + b.width * b.height - inter;
+  return uni > 0.f ? inter / uni : 0.f;
+}
+
+int weighted_non_max_suppression(const std::vector<detection>& detections, float iou_threshold,
+                                 int max_detections, std::vector<detection>& out,
+                                 std::vector<int>& scratch) {
+  out.clear();
+  scratch.clear();
+  for (int i = 0; i < static_cast<int>(detections.size()); ++i) scratch.push_back(i);
+  // Stable, so equal scores keep the decoder's (anchor) order as MediaPipe's sort does in
+  // practice.
+  std::stable_sort(scratch.begin(), scratch.end(),
+                   [&](int a, int b) { return detections[a].score > detections[b].score; });
+  size_t remaining = scratch.size();
+  while (remaining > 0) {
+    if (max_detections > 0 && static_cast<int>(out.size()) >= max_detections) break;
+    const detection& top = detections[scratch[0]];
+    detection weighted = top;
+    float total = 0.f, x0 = 0.f, y0 = 0.f, x1 = 0.f, y1 = 0.f;
+    std::array<float, 2 * k_detection_max_keypoints> kp{};
+    size_t kept = 0;
+    // Partition in place: the overlapping group is averaged, the rest is compacted to the
+    // front in score order for the next round.
+    for (size_t i = 0; i < remaining; ++i) {
+      const detection& d = detections[scratch[i]];
+      if (detection_iou(d, top) > iou_threshold) {
+        total += d.score;
+        x0 += d.xmin * d.score;
+        y0 += d.ymin * d.score;
+        x1 += (d.xmin + d.width) * d.score;
+        y1 += (d.ymin + d.height) * d.score;
+        for (int k = 0; k < 2 * top.keypoint_count; ++k) kp[k] += d.keypoints[k] * d.score;
+      } else {
+        scratch[kept++] = scratch[i];
+      }
+    }
+    if (total > 0.f) {
+      weighted.xmin = x0 / total;
+      weighted.ymin = y0 / total;
+      weighted.width = x1 / total - weighted.xmin;
+      weighted.height = y1 / total - weighted.ymin;
+      for (int k = 0; k < 2 * top.keypoint_count; ++k) weighted.keypoints[k] = kp[k] / total;
+    }
+    out.push_back(weighted);
+    // A degenerate top box (zero area) overlaps nothing, not even itself: drop it so the
+    // loop always progresses, as MediaPipe's "size unchanged" exit does.
+    if (kept == remaining) break;
+    remaining = kept;
+  }
+  return static_cast<int>(out.size());
+}
+
+float normalize_radians(float angle) {
+  const double a = angle;
+  return static_cast<float>(a - 2.0 * k_pi * std::floor((a + k_pi) / (2.0 * k_pi)));
+}
+
+normalized_rect roi_from_alignment_points(float center_x, float center_y, float scale_x_point,
+                                          float scale_y_point, int image_width, int image_height,
+                                          const roi_from_points_options& o) {
+  const float w = static_cast<float>(image_width);
+  const float h = static_cast<float>(image_height);
+  const float x0 = center_x * w, y0 = center_y * h;
+  const float x1 = scale_x_point * w, y1 = scale_y_point * h;
+  const float box = std::sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0)) * 2.f;
+  normalized_rect r;
+  r.x_center = x0 / w;
+  r.y_center = y0 / h;
+  r.width = box / w;
+  r.height = box / h;
+  // y is down in the image, so the vector's angle is measured with -dy.
+  r.rotation = normalize_radians(o.target_angle - std::atan2(-(y1 - y0), x1 - x0));
+  float rw = r.width, rh = r.height;
+  if (o.square_long) {
+    const float side = std::max(rw * w, rh * h);
+    rw = side / w;
+    rh = side / h;
+  }
+  r.width = rw * o.scale_x;
+  r.height = rh * o.scale_y;
+  return r;
+}
+
+normalized_rect pose_detection_to_roi(const detection& d, int image_width, int image_height,
+                                      const roi_from_points_options& options) {
+  return roi_from_alignment_points(d.keypoints[0], d.keypoints[1], d.keypoints[2], d.keypoints[3],
+                                   image_width, image_height, options);
+}
+
+}  // namespace avatarmap
