@@ -18,6 +18,8 @@ const char* k_usage =
     "Usage:\n"
     "  avatarmap solve IN.landmarks.jsonl -o OUT.pose.jsonl [options]\n"
     "      Landmarks -> proxy pose (VRM 1.0 bones, hips position, expressions).\n"
+    "  avatarmap capture INPUT -o OUT.landmarks.jsonl [--model lite|full|heavy]\n"
+    "      Video, image or image sequence -> landmarks (ONNX backend; body in this version).\n"
     "  avatarmap convert IN -o OUT [--avatar AVATAR] [--rig auto|NAME|FILE.json] [--fps N]\n"
     "      Landmarks, poses or .vrma in; .vrma, .glb (animated avatar), .bvh or poses out.\n"
     "  avatarmap synth -o OUT.landmarks.jsonl [--seconds S] [--fps F] [--noise MM] [--seed N]\n"
@@ -50,6 +52,7 @@ int main(int argc, char** argv) {
   }
   if (cmd == "solve") return avatarmap::cli::run_solve(argc, argv);
   if (cmd == "convert") return avatarmap::cli::run_convert(argc, argv);
+  if (cmd == "capture") return avatarmap::cli::run_capture(argc, argv);
   if (cmd == "synth") return avatarmap::cli::run_synth(argc, argv);
   if (cmd == "demo") return avatarmap::cli::run_demo(argc, argv);
   if (cmd == "import-tfjs") return avatarmap::cli::run_import_tfjs(argc, argv);

@@ -186,6 +186,28 @@ case $case_name in
       expect_in err.txt "unknown rig table 'nonexistent'"
     fi
     ;;
+  capture)
+    run 0 capture --help
+    expect_in out.txt "Usage: avatarmap capture"
+    run 2 capture
+    run 2 capture in.mp4
+    expect_in err.txt "-o OUT.landmarks.jsonl"
+    run 2 capture in.mp4 -o out.landmarks.jsonl --model huge
+    run 2 capture in.mp4 -o out.landmarks.jsonl --hands
+    expect_in err.txt "body only"
+    run 1 capture missing.mp4 -o out.landmarks.jsonl
+    expect_in err.txt "missing.mp4"
+    [ -e out.landmarks.jsonl ] && fail "a failed capture wrote its output"
+    models="${AVATARMAP_MODELS:-}/onnx"
+    if [ -n "${AVATARMAP_TEST_DATA:-}" ] && [ -f "$models/pose_detection.onnx" ]; then
+      run 0 capture "$AVATARMAP_TEST_DATA/motion/tfjs-models/pose.jpg" -o pose.landmarks.jsonl \
+        --models "$models" --static
+      expect_in err.txt "captured 1 frames (1000x667"
+      expect_in err.txt "a person in 1 frames"
+      expect_in pose.landmarks.jsonl '"pose_world"'
+      run 0 solve pose.landmarks.jsonl -o pose.pose.jsonl
+    fi
+    ;;
   solve_stdio)
     synth_input in.landmarks.jsonl 1 || exit 1
     "$exe" solve - -o - <in.landmarks.jsonl >out.pose.jsonl 2>err.txt ||

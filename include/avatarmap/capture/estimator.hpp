@@ -39,6 +39,8 @@ struct estimate_args {
 struct estimator_options {
   std::string source;  // replay: the *.landmarks.jsonl path; onnx: the models folder
   int threads = 1;
+  int model_complexity = 1;    // onnx: pose landmark model 0 lite, 1 full, 2 heavy
+  bool static_images = false;  // onnx: detect on every frame (no tracking between frames)
 };
 
 class estimator {

@@ -32,6 +32,10 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
   pose_pipeline_options po;
   po.models_dir = options.source;
   po.intra_op_threads = options.threads < 1 ? 1 : options.threads;
+  if (options.model_complexity < 0 || options.model_complexity > 2)
+    return status::error("model complexity must be 0 (lite), 1 (full) or 2 (heavy)");
+  po.complexity = static_cast<pose_model_complexity>(options.model_complexity);
+  po.static_images = options.static_images;
   std::unique_ptr<pose_pipeline> pose;
   status s = pose_pipeline::create(po, pose);
   if (!s.ok()) return s;
