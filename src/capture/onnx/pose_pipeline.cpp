@@ -13,28 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "ort_model.hpp"
+
 namespace avatarmap {
 
 namespace {
-
-constexpr int k_detector_size = 224;
-constexpr int k_landmark_size = 256;
-constexpr int k_landmark_points = 39;  // 33 landmarks + 6 auxiliary points
-constexpr int k_aux_first = 33;        // auxiliary points 33 and 34 align the next region
-constexpr int k_heatmap_size = 64;     // optional heatmap output [1, 64, 64, 39]
-constexpr int k_refine_kernel = 7;     // RefineLandmarksFromHeatmap kernel_size
-constexpr float k_min_confidence_to_refine = 0.5f;
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-float sigmoid(float x) { return 1.f / (1.f + std::exp(-x)); }
-
-Ort::Env& ort_env() {
-  static Ort::Env env(ORT_LOGGING_LEVEL_WARNING, "avatarmap_pose");
-  return env;
-}
 
 const char* complexity_name(pose_model_complexity c) {
   switch (c) {
@@ -47,78 +30,13 @@ const char* complexity_name(pose_model_complexity c) {
   }
 }
 
-// One ORT session with its input and (a chosen subset of) outputs bound to buffers owned
-// here, so Run() writes straight into them.
-struct bound_model {
-  std::unique_ptr<Ort::Session> session;
-  std::string input_name;
-  std::vector<std::string> output_names;  // chosen outputs only, in buffer order
-  std::vector<const char*> output_name_ptrs;
-  std::vector<float> input;
-  std::vector<std::vector<float>> outputs;
-  std::vector<Ort::Value> output_values;
-  Ort::Value input_value{nullptr};
-
-  // Loads `path` and binds the outputs whose element counts are `counts` (each must match
-  // exactly one output). Throws Ort::Exception; returns a message on a shape mismatch.
-  // `optional` outputs are bound when present (their buffers then follow the required ones);
-  // optional_found tells which were.
-  std::string load(const std::string& path, const Ort::SessionOptions& so,
-                   const std::vector<int64_t>& input_shape, const std::vector<int64_t>& counts,
-                   const std::vector<int64_t>& optional = {},
-                   std::vector<bool>* optional_found = nullptr) {
-    session = std::make_unique<Ort::Session>(ort_env(), path.c_str(), so);
-    Ort::AllocatorWithDefaultOptions alloc;
-    if (session->GetInputCount() != 1) return path + ": expected one input";
-    input_name = session->GetInputNameAllocated(0, alloc).get();
-    std::vector<int64_t> in_shape =
-        session->GetInputTypeInfo(0).GetTensorTypeAndShapeInfo().GetShape();
-    if (in_shape != input_shape) return path + ": unexpected input shape";
-    const Ort::MemoryInfo mem = Ort::MemoryInfo::CreateCpu(OrtArenaAllocator, OrtMemTypeDefault);
-    size_t in_count = 1;
-    for (int64_t d : input_shape) in_count *= static_cast<size_t>(d);
-    input.assign(in_count, 0.f);
-    input_value = Ort::Value::CreateTensor<float>(mem, input.data(), input.size(),
-                                                  input_shape.data(), input_shape.size());
-    std::vector<int64_t> all = counts;
-    all.insert(all.end(), optional.begin(), optional.end());
-    if (optional_found) optional_found->assign(optional.size(), false);
-    for (size_t w = 0; w < all.size(); ++w) {
-      const int64_t want = all[w];
-      const bool is_optional = w >= counts.size();
-      int found = -1;
-      std::vector<int64_t> shape;
-      for (size_t i = 0; i < session->GetOutputCount(); ++i) {
-        std::vector<int64_t> s =
-            session->GetOutputTypeInfo(i).GetTensorTypeAndShapeInfo().GetShape();
-        int64_t n = 1;
-        for (int64_t d : s) n *= d;
-        if (n == want) {
-          if (found >= 0) return path + ": two outputs with " + std::to_string(want) + " values";
-          found = static_cast<int>(i);
-          shape = s;
-        }
-      }
-      if (found < 0) {
-        if (is_optional) continue;
-        return path + ": no output with " + std::to_string(want) + " values";
-      }
-      if (is_optional) (*optional_found)[w - counts.size()] = true;
-      output_names.push_back(session->GetOutputNameAllocated(found, alloc).get());
-      outputs.emplace_back(static_cast<size_t>(want), 0.f);
-      output_values.push_back(Ort::Value::CreateTensor<float>(
-          mem, outputs.back().data(), outputs.back().size(), shape.data(), shape.size()));
-    }
-    for (const std::string& n : output_names) output_name_ptrs.push_back(n.c_str());
-    return {};
-  }
-
-  void run() {
-    const char* in = input_name.c_str();
-    session->Run(Ort::RunOptions{nullptr}, &in, &input_value, 1, output_name_ptrs.data(),
-                 output_values.data(), output_values.size());
-  }
-};
+constexpr int k_detector_size = 224;
+constexpr int k_landmark_size = 256;
+constexpr int k_landmark_points = 39;  // 33 landmarks + 6 auxiliary points
+constexpr int k_aux_first = 33;        // auxiliary points 33 and 34 align the next region
+constexpr int k_heatmap_size = 64;     // optional heatmap output [1, 64, 64, 39]
+constexpr int k_refine_kernel = 7;     // RefineLandmarksFromHeatmap kernel_size
+constexpr float k_min_confidence_to_refine = 0.5f;
 
 }  // namespace
 
@@ -296,12 +214,8 @@ status pose_pipeline::create(const pose_pipeline_options& options,
   std::unique_ptr<impl> m(new impl());
   m->options = options;
   try {
-    Ort::SessionOptions so;
-    so.SetIntraOpNumThreads(options.intra_op_threads);
-    so.SetInterOpNumThreads(1);
-    so.SetExecutionMode(ExecutionMode::ORT_SEQUENTIAL);
-    so.SetGraphOptimizationLevel(GraphOptimizationLevel::ORT_ENABLE_ALL);
-    so.AddConfigEntry("session.intra_op.allow_spinning", options.allow_spinning ? "1" : "0");
+    const Ort::SessionOptions so =
+        make_session_options(options.intra_op_threads, options.allow_spinning);
     std::string e =
         m->detector.load(det_path, so, {1, k_detector_size, k_detector_size, 3}, {2254 * 12, 2254});
     if (e.empty()) {

@@ -1,5 +1,8 @@
-// The geometry of MediaPipe's pose graph: SSD anchors, detection decoding, weighted NMS and
-// alignment-point regions of interest (declared in pose_pipeline.hpp; needs no ONNX Runtime).
+// Detection geometry of MediaPipe's graphs: SSD anchors, detection decoding, weighted NMS and
+// regions of interest (detection.hpp), plus the pose graph's anchor options and region
+// (pose_pipeline.hpp). Needs no ONNX Runtime.
+#include "avatarmap/capture/detection.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -223,16 +226,95 @@ normalized_rect roi_from_alignment_points(float center_x, float center_y, float 
   r.y_center = y0 / h;
   r.width = box / w;
   r.height = box / h;
+  r.rotation = rotation_from_points(center_x, center_y, scale_x_point, scale_y_point, image_width,
+                                    image_height, o.target_angle);
+  rect_transform_options t;
+  t.scale_x = o.scale_x;
+  t.scale_y = o.scale_y;
+  t.square_long = o.square_long;
+  return transform_rect(r, image_width, image_height, t);
+}
+
+float rotation_from_points(float x0, float y0, float x1, float y1, int image_width,
+                           int image_height, float target_angle) {
+  const float w = static_cast<float>(image_width), h = static_cast<float>(image_height);
   // y is down in the image, so the vector's angle is measured with -dy.
-  r.rotation = normalize_radians(o.target_angle - std::atan2(-(y1 - y0), x1 - x0));
-  float rw = r.width, rh = r.height;
-  if (o.square_long) {
-    const float side = std::max(rw * w, rh * h);
-    rw = side / w;
-    rh = side / h;
+  return normalize_radians(target_angle - std::atan2(-(y1 - y0) * h, (x1 - x0) * w));
+}
+
+normalized_rect transform_rect(const normalized_rect& r, int image_width, int image_height,
+                               const rect_transform_options& o) {
+  const float w = static_cast<float>(image_width), h = static_cast<float>(image_height);
+  normalized_rect out = r;
+  if (o.shift_x != 0.f || o.shift_y != 0.f) {
+    // The shift runs along the region's own axes, measured in pixels.
+    const float c = std::cos(r.rotation), s = std::sin(r.rotation);
+    const float dx = w * r.width * o.shift_x, dy = h * r.height * o.shift_y;
+    out.x_center += (dx * c - dy * s) / w;
+    out.y_center += (dx * s + dy * c) / h;
   }
-  r.width = rw * o.scale_x;
-  r.height = rh * o.scale_y;
+  if (o.square_long) {
+    const float side = std::max(r.width * w, r.height * h);
+    out.width = side / w;
+    out.height = side / h;
+  }
+  out.width *= o.scale_x;
+  out.height *= o.scale_y;
+  return out;
+}
+
+normalized_rect detection_to_rect(const detection& d, int start_keypoint, int end_keypoint,
+                                  float target_angle, int image_width, int image_height) {
+  normalized_rect r;
+  r.x_center = d.xmin + d.width * 0.5f;
+  r.y_center = d.ymin + d.height * 0.5f;
+  r.width = d.width;
+  r.height = d.height;
+  r.rotation = 0.f;
+  if (start_keypoint >= 0 && end_keypoint >= 0 && start_keypoint < d.keypoint_count &&
+      end_keypoint < d.keypoint_count)
+    r.rotation =
+        rotation_from_points(d.keypoints[2 * start_keypoint], d.keypoints[2 * start_keypoint + 1],
+                             d.keypoints[2 * end_keypoint], d.keypoints[2 * end_keypoint + 1],
+                             image_width, image_height, target_angle);
+  return r;
+}
+
+normalized_rect rotated_bounding_rect(const float* xy, int count, float rotation, int image_width,
+                                      int image_height) {
+  const float w = static_cast<float>(image_width), h = static_cast<float>(image_height);
+  normalized_rect r;
+  r.rotation = rotation;
+  if (count <= 0) return r;
+  // Centre of the axis-aligned box, in pixels; the points are turned about it by -rotation.
+  float ax0 = xy[0] * w, ax1 = ax0, ay0 = xy[1] * h, ay1 = ay0;
+  for (int i = 1; i < count; ++i) {
+    ax0 = std::min(ax0, xy[2 * i] * w);
+    ax1 = std::max(ax1, xy[2 * i] * w);
+    ay0 = std::min(ay0, xy[2 * i + 1] * h);
+    ay1 = std::max(ay1, xy[2 * i + 1] * h);
+  }
+  const float cx = (ax0 + ax1) * 0.5f, cy = (ay0 + ay1) * 0.5f;
+  const float rc = std::cos(-rotation), rs = std::sin(-rotation);
+  float x0 = 0.f, x1 = 0.f, y0 = 0.f, y1 = 0.f;
+  for (int i = 0; i < count; ++i) {
+    const float ox = xy[2 * i] * w - cx, oy = xy[2 * i + 1] * h - cy;
+    const float px = ox * rc - oy * rs, py = ox * rs + oy * rc;
+    if (i == 0) {
+      x0 = x1 = px;
+      y0 = y1 = py;
+    }
+    x0 = std::min(x0, px);
+    x1 = std::max(x1, px);
+    y0 = std::min(y0, py);
+    y1 = std::max(y1, py);
+  }
+  const float pcx = (x0 + x1) * 0.5f, pcy = (y0 + y1) * 0.5f;
+  const float c = std::cos(rotation), s = std::sin(rotation);
+  r.x_center = (pcx * c - pcy * s + cx) / w;
+  r.y_center = (pcx * s + pcy * c + cy) / h;
+  r.width = (x1 - x0) / w;
+  r.height = (y1 - y0) / h;
   return r;
 }
 

@@ -1,0 +1,76 @@
+#include "ort_model.hpp"
+
+namespace avatarmap {
+
+Ort::Env& ort_env() {
+  static Ort::Env env(ORT_LOGGING_LEVEL_WARNING, "avatarmap");
+  return env;
+}
+
+Ort::SessionOptions make_session_options(int threads, bool allow_spinning) {
+  Ort::SessionOptions so;
+  so.SetIntraOpNumThreads(threads);
+  so.SetInterOpNumThreads(1);
+  so.SetExecutionMode(ExecutionMode::ORT_SEQUENTIAL);
+  so.SetGraphOptimizationLevel(GraphOptimizationLevel::ORT_ENABLE_ALL);
+  so.AddConfigEntry("session.intra_op.allow_spinning", allow_spinning ? "1" : "0");
+  return so;
+}
+
+std::string bound_model::load(const std::string& path, const Ort::SessionOptions& so,
+                              const std::vector<int64_t>& input_shape,
+                              const std::vector<int64_t>& counts,
+                              const std::vector<int64_t>& optional,
+                              std::vector<bool>* optional_found) {
+  session = std::make_unique<Ort::Session>(ort_env(), path.c_str(), so);
+  Ort::AllocatorWithDefaultOptions alloc;
+  if (session->GetInputCount() != 1) return path + ": expected one input";
+  input_name = session->GetInputNameAllocated(0, alloc).get();
+  std::vector<int64_t> in_shape =
+      session->GetInputTypeInfo(0).GetTensorTypeAndShapeInfo().GetShape();
+  if (in_shape != input_shape) return path + ": unexpected input shape";
+  const Ort::MemoryInfo mem = Ort::MemoryInfo::CreateCpu(OrtArenaAllocator, OrtMemTypeDefault);
+  size_t in_count = 1;
+  for (int64_t d : input_shape) in_count *= static_cast<size_t>(d);
+  input.assign(in_count, 0.f);
+  input_value = Ort::Value::CreateTensor<float>(mem, input.data(), input.size(), input_shape.data(),
+                                                input_shape.size());
+  std::vector<int64_t> all = counts;
+  all.insert(all.end(), optional.begin(), optional.end());
+  if (optional_found) optional_found->assign(optional.size(), false);
+  for (size_t w = 0; w < all.size(); ++w) {
+    const int64_t want = all[w];
+    const bool is_optional = w >= counts.size();
+    int found = -1;
+    std::vector<int64_t> shape;
+    for (size_t i = 0; i < session->GetOutputCount(); ++i) {
+      std::vector<int64_t> s = session->GetOutputTypeInfo(i).GetTensorTypeAndShapeInfo().GetShape();
+      int64_t n = 1;
+      for (int64_t d : s) n *= d;
+      if (n == want) {
+        if (found >= 0) return path + ": two outputs with " + std::to_string(want) + " values";
+        found = static_cast<int>(i);
+        shape = s;
+      }
+    }
+    if (found < 0) {
+      if (is_optional) continue;
+      return path + ": no output with " + std::to_string(want) + " values";
+    }
+    if (is_optional) (*optional_found)[w - counts.size()] = true;
+    output_names.push_back(session->GetOutputNameAllocated(found, alloc).get());
+    outputs.emplace_back(static_cast<size_t>(want), 0.f);
+    output_values.push_back(Ort::Value::CreateTensor<float>(
+        mem, outputs.back().data(), outputs.back().size(), shape.data(), shape.size()));
+  }
+  for (const std::string& n : output_names) output_name_ptrs.push_back(n.c_str());
+  return {};
+}
+
+void bound_model::run() {
+  const char* in = input_name.c_str();
+  session->Run(Ort::RunOptions{nullptr}, &in, &input_value, 1, output_name_ptrs.data(),
+               output_values.data(), output_values.size());
+}
+
+}  // namespace avatarmap

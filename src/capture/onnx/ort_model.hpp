@@ -1,0 +1,61 @@
+// The ONNX Runtime plumbing shared by the capture pipelines (internal to src/capture/onnx):
+// one process-wide Ort::Env, session options, and a session whose input and chosen outputs
+// are bound to buffers it owns, so inference writes straight into them and the steady state
+// allocates nothing outside ORT.
+#pragma once
+
+#include <onnxruntime_cxx_api.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace avatarmap {
+
+/// Milliseconds since t0.
+inline double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+inline float sigmoid(float x) { return 1.f / (1.f + std::exp(-x)); }
+
+/// The process-wide ORT environment (created on first use).
+Ort::Env& ort_env();
+
+/// Sequential execution, full graph optimisation, `threads` intra-op threads; spinning off
+/// unless asked (a spinning pool doubles latency when another process holds a core).
+Ort::SessionOptions make_session_options(int threads, bool allow_spinning);
+
+// One ORT session with its input and (a chosen subset of) outputs bound to buffers owned
+// here, so Run() writes straight into them.
+struct bound_model {
+  std::unique_ptr<Ort::Session> session;
+  std::string input_name;
+  std::vector<std::string> output_names;  // chosen outputs only, in buffer order
+  std::vector<const char*> output_name_ptrs;
+  std::vector<float> input;
+  std::vector<std::vector<float>> outputs;
+  std::vector<Ort::Value> output_values;
+  Ort::Value input_value{nullptr};
+
+  // Loads `path` and binds the outputs whose element counts are `counts` (each must match
+  // exactly one output). Throws Ort::Exception; returns a message on a shape mismatch.
+  // `optional` outputs are bound when present (their buffers then follow the required ones);
+  // optional_found tells which were.
+  // Loads `path` and binds the outputs whose element counts are `counts` (each must match
+  // exactly one output). Throws Ort::Exception; returns a message on a shape mismatch.
+  // `optional` outputs are bound when present (their buffers then follow the required ones);
+  // optional_found tells which were.
+  std::string load(const std::string& path, const Ort::SessionOptions& so,
+                   const std::vector<int64_t>& input_shape, const std::vector<int64_t>& counts,
+                   const std::vector<int64_t>& optional = {},
+                   std::vector<bool>* optional_found = nullptr);
+
+  /// Runs the session on `input` into `outputs`. Throws Ort::Exception.
+  void run();
+};
+
+}  // namespace avatarmap
