@@ -54,6 +54,9 @@ struct pose_pipeline_options {
   float nms_iou_threshold = 0.3f;    // weighted NMS overlap threshold, (0, 1]
   float min_presence = 0.5f;         // landmark model presence flag below this: lost
   bool static_images = false;        // true: run the detector on every frame
+  /// Video mode (static_images false): smooth the landmarks over time as MediaPipe's
+  /// pose_landmark_filtering does (landmark_smoothing.hpp), using the frame's time out.t.
+  bool smooth_landmarks = true;
 };
 
 /// Time spent in the last process() call, milliseconds (0 for a stage that did not run).
@@ -81,10 +84,11 @@ class pose_pipeline {
   pose_pipeline(const pose_pipeline&) = delete;
   pose_pipeline& operator=(const pose_pipeline&) = delete;
 
-  /// Processes one frame: sets the pose (33 points, normalised image coordinates, z in units
-  /// of the image width, visibility and presence) and pose_world (metres, origin at the hip
-  /// centre, rotated back to the image's axes) parts of `out` when found, clears them
-  /// otherwise; other parts are untouched. No allocation in the steady state (outside ORT).
+  /// Processes one frame (out.t is its time in seconds, for the smoothing): sets the pose (33
+  /// points, normalised image coordinates, z in units of the image width, visibility and presence)
+  /// and pose_world (metres, origin at the hip centre, rotated back to the image's axes) parts of
+  /// `out` when found, clears them otherwise; other parts are untouched. No allocation in the
+  /// steady state (outside ORT).
   pose_result process(const image_view& image, landmark_frame& out);
 
   /// Forgets the tracked region: the next frame runs the detector.

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "avatarmap/capture/landmark_smoothing.hpp"
 #include "ort_model.hpp"
 
 namespace avatarmap {
@@ -79,6 +80,13 @@ struct pose_pipeline::impl {
   crop_options detector_crop;
   crop_options landmark_crop;
 
+  // Video-mode smoothing, as pose_landmark_filtering.pbtxt and the auxiliary-landmark
+  // filter of pose_landmark_cpu.pbtxt configure it.
+  landmark_smoother smooth_image{{0.05f, 80.f, 1.f, false}};
+  landmark_smoother smooth_world{{0.1f, 40.f, 1.f, true}};
+  landmark_smoother smooth_aux{{0.01f, 10.f, 1.f, false}};
+  visibility_smoother smooth_visibility{0.1f};
+
   bool has_roi = false;
   normalized_rect roi;  // tracked region for the next frame
   normalized_rect used_roi;
@@ -122,8 +130,17 @@ struct pose_pipeline::impl {
     return true;
   }
 
-  // Runs the landmark model on `r`; false when the pose is not present.
-  bool landmarks(const image_view& image, const normalized_rect& r, landmark_frame& out) {
+  void reset_smoothing() {
+    smooth_image.reset();
+    smooth_world.reset();
+    smooth_aux.reset();
+    smooth_visibility.reset();
+  }
+
+  // Runs the landmark model on `r`; false when the pose is not present. `t` (seconds) and
+  // `smoothing` drive the video-mode filters.
+  bool landmarks(const image_view& image, const normalized_rect& r, double t, bool smoothing,
+                 landmark_frame& out) {
     const auto t0 = std::chrono::steady_clock::now();
     crop_transform tr;
     image_crop_job job;
@@ -172,16 +189,27 @@ struct pose_pipeline::impl {
       l.presence = out.pose[i].presence;
     }
     // PoseLandmarksToRoi: the next region from auxiliary points 33 (centre) and 34 (scale).
-    const float* a0 = raw + k_aux_first * 5;
-    const float* a1 = raw + (k_aux_first + 1) * 5;
-    float a0x = a0[0], a0y = a0[1], a1x = a1[0], a1y = a1[1];
-    if (has_heatmap) {
-      refine_from_heatmap(landmark.outputs[3].data(), k_aux_first, a0x, a0y);
-      refine_from_heatmap(landmark.outputs[3].data(), k_aux_first + 1, a1x, a1y);
+    avatarmap::landmark aux[2];
+    for (int k = 0; k < 2; ++k) {
+      const float* a = raw + (k_aux_first + k) * 5;
+      float ax = a[0], ay = a[1];
+      if (has_heatmap) refine_from_heatmap(landmark.outputs[3].data(), k_aux_first + k, ax, ay);
+      const crop_point c = project_to_image(tr, {ax, ay, a[2]});
+      aux[k].x = c.x;
+      aux[k].y = c.y;
+      aux[k].z = c.z;
     }
-    const crop_point c0 = project_to_image(tr, {a0x, a0y, 0.f});
-    const crop_point c1 = project_to_image(tr, {a1x, a1y, 0.f});
-    roi = roi_from_alignment_points(c0.x, c0.y, c1.x, c1.y, image.width, image.height);
+    if (smoothing) {
+      smooth_image.apply(t, out.pose.data(), k_pose_landmark_count, true, image.width,
+                         image.height);
+      smooth_visibility.apply(out.pose.data(), k_pose_landmark_count);
+      smooth_world.apply(t, out.pose_world.data(), k_pose_landmark_count, false, 0, 0);
+      smooth_aux.apply(t, aux, 2, true, image.width, image.height);
+      for (int i = 0; i < k_pose_landmark_count; ++i)
+        out.pose_world[i].visibility = out.pose[i].visibility;
+    }
+    roi = roi_from_alignment_points(aux[0].x, aux[0].y, aux[1].x, aux[1].y, image.width,
+                                    image.height);
     has_roi = true;
     timings.landmark_ms = ms_since(t0);
     return true;
@@ -266,8 +294,10 @@ pose_result pose_pipeline::process(const image_view& image, landmark_frame& out)
       if (!m.detect(image, r)) return m.error.empty() ? pose_result::not_found : pose_result::error;
     }
     m.used_roi = r;
-    if (!m.landmarks(image, r, out)) {
+    const bool smoothing = m.options.smooth_landmarks && !m.options.static_images;
+    if (!m.landmarks(image, r, out.t, smoothing, out)) {
       m.has_roi = false;  // lost: the next frame runs the detector
+      m.reset_smoothing();
       return m.error.empty() ? pose_result::not_found : pose_result::error;
     }
   } catch (const Ort::Exception& ex) {
@@ -280,7 +310,10 @@ pose_result pose_pipeline::process(const image_view& image, landmark_frame& out)
   return pose_result::found;
 }
 
-void pose_pipeline::reset() { impl_->has_roi = false; }
+void pose_pipeline::reset() {
+  impl_->has_roi = false;
+  impl_->reset_smoothing();
+}
 const normalized_rect& pose_pipeline::last_roi() const { return impl_->used_roi; }
 bool pose_pipeline::tracking() const { return impl_->has_roi; }
 float pose_pipeline::last_presence() const { return impl_->presence; }
