@@ -318,6 +318,83 @@ normalized_rect rotated_bounding_rect(const float* xy, int count, float rotation
   return r;
 }
 
+bool points_to_rect(const float* xy, int count, int stride_floats, int start, int end,
+                    float target_angle, int image_width, int image_height, normalized_rect& out) {
+  if (xy == nullptr || count < 1 || stride_floats < 2 || start < 0 || end < 0 || start >= count ||
+      end >= count)
+    return false;
+  float x0 = xy[0], x1 = xy[0], y0 = xy[1], y1 = xy[1];
+  for (int i = 0; i < count; ++i) {
+    const float x = xy[static_cast<size_t>(i) * stride_floats];
+    const float y = xy[static_cast<size_t>(i) * stride_floats + 1];
+    if (!std::isfinite(x) || !std::isfinite(y)) return false;
+    x0 = std::min(x0, x);
+    x1 = std::max(x1, x);
+    y0 = std::min(y0, y);
+    y1 = std::max(y1, y);
+  }
+  out.x_center = (x0 + x1) * 0.5f;
+  out.y_center = (y0 + y1) * 0.5f;
+  out.width = x1 - x0;
+  out.height = y1 - y0;
+  const float* a = xy + static_cast<size_t>(start) * stride_floats;
+  const float* b = xy + static_cast<size_t>(end) * stride_floats;
+  out.rotation =
+      rotation_from_points(a[0], a[1], b[0], b[1], image_width, image_height, target_angle);
+  return true;
+}
+
+detection project_detection(const crop_transform& tr, const detection& d) {
+  const float tw = static_cast<float>(tr.tensor_width), th = static_cast<float>(tr.tensor_height);
+  detection out = d;
+  for (int k = 0; k < d.keypoint_count; ++k) {
+    const crop_point p =
+        project_to_image(tr, {d.keypoints[2 * k] * tw, d.keypoints[2 * k + 1] * th, 0.f});
+    out.keypoints[2 * k] = p.x;
+    out.keypoints[2 * k + 1] = p.y;
+  }
+  const float cx[4] = {d.xmin, d.xmin + d.width, d.xmin + d.width, d.xmin};
+  const float cy[4] = {d.ymin, d.ymin, d.ymin + d.height, d.ymin + d.height};
+  float x0 = 0.f, x1 = 0.f, y0 = 0.f, y1 = 0.f;
+  for (int i = 0; i < 4; ++i) {
+    const crop_point p = project_to_image(tr, {cx[i] * tw, cy[i] * th, 0.f});
+    x0 = i == 0 ? p.x : std::min(x0, p.x);
+    x1 = i == 0 ? p.x : std::max(x1, p.x);
+    y0 = i == 0 ? p.y : std::min(y0, p.y);
+    y1 = i == 0 ? p.y : std::max(y1, p.y);
+  }
+  out.xmin = x0;
+  out.ymin = y0;
+  out.width = x1 - x0;
+  out.height = y1 - y0;
+  return out;
+}
+
+float normalized_rect_iou(const normalized_rect& a, const normalized_rect& b, int image_width,
+                          int image_height) {
+  const float w = static_cast<float>(image_width), h = static_cast<float>(image_height);
+  const float ax0 = (a.x_center - a.width * 0.5f) * w, ax1 = (a.x_center + a.width * 0.5f) * w;
+  const float ay0 = (a.y_center - a.height * 0.5f) * h, ay1 = (a.y_center + a.height * 0.5f) * h;
+  const float bx0 = (b.x_center - b.width * 0.5f) * w, bx1 = (b.x_center + b.width * 0.5f) * w;
+  const float by0 = (b.y_center - b.height * 0.5f) * h, by1 = (b.y_center + b.height * 0.5f) * h;
+  const float ix = std::min(ax1, bx1) - std::max(ax0, bx0);
+  const float iy = std::min(ay1, by1) - std::max(ay0, by0);
+  if (!(ix > 0.f && iy > 0.f)) return 0.f;
+  const float inter = ix * iy;
+  const float uni = (ax1 - ax0) * (ay1 - ay0) + (bx1 - bx0) * (by1 - by0) - inter;
+  return uni > 0.f ? inter / uni : 0.f;
+}
+
+bool normalized_rect_contains(const normalized_rect& r, float x, float y, int image_width,
+                              int image_height) {
+  const float w = static_cast<float>(image_width), h = static_cast<float>(image_height);
+  const float dx = (x - r.x_center) * w, dy = (y - r.y_center) * h;
+  // Into the region's own axes: rotate by -rotation.
+  const float c = std::cos(r.rotation), s = std::sin(r.rotation);
+  const float u = dx * c + dy * s, v = -dx * s + dy * c;
+  return std::fabs(u) <= r.width * w * 0.5f && std::fabs(v) <= r.height * h * 0.5f;
+}
+
 normalized_rect pose_detection_to_roi(const detection& d, int image_width, int image_height,
                                       const roi_from_points_options& options) {
   return roi_from_alignment_points(d.keypoints[0], d.keypoints[1], d.keypoints[2], d.keypoints[3],

@@ -1,5 +1,5 @@
 // `avatarmap capture INPUT -o OUT.landmarks.jsonl`: video, image or image sequence in,
-// landmarks out, through the ONNX backend (body in this version).
+// landmarks out, through the ONNX backend (body, hands, face), with an optional overlay.
 #include <unistd.h>
 
 #include <chrono>
@@ -10,8 +10,10 @@
 #include "avatarmap/capture/estimator.hpp"
 #include "avatarmap/capture/video_source.hpp"
 #include "avatarmap/io/landmark_file.hpp"
+#include "cli/capture_setup.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
+#include "cli/overlay_output.hpp"
 
 namespace avatarmap::cli {
 namespace {
@@ -21,26 +23,20 @@ const char* k_capture_help =
     "\n"
     "Estimates landmarks on every frame of INPUT (a video file, an image, a folder of images\n"
     "or a printf pattern like frames/%05d.png) with MediaPipe's models run by ONNX Runtime,\n"
-    "and writes them as *.landmarks.jsonl (docs/file-formats.md). This version estimates the\n"
-    "body (33 points, image + world); hands and face come next.\n"
+    "and writes them as *.landmarks.jsonl (docs/file-formats.md): the body (33 points, image\n"
+    "+ world) and, when asked, both hands and the face mesh. Video is tracked (detectors run\n"
+    "only when a part is lost) and smoothed as MediaPipe does; --static treats every frame\n"
+    "on its own.\n"
     "\n"
     "Options:\n"
     "  -o, --output PATH     where to write the landmarks (required; written atomically)\n"
-    "  --model lite|full|heavy  pose landmark model (default full)\n"
-    "  --threads N           ONNX Runtime threads (default 1: the decoder keeps the other core)\n"
-    "  --models DIR          converted models (default: $AVATARMAP_MODELS/onnx, else the\n"
-    "                        cache scripts/prepare_capture.sh fills)\n"
-    "  --static              detect on every frame (images unrelated to each other)\n"
-    "  --progress / --quiet  force / silence the progress line (default: on a terminal)\n";
-
-std::string default_models_dir() {
-  if (const char* m = std::getenv("AVATARMAP_MODELS"); m && *m) return std::string(m) + "/onnx";
-#ifdef AVATARMAP_DEFAULT_MODELS_DIR
-  return AVATARMAP_DEFAULT_MODELS_DIR;
-#else
-  return ".cache/avatarmap/models/onnx";
-#endif
-}
+    "  --overlay PATH        also draw the landmarks on the frames: PATH.mp4/.mkv/.avi writes\n"
+    "                        a video, PATH.png one image (the first frame) and a pattern like\n"
+    "                        overlay_%05d.png one image per frame\n"
+    "  --loop N              run over INPUT N times (times keep increasing; for soak tests)\n"
+    "  --progress / --quiet  force / silence the progress line (default: on a terminal)\n"
+    "\n"
+    "Estimator options:\n";
 
 }  // namespace
 
@@ -48,22 +44,21 @@ int run_capture(int argc, char** argv) {
   args a(argc, argv, 2);
   if (a.flag("--help") || a.flag("-h")) {
     std::fputs(k_capture_help, stdout);
+    std::fputs(k_estimator_options_help, stdout);
     return 0;
   }
-  std::string out_path, model = "full", models_dir = default_models_dir();
+  std::string out_path, overlay_path, error;
   a.value("--output", out_path, "-o");
-  a.value("--model", model);
-  a.value("--models", models_dir);
-  double threads = 1;
-  a.number("--threads", threads);
-  const bool static_images = a.flag("--static");
+  a.value("--overlay", overlay_path);
+  double loops = 1;
+  a.number("--loop", loops);
   bool progress = isatty(STDERR_FILENO);
   if (a.flag("--progress")) progress = true;
-  if (a.flag("--quiet")) progress = false;
-  if (a.flag("--hands") || a.flag("--face")) {
-    std::fprintf(stderr,
-                 "avatarmap capture: hands and face are not estimated by this version yet "
-                 "(body only)\n");
+  const bool quiet = a.flag("--quiet");
+  if (quiet) progress = false;
+  estimator_cli ec;
+  if (!parse_estimator_options(a, false, ec, error)) {
+    std::fprintf(stderr, "avatarmap capture: %s\n", error.c_str());
     return 2;
   }
   if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 1 || out_path.empty()) {
@@ -73,31 +68,34 @@ int run_capture(int argc, char** argv) {
                                         : "give the output with -o OUT.landmarks.jsonl");
     return 2;
   }
-  const int complexity = model == "lite" ? 0 : model == "full" ? 1 : model == "heavy" ? 2 : -1;
-  if (complexity < 0 || !(threads >= 1 && threads <= 64)) {
-    std::fprintf(stderr, "avatarmap capture: --model is lite, full or heavy; --threads 1..64\n");
+  if (!(loops >= 1 && loops <= 1e6) || loops != static_cast<long>(loops)) {
+    std::fprintf(stderr, "avatarmap capture: --loop wants a whole number >= 1\n");
     return 2;
   }
+  const std::string input = a.rest()[0];
 
   video_source source;
-  status st = source.open(a.rest()[0]);
+  video_source_quiet_log(true);
+  status st = source.open(input);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
     return 1;
   }
-  estimator_options eo;
-  eo.source = models_dir;
-  eo.threads = static_cast<int>(threads);
-  eo.model_complexity = complexity;
-  eo.static_images = static_images;
   std::unique_ptr<estimator> est;
-  st = create_estimator("onnx", eo, est);
+  st = make_estimator(ec, est);
   if (!st.ok()) {
-    std::fprintf(stderr, "avatarmap capture: %s (run scripts/prepare_capture.sh)\n",
-                 st.message().c_str());
+    std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
     return 1;
   }
   const video_info info = source.info();
+  overlay_output overlay;
+  if (!overlay_path.empty()) {
+    st = overlay.open(overlay_path, info.width, info.height, info.fps > 0 ? info.fps : 30.0);
+    if (!st.ok()) {
+      std::fprintf(stderr, "avatarmap capture: --overlay: %s\n", st.message().c_str());
+      return 1;
+    }
+  }
   landmark_writer writer;
   landmark_file_header h;
   h.present = true;
@@ -113,59 +111,99 @@ int run_capture(int argc, char** argv) {
   using clock_type = std::chrono::steady_clock;
   const auto t0 = clock_type::now();
   auto last = t0;
-  long frames = 0, with_pose = 0, errors = 0;
+  long frames = 0, errors = 0, part_frames[k_frame_part_count] = {};
+  long rss_warm = 0, rss_peak = 0;
+  timing_totals timings;
   image_view image;
-  double t = 0.0;
+  double t = 0.0, t_offset = 0.0, t_last = 0.0;
   landmark_frame frame;
-  for (;;) {
-    const read_result r = source.next(image, t);
-    if (r == read_result::end) break;
-    if (r == read_result::error) {
-      ++errors;
-      std::fprintf(stderr, "warning: %s\n", source.error().c_str());
-      continue;
+  estimate_args ea;
+  ea.body = ec.body;
+  ea.hands = ec.options.hands;
+  ea.face = ec.options.face;
+  for (long pass = 0; pass < static_cast<long>(loops); ++pass) {
+    if (pass > 0) {
+      // The next pass continues the clock one frame period after the last frame.
+      t_offset = t_last + (info.fps > 0 ? 1.0 / info.fps : 1.0 / 30.0);
+      st = source.open(input);
+      if (!st.ok()) {
+        std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
+        return 1;
+      }
     }
-    estimate_args ea;
-    ea.image = image;
-    ea.t = t;
-    ea.hands = ea.face = false;
-    st = est->estimate(ea, frame);
-    if (!st.ok()) {
-      std::fprintf(stderr, "avatarmap capture: frame at %.3f s: %s\n", t, st.message().c_str());
-      return 1;
-    }
-    frame.t = t;
-    if (frame.has(frame_part::pose)) ++with_pose;
-    st = writer.write(frame);
-    if (!st.ok()) {
-      std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
-      return 1;
-    }
-    ++frames;
-    if (progress) {
-      const auto now = clock_type::now();
-      if (std::chrono::duration<double>(now - last).count() > 0.5) {
-        last = now;
-        const double el = std::chrono::duration<double>(now - t0).count();
-        std::fprintf(stderr, "\rcapture: %ld frames, %.1f frames/s   ", frames, frames / el);
-        std::fflush(stderr);
+    for (;;) {
+      const read_result r = source.next(image, t);
+      if (r == read_result::end) break;
+      if (r == read_result::error) {
+        ++errors;
+        std::fprintf(stderr, "warning: %s\n", source.error().c_str());
+        continue;
+      }
+      ea.image = image;
+      ea.t = t + t_offset;
+      t_last = ea.t;
+      st = est->estimate(ea, frame);
+      if (!st.ok()) {
+        std::fprintf(stderr, "avatarmap capture: frame at %.3f s: %s\n", ea.t,
+                     st.message().c_str());
+        return 1;
+      }
+      frame.t = ea.t;
+      for (int p = 0; p < k_frame_part_count; ++p)
+        part_frames[p] += frame.has(static_cast<frame_part>(p));
+      if (const estimator_timings* et = est->last_timings()) timings.add(*et);
+      st = writer.write(frame);
+      if (st.ok() && overlay.is_open()) st = overlay.write(image, frame);
+      if (!st.ok()) {
+        std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
+        return 1;
+      }
+      ++frames;
+      if (frames == 100) rss_warm = resident_kib();
+      if (frames % 100 == 0) rss_peak = std::max(rss_peak, resident_kib());
+      if (progress) {
+        const auto now = clock_type::now();
+        if (std::chrono::duration<double>(now - last).count() > 0.5) {
+          last = now;
+          const double el = std::chrono::duration<double>(now - t0).count();
+          const double total = static_cast<double>(info.frame_count) * loops;
+          if (total > 0)
+            std::fprintf(stderr, "\rcapture: %ld/%.0f frames (%.0f%%), %.1f frames/s   ", frames,
+                         total, 100.0 * frames / total, frames / el);
+          else
+            std::fprintf(stderr, "\rcapture: %ld frames, %.1f frames/s   ", frames, frames / el);
+          std::fflush(stderr);
+        }
       }
     }
   }
   st = writer.commit();
+  if (st.ok() && overlay.is_open()) st = overlay.close();
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
     return 1;
   }
   const double el = std::chrono::duration<double>(clock_type::now() - t0).count();
   if (progress) std::fputs("\r", stderr);
-  std::fprintf(stderr,
-               "captured %ld frames (%dx%d, %s) in %.2f s: %.1f frames/s end to end; a person in "
-               "%ld frames%s\n",
+  if (quiet) return 0;
+  std::fprintf(stderr, "captured %ld frames (%dx%d, %s) in %.2f s: %.1f frames/s end to end%s\n",
                frames, info.width, info.height, info.codec.c_str(), el, frames / (el > 0 ? el : 1),
-               with_pose,
                errors ? (", " + std::to_string(errors) + " frames not decoded").c_str() : "");
+  std::fprintf(stderr, "found: body in %ld frames", part_frames[0]);
+  if (ea.hands)
+    std::fprintf(stderr, ", left hand %ld, right hand %ld",
+                 part_frames[static_cast<int>(frame_part::left_hand)],
+                 part_frames[static_cast<int>(frame_part::right_hand)]);
+  if (ea.face) std::fprintf(stderr, ", face %ld", part_frames[static_cast<int>(frame_part::face)]);
+  std::fputc('\n', stderr);
+  timings.print(stderr);
+  if (rss_warm > 0) {
+    rss_peak = std::max(rss_peak, resident_kib());
+    std::fprintf(stderr, "memory: %.1f MiB resident after 100 frames, %.1f MiB at most after\n",
+                 rss_warm / 1024.0, rss_peak / 1024.0);
+  }
   std::fprintf(stderr, "wrote %s\n", out_path.c_str());
+  if (!overlay_path.empty()) std::fprintf(stderr, "wrote %s\n", overlay_path.c_str());
   return 0;
 }
 

@@ -7,6 +7,8 @@ namespace avatarmap::cli {
 int run_solve(int argc, char** argv);
 int run_convert(int argc, char** argv);
 int run_capture(int argc, char** argv);
+int run_animate(int argc, char** argv);
+int run_live_command(int argc, char** argv);
 int run_synth(int argc, char** argv);
 int run_demo(int argc, char** argv);
 int run_import_tfjs(int argc, char** argv);

@@ -18,8 +18,12 @@ const char* k_usage =
     "Usage:\n"
     "  avatarmap solve IN.landmarks.jsonl -o OUT.pose.jsonl [options]\n"
     "      Landmarks -> proxy pose (VRM 1.0 bones, hips position, expressions).\n"
-    "  avatarmap capture INPUT -o OUT.landmarks.jsonl [--model lite|full|heavy]\n"
-    "      Video, image or image sequence -> landmarks (ONNX backend; body in this version).\n"
+    "  avatarmap capture INPUT -o OUT.landmarks.jsonl [--hands] [--face] [--overlay OUT.mp4]\n"
+    "      Video, image or image sequence -> landmarks (MediaPipe's models on ONNX Runtime).\n"
+    "  avatarmap animate VIDEO -o OUT.vrma|OUT.glb|OUT.bvh [--avatar AVATAR]\n"
+    "      capture + convert in one command: video in, avatar animation out.\n"
+    "  avatarmap live INPUT [-o OUT.pose.jsonl] [--fps 60] [--hands] [--face]\n"
+    "      Latest-frame live loop (camera, or a file paced as one) with latency figures.\n"
     "  avatarmap convert IN -o OUT [--avatar AVATAR] [--rig auto|NAME|FILE.json] [--fps N]\n"
     "      Landmarks, poses or .vrma in; .vrma, .glb (animated avatar), .bvh or poses out.\n"
     "  avatarmap synth -o OUT.landmarks.jsonl [--seconds S] [--fps F] [--noise MM] [--seed N]\n"
@@ -53,6 +57,8 @@ int main(int argc, char** argv) {
   if (cmd == "solve") return avatarmap::cli::run_solve(argc, argv);
   if (cmd == "convert") return avatarmap::cli::run_convert(argc, argv);
   if (cmd == "capture") return avatarmap::cli::run_capture(argc, argv);
+  if (cmd == "animate") return avatarmap::cli::run_animate(argc, argv);
+  if (cmd == "live") return avatarmap::cli::run_live_command(argc, argv);
   if (cmd == "synth") return avatarmap::cli::run_synth(argc, argv);
   if (cmd == "demo") return avatarmap::cli::run_demo(argc, argv);
   if (cmd == "import-tfjs") return avatarmap::cli::run_import_tfjs(argc, argv);

@@ -189,23 +189,121 @@ case $case_name in
   capture)
     run 0 capture --help
     expect_in out.txt "Usage: avatarmap capture"
+    expect_in out.txt "--overlay"
     run 2 capture
     run 2 capture in.mp4
     expect_in err.txt "-o OUT.landmarks.jsonl"
     run 2 capture in.mp4 -o out.landmarks.jsonl --model huge
-    run 2 capture in.mp4 -o out.landmarks.jsonl --hands
-    expect_in err.txt "body only"
+    expect_in err.txt "--model is lite, full or heavy"
+    run 2 capture in.mp4 -o out.landmarks.jsonl --hand-model heavy
+    run 2 capture in.mp4 -o out.landmarks.jsonl --loop 0
     run 1 capture missing.mp4 -o out.landmarks.jsonl
     expect_in err.txt "missing.mp4"
     [ -e out.landmarks.jsonl ] && fail "a failed capture wrote its output"
     models="${AVATARMAP_MODELS:-}/onnx"
     if [ -n "${AVATARMAP_TEST_DATA:-}" ] && [ -f "$models/pose_detection.onnx" ]; then
-      run 0 capture "$AVATARMAP_TEST_DATA/motion/tfjs-models/pose.jpg" -o pose.landmarks.jsonl \
-        --models "$models" --static
+      tfjs="$AVATARMAP_TEST_DATA/motion/tfjs-models"
+      run 0 capture "$tfjs/pose.jpg" -o pose.landmarks.jsonl --models "$models" --static
       expect_in err.txt "captured 1 frames (1000x667"
-      expect_in err.txt "a person in 1 frames"
+      expect_in err.txt "found: body in 1 frames"
       expect_in pose.landmarks.jsonl '"pose_world"'
       run 0 solve pose.landmarks.jsonl -o pose.pose.jsonl
+      # Hands and face, with an overlay image and an overlay video.
+      run 0 capture "$tfjs/hands.jpg" -o hands.landmarks.jsonl --models "$models" --static \
+        --hands --face --overlay hands.png
+      expect_in err.txt "left hand 1, right hand 1"
+      expect_in hands.landmarks.jsonl '"left_hand_world"'
+      expect_in hands.landmarks.jsonl '"right_hand"'
+      [ -s hands.png ] || fail "no overlay image"
+      run 0 capture "$tfjs/portrait.jpg" -o face.landmarks.jsonl --models "$models" --static --face
+      expect_in err.txt "face 1"
+      expect_in face.landmarks.jsonl '"face"'
+      run 0 capture "$tfjs/pose_squats.mp4" -o squats.landmarks.jsonl --models "$models" \
+        --hands --face --overlay squats.mp4
+      expect_in err.txt "captured 65 frames (720x1280, h264)"
+      expect_in err.txt "face 65"
+      expect_in err.txt "hand landmarks"
+      [ "$(lines squats.landmarks.jsonl)" -eq 66 ] || fail "expected 65 frames and a header"
+      run 0 capture squats.mp4 -o overlay.landmarks.jsonl --models "$models" --quiet
+      [ "$(lines overlay.landmarks.jsonl)" -eq 66 ] || fail "the overlay video has not 65 frames"
+      # Bad models: missing and corrupt files are named, nothing is written.
+      mkdir -p bad
+      cp "$models"/pose_detection.onnx "$models"/pose_landmark_full.onnx bad/
+      run 1 capture "$tfjs/pose.jpg" -o bad.landmarks.jsonl --models bad --hands
+      expect_in err.txt "palm_detection_full.onnx"
+      expect_in err.txt "prepare_capture.sh"
+      head -c 1000 "$models/pose_landmark_full.onnx" >bad/pose_landmark_full.onnx
+      run 1 capture "$tfjs/pose.jpg" -o bad.landmarks.jsonl --models bad
+      expect_in err.txt "pose_landmark_full.onnx"
+      [ -e bad.landmarks.jsonl ] && fail "a failed capture wrote its output"
+      # No person: a black image gives a frame with no parts.
+      if command -v /usr/bin/python3 >/dev/null; then
+        /usr/bin/python3 -c "
+import zlib,struct
+w,h=64,48
+raw=b''.join(b'\\x00'+b'\\x00'*w*3 for _ in range(h))
+def chunk(t,d): return struct.pack('>I',len(d))+t+d+struct.pack('>I',zlib.crc32(t+d)&0xffffffff)
+open('black.png','wb').write(b'\\x89PNG\\r\\n\\x1a\\n'+chunk(b'IHDR',struct.pack('>IIBBBBB',w,h,8,2,0,0,0))+chunk(b'IDAT',zlib.compress(raw))+chunk(b'IEND',b''))"
+        run 0 capture black.png -o black.landmarks.jsonl --models "$models" --hands --face
+        expect_in err.txt "found: body in 0 frames, left hand 0, right hand 0, face 0"
+      fi
+    fi
+    ;;
+  animate)
+    run 0 animate --help
+    expect_in out.txt "Usage: avatarmap animate"
+    run 2 animate
+    run 2 animate in.mp4
+    run 2 animate in.mp4 -o out.txt
+    expect_in err.txt ".vrma, .glb, .bvh or .pose.jsonl"
+    run 2 animate in.mp4 -o out.glb
+    expect_in err.txt "--avatar"
+    run 2 animate in.mp4 -o out.vrma --bogus
+    expect_in err.txt "unknown option --bogus"
+    run 1 animate missing.mp4 -o out.vrma
+    [ -e out.vrma ] && fail "a failed animate wrote its output"
+    models="${AVATARMAP_MODELS:-}/onnx"
+    if [ -n "${AVATARMAP_TEST_DATA:-}" ] && [ -f "$models/pose_detection.onnx" ]; then
+      tfjs="$AVATARMAP_TEST_DATA/motion/tfjs-models"
+      avatar="$AVATARMAP_TEST_DATA/avatars/vrm1_spec_53bones.vrm"
+      run 0 animate "$tfjs/pose_squats.mp4" --avatar "$avatar" -o squats.glb --models "$models" \
+        --keep-landmarks squats.landmarks.jsonl --fps 10
+      expect_in err.txt "captured 65 frames"
+      expect_in err.txt "wrote squats.glb"
+      [ -s squats.glb ] || fail "no .glb written"
+      expect_in squats.landmarks.jsonl '"left_hand"'
+      expect_in squats.landmarks.jsonl '"face"'
+      run 0 animate "$tfjs/pose_squats.mp4" -o squats.vrma --models "$models" --body-only --quiet
+      [ -s squats.vrma ] || fail "no .vrma written"
+      [ -s err.txt ] && fail "--quiet printed: $(head -c 300 err.txt)"
+      ls "${TMPDIR:-/tmp}"/avatarmap-animate-* 2>/dev/null | grep -q . &&
+        echo "note: temporary landmark files of other runs exist" >&2
+    fi
+    ;;
+  live)
+    run 0 live --help
+    expect_in out.txt "Usage: avatarmap live"
+    run 2 live
+    run 2 live in.mp4 --fps 0
+    run 1 live missing.mp4
+    models="${AVATARMAP_MODELS:-}/onnx"
+    if [ -n "${AVATARMAP_TEST_DATA:-}" ] && [ -f "$models/pose_detection.onnx" ]; then
+      tfjs="$AVATARMAP_TEST_DATA/motion/tfjs-models"
+      # Unpaced: frames arrive faster than they are processed, so some are dropped; every
+      # frame is either processed or dropped.
+      run 0 live "$tfjs/pose_squats.mp4" --unpaced --models "$models" -o live.pose.jsonl --fps 60
+      expect_in err.txt "65 frames delivered"
+      expect_in err.txt "latency (frame delivered -> pose ready)"
+      processed=$(sed -n 's/.* \([0-9]*\) processed.*/\1/p' err.txt)
+      dropped=$(sed -n 's/.*, \([0-9]*\) dropped.*/\1/p' err.txt)
+      [ $((processed + dropped)) -eq 65 ] || fail "processed $processed + dropped $dropped != 65"
+      expect_in live.pose.jsonl '"fps":60'
+      # Paced for 1 second: about 5 frames of a 5 fps video, output at 60 fps.
+      run 0 live "$tfjs/pose_squats.mp4" --seconds 1 --models "$models" -o paced.pose.jsonl
+      n=$(($(lines paced.pose.jsonl) - 1))
+      if [ "$n" -lt 30 ] || [ "$n" -gt 61 ]; then
+        fail "1 s at 60 fps wrote $n poses"
+      fi
     fi
     ;;
   solve_stdio)

@@ -151,6 +151,30 @@ float rotation_from_points(float x0, float y0, float x1, float y1, int image_wid
 normalized_rect rotated_bounding_rect(const float* xy, int count, float rotation, int image_width,
                                       int image_height);
 
+/// LandmarksToDetection + DetectionsToRects (default conversion): the axis-aligned bounding
+/// box of `count` points (normalised, x and y read from `xy` with `stride_floats` floats per
+/// point) with the rotation that makes point `start` -> point `end` point to `target_angle`
+/// (radians). Returns false when count < 1, start or end is out of range, or a point is not
+/// finite.
+bool points_to_rect(const float* xy, int count, int stride_floats, int start, int end,
+                    float target_angle, int image_width, int image_height, normalized_rect& out);
+
+/// DetectionProjection: a detection decoded in fractions of the crop tensor (as
+/// decode_detections gives it) mapped through the crop's transform to normalised image
+/// coordinates: keypoints exactly, the box as the axis-aligned box around its 4 projected
+/// corners.
+detection project_detection(const crop_transform& transform, const detection& d);
+
+/// Intersection over union of two regions, as MediaPipe's AssociationNormRectCalculator
+/// measures them: axis-aligned boxes (the rotation is ignored) in pixels. 0 when they do not
+/// overlap or on an empty union.
+float normalized_rect_iou(const normalized_rect& a, const normalized_rect& b, int image_width,
+                          int image_height);
+
+/// Whether the point (x, y) (normalised) lies inside the rotated region `r`.
+bool normalized_rect_contains(const normalized_rect& r, float x, float y, int image_width,
+                              int image_height);
+
 /// MediaPipe's angle normalisation into [-pi, pi).
 float normalize_radians(float angle);
 

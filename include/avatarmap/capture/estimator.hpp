@@ -1,6 +1,7 @@
 // The pluggable landmark estimator: an image in, a landmark frame out. Backends are listed
 // in one table (estimator_backends()); "replay" (recorded landmarks) is always built, so
-// everything downstream is testable without models. The ONNX backend arrives with capture.
+// everything downstream is testable without models; "onnx" runs MediaPipe's models
+// (capture/*_pipeline.hpp).
 #pragma once
 
 #include <cstdint>
@@ -39,8 +40,26 @@ struct estimate_args {
 struct estimator_options {
   std::string source;  // replay: the *.landmarks.jsonl path; onnx: the models folder
   int threads = 1;
-  int model_complexity = 1;    // onnx: pose landmark model 0 lite, 1 full, 2 heavy
-  bool static_images = false;  // onnx: detect on every frame (no tracking between frames)
+  int model_complexity = 1;       // onnx: pose landmark model 0 lite, 1 full, 2 heavy
+  bool static_images = false;     // onnx: detect on every frame (no tracking between frames)
+  bool hands = false;             // onnx: load the hand models (estimate_args::hands then works)
+  bool face = false;              // onnx: load the face models (estimate_args::face then works)
+  int hand_model_complexity = 1;  // onnx: hand landmark model 0 lite, 1 full
+  /// onnx: the images are mirrored (a selfie preview). Sides in the output are always the
+  /// person's own; this only tells the hand model's handedness how to read the image.
+  bool mirrored_input = false;
+};
+
+/// Where the time of the last estimate() went, milliseconds (0 for a stage that did not run).
+struct estimator_timings {
+  double total_ms = 0.0;
+  double pose_detector_ms = 0.0;
+  double pose_landmark_ms = 0.0;
+  double palm_detector_ms = 0.0;
+  double hand_landmark_ms = 0.0;  // both hands together
+  double face_detector_ms = 0.0;
+  double face_mesh_ms = 0.0;
+  int detector_runs = 0;  // detectors (pose, palm, face) run for this frame
 };
 
 class estimator {
@@ -52,6 +71,8 @@ class estimator {
   virtual status estimate(const estimate_args& args, landmark_frame& out) = 0;
   /// Backend name as listed in estimator_backends().
   virtual std::string_view name() const = 0;
+  /// Per-stage timings of the last estimate(), or nullptr for a backend without stages.
+  virtual const estimator_timings* last_timings() const { return nullptr; }
 };
 
 /// One row of the backend table.

@@ -1,5 +1,5 @@
-// The "onnx" estimator backend (AVATARMAP_HAVE_ONNX): the body part for now (pose_pipeline);
-// hands and face are not estimated yet.
+// The "onnx" estimator backend (AVATARMAP_HAVE_ONNX): body, hands and face through
+// pose_pipeline, hand_pipeline and face_pipeline.
 #pragma once
 
 #include <memory>
@@ -8,8 +8,10 @@
 
 namespace avatarmap {
 
-/// Creates the backend: options.source is the folder of converted models (pose_detection.onnx,
-/// pose_landmark_full.onnx), options.threads the ORT intra-op threads.
+/// Creates the backend: options.source is the folder of converted models, options.threads the
+/// ORT intra-op threads of each model; the hand and face models are loaded only when
+/// options.hands / options.face ask for them (estimate_args::hands/face are ignored
+/// otherwise).
 status create_onnx_estimator(const estimator_options& options, std::unique_ptr<estimator>& out);
 
 }  // namespace avatarmap

@@ -1,0 +1,126 @@
+#include "cli/capture_setup.hpp"
+
+#include <cstdlib>
+#include <fstream>
+
+namespace avatarmap::cli {
+
+const char* const k_estimator_options_help =
+    "  --model lite|full|heavy  pose landmark model (default full)\n"
+    "  --hands / --no-hands  estimate both hands (21 points each, image + world)\n"
+    "  --face / --no-face    estimate the face mesh (468 points)\n"
+    "  --hand-model lite|full  hand landmark model (default full)\n"
+    "  --mirrored            the input is mirrored (a selfie preview); sides stay the person's\n"
+    "  --threads N           ONNX Runtime threads per model (default 1: the decoder and the\n"
+    "                        other process on a 2-core machine keep the other core)\n"
+    "  --models DIR          converted models (default: $AVATARMAP_MODELS/onnx, else the cache\n"
+    "                        scripts/prepare_capture.sh fills)\n"
+    "  --static              detect on every frame (images unrelated to each other)\n";
+
+namespace {
+
+std::string default_models_dir() {
+  if (const char* m = std::getenv("AVATARMAP_MODELS"); m && *m) return std::string(m) + "/onnx";
+#ifdef AVATARMAP_DEFAULT_MODELS_DIR
+  return AVATARMAP_DEFAULT_MODELS_DIR;
+#else
+  return ".cache/avatarmap/models/onnx";
+#endif
+}
+
+}  // namespace
+
+bool parse_estimator_options(args& a, bool hands_face_default, estimator_cli& out,
+                             std::string& error) {
+  estimator_options& o = out.options;
+  o.source = default_models_dir();
+  std::string model = "full", hand_model = "full";
+  a.value("--model", model);
+  a.value("--hand-model", hand_model);
+  a.value("--models", o.source);
+  double threads = 1;
+  a.number("--threads", threads);
+  o.static_images = a.flag("--static");
+  o.mirrored_input = a.flag("--mirrored");
+  o.hands = hands_face_default;
+  o.face = hands_face_default;
+  if (a.flag("--hands")) o.hands = true;
+  if (a.flag("--no-hands")) o.hands = false;
+  if (a.flag("--face")) o.face = true;
+  if (a.flag("--no-face")) o.face = false;
+  o.model_complexity = model == "lite" ? 0 : model == "full" ? 1 : model == "heavy" ? 2 : -1;
+  o.hand_model_complexity = hand_model == "lite" ? 0 : hand_model == "full" ? 1 : -1;
+  if (o.model_complexity < 0) {
+    error = "--model is lite, full or heavy";
+    return false;
+  }
+  if (o.hand_model_complexity < 0) {
+    error = "--hand-model is lite or full";
+    return false;
+  }
+  if (!(threads >= 1 && threads <= 64)) {
+    error = "--threads must be 1..64";
+    return false;
+  }
+  o.threads = static_cast<int>(threads);
+  return true;
+}
+
+status make_estimator(const estimator_cli& cli, std::unique_ptr<estimator>& out) {
+  status st = create_estimator("onnx", cli.options, out);
+  if (!st.ok())
+    return status::error(st.message() +
+                         " (scripts/prepare_capture.sh fetches and converts the "
+                         "models; --models DIR points elsewhere)");
+  return {};
+}
+
+void timing_totals::add(const estimator_timings& t) {
+  sum.total_ms += t.total_ms;
+  sum.pose_detector_ms += t.pose_detector_ms;
+  sum.pose_landmark_ms += t.pose_landmark_ms;
+  sum.palm_detector_ms += t.palm_detector_ms;
+  sum.hand_landmark_ms += t.hand_landmark_ms;
+  sum.face_detector_ms += t.face_detector_ms;
+  sum.face_mesh_ms += t.face_mesh_ms;
+  sum.detector_runs += t.detector_runs;
+  pose_detector_frames += t.pose_detector_ms > 0;
+  palm_frames += t.palm_detector_ms > 0;
+  face_detector_frames += t.face_detector_ms > 0;
+  ++frames;
+}
+
+void timing_totals::print(std::FILE* to) const {
+  if (frames == 0) return;
+  const double n = static_cast<double>(frames);
+  std::fprintf(to, "per frame (ms, mean over %ld frames): estimate %.2f", frames, sum.total_ms / n);
+  auto stage = [&](const char* name, double ms) {
+    if (ms > 0) std::fprintf(to, ", %s %.2f", name, ms / n);
+  };
+  stage("pose landmarks", sum.pose_landmark_ms);
+  stage("hand landmarks", sum.hand_landmark_ms);
+  stage("face mesh", sum.face_mesh_ms);
+  std::fputc('\n', to);
+  auto detector = [&](const char* name, double ms, long runs) {
+    if (runs > 0) std::fprintf(to, "  %s ran on %ld frames, %.2f ms each\n", name, runs, ms / runs);
+  };
+  detector("pose detector", sum.pose_detector_ms, pose_detector_frames);
+  detector("palm detector", sum.palm_detector_ms, palm_frames);
+  detector("face detector", sum.face_detector_ms, face_detector_frames);
+}
+
+long resident_kib() {
+  std::ifstream f("/proc/self/status");
+  std::string key;
+  while (f >> key) {
+    if (key == "VmRSS:") {
+      long v = 0;
+      f >> v;
+      return v;
+    }
+    f.ignore(1 << 12, '\n');
+  }
+  return 0;
+}
+
+}  // namespace avatarmap::cli

@@ -1,0 +1,44 @@
+// What `capture`, `live` and `animate` share: the estimator options on the command line, the
+// ONNX estimator they make, and the per-stage timing summary.
+#pragma once
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "avatarmap/capture/estimator.hpp"
+#include "cli/cli_args.hpp"
+
+namespace avatarmap::cli {
+
+/// The options' help lines (for the commands' --help texts).
+extern const char* const k_estimator_options_help;
+
+struct estimator_cli {
+  estimator_options options;
+  bool body = true;
+};
+
+/// Reads --model, --hand-model, --threads, --models, --static, --hands, --face, --body-only,
+/// --mirrored. `hands_face_default` is what --hands/--face default to (animate: on). Returns
+/// false with a message for a bad value.
+bool parse_estimator_options(args& a, bool hands_face_default, estimator_cli& out,
+                             std::string& error);
+
+/// Creates the ONNX estimator; the error says how to get the models.
+status make_estimator(const estimator_cli& cli, std::unique_ptr<estimator>& out);
+
+/// Sums of estimator_timings over frames, for the summary line.
+struct timing_totals {
+  estimator_timings sum{};
+  long frames = 0;
+  long pose_detector_frames = 0, palm_frames = 0, face_detector_frames = 0;
+  void add(const estimator_timings& t);
+  /// Prints mean milliseconds per frame for each stage that ran.
+  void print(std::FILE* to) const;
+};
+
+/// Resident memory of this process in KiB (from /proc/self/status; 0 when unknown).
+long resident_kib();
+
+}  // namespace avatarmap::cli

@@ -1,0 +1,205 @@
+// `avatarmap live INPUT`: the latest-frame live loop (capture/live_capture.hpp). A camera, or
+// a file paced to its time stamps as a camera would deliver it; frames the estimator cannot
+// keep up with are dropped. Each processed frame is solved and pushed to the pose resampler;
+// an output thread samples it at --fps (a higher rate than capture) into OUT.pose.jsonl.
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "avatarmap/capture/live_capture.hpp"
+#include "avatarmap/capture/video_source.hpp"
+#include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/solve/frame_solver.hpp"
+#include "avatarmap/time/pose_resampler.hpp"
+#include "cli/capture_setup.hpp"
+#include "cli/commands.hpp"
+
+namespace avatarmap::cli {
+namespace {
+
+const char* k_live_help =
+    "Usage: avatarmap live INPUT [-o OUT.pose.jsonl] [options]\n"
+    "\n"
+    "Runs the capture live: INPUT is a camera (v4l2:/dev/video0, where FFmpeg's devices are\n"
+    "built in) or a file, which is then delivered at its own frame rate as a camera would.\n"
+    "Only the newest frame is processed; frames that arrive while the estimator is busy are\n"
+    "dropped and counted. Each result is solved into a proxy pose and handed to the\n"
+    "resampler, and the output runs at --fps from it (slerp between captured frames, short\n"
+    "extrapolation past the newest). Prints capture rate, drops and latency (frame delivered\n"
+    "-> pose ready).\n"
+    "\n"
+    "Options:\n"
+    "  -o, --output PATH     write the resampled poses (*.pose.jsonl, atomically)\n"
+    "  --fps N               output rate (default 60)\n"
+    "  --seconds S           stop after S seconds (default: when the input ends)\n"
+    "  --unpaced             deliver file frames as fast as they decode (stress test)\n"
+    "  --quiet               no progress line and no summary\n"
+    "\n"
+    "Estimator options (hands and face off unless asked):\n";
+
+}  // namespace
+
+int run_live_command(int argc, char** argv) {
+  args a(argc, argv, 2);
+  if (a.flag("--help") || a.flag("-h")) {
+    std::fputs(k_live_help, stdout);
+    std::fputs(k_estimator_options_help, stdout);
+    return 0;
+  }
+  std::string out_path, error;
+  a.value("--output", out_path, "-o");
+  double out_fps = 60.0, seconds = 0.0;
+  a.number("--fps", out_fps);
+  a.number("--seconds", seconds);
+  const bool unpaced = a.flag("--unpaced");
+  const bool quiet = a.flag("--quiet");
+  const bool progress = !quiet && isatty(STDERR_FILENO);
+  estimator_cli ec;
+  if (!parse_estimator_options(a, false, ec, error)) {
+    std::fprintf(stderr, "avatarmap live: %s\n", error.c_str());
+    return 2;
+  }
+  if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 1) {
+    std::fprintf(stderr, "avatarmap live: %s\n",
+                 !a.error().empty() ? a.error().c_str() : "give exactly one input (see --help)");
+    return 2;
+  }
+  if (!(out_fps > 0 && out_fps <= 1000) || !(seconds >= 0)) {
+    std::fprintf(stderr, "avatarmap live: --fps must be in (0, 1000], --seconds >= 0\n");
+    return 2;
+  }
+  video_source source;
+  video_source_quiet_log(true);
+  status st = source.open(a.rest()[0]);
+  if (!st.ok()) {
+    std::fprintf(stderr, "avatarmap live: %s\n", st.message().c_str());
+    return 1;
+  }
+  std::unique_ptr<estimator> est;
+  st = make_estimator(ec, est);
+  if (!st.ok()) {
+    std::fprintf(stderr, "avatarmap live: %s\n", st.message().c_str());
+    return 1;
+  }
+  const video_info info = source.info();
+  solver_options so;
+  so.image_width = static_cast<float>(info.width);
+  so.image_height = static_cast<float>(info.height);
+  frame_solver solver(so);
+  pose_writer writer;
+  const bool writing = !out_path.empty();
+  if (!out_path.empty()) {
+    pose_file_header h;
+    h.fps = out_fps;
+    st = writer.open(out_path, h);
+    if (!st.ok()) {
+      std::fprintf(stderr, "avatarmap live: %s\n", st.message().c_str());
+      return 1;
+    }
+  }
+
+  // Stream time: the capture clock of the newest processed frame, advanced by wall time.
+  using clock_type = std::chrono::steady_clock;
+  std::mutex m;
+  pose_resampler resampler;
+  bool have_pose = false;
+  double stream_t = 0.0;                 // capture time of the newest pose
+  clock_type::time_point stream_wall{};  // when it was pushed
+  std::atomic<bool> done{false};
+  long written = 0;
+  status write_status;
+  std::thread output([&] {
+    proxy_pose p;
+    const auto period = std::chrono::duration_cast<clock_type::duration>(
+        std::chrono::duration<double>(1.0 / out_fps));
+    auto next = clock_type::now();
+    while (!done.load()) {
+      next += period;
+      std::this_thread::sleep_until(next);
+      std::lock_guard<std::mutex> lock(m);
+      if (!have_pose) continue;
+      const double t =
+          stream_t + std::chrono::duration<double>(clock_type::now() - stream_wall).count();
+      if (!resampler.sample(t, p)) continue;
+      p.t = t;
+      if (writing && write_status.ok()) write_status = writer.write(p);
+      ++written;
+    }
+  });
+
+  landmark_frame frame;
+  proxy_pose pose;
+  estimate_args ea;
+  ea.hands = ec.options.hands;
+  ea.face = ec.options.face;
+  timing_totals timings;
+  long with_body = 0;
+  auto last_progress = clock_type::now();
+  live_options lo;
+  lo.pace_to_timestamps = !unpaced;
+  lo.max_seconds = seconds;
+  live_stats stats;
+  status est_status;
+  st = run_live([&](image_view& v, double& t) { return source.next(v, t); },
+                [&](const image_view& img, const live_frame_info& info_) {
+                  ea.image = img;
+                  ea.t = info_.t;
+                  est_status = est->estimate(ea, frame);
+                  if (!est_status.ok()) return false;
+                  frame.t = info_.t;
+                  if (const estimator_timings* et = est->last_timings()) timings.add(*et);
+                  with_body += frame.has(frame_part::pose);
+                  solver.solve(frame, pose);
+                  {
+                    std::lock_guard<std::mutex> lock(m);
+                    resampler.push(pose);
+                    have_pose = true;
+                    stream_t = pose.t;
+                    stream_wall = clock_type::now();
+                  }
+                  if (progress) {
+                    const auto now = clock_type::now();
+                    if (std::chrono::duration<double>(now - last_progress).count() > 0.5) {
+                      last_progress = now;
+                      std::fprintf(stderr, "\rlive: t %.1f s, %ld dropped so far   ", info_.t,
+                                   info_.dropped_so_far);
+                      std::fflush(stderr);
+                    }
+                  }
+                  return true;
+                },
+                lo, stats);
+  done.store(true);
+  output.join();
+  if (st.ok()) st = est_status;
+  if (st.ok()) st = write_status;
+  if (st.ok() && writing) st = writer.commit();
+  if (!st.ok()) {
+    std::fprintf(stderr, "avatarmap live: %s\n", st.message().c_str());
+    return 1;
+  }
+  if (progress) std::fputs("\r", stderr);
+  if (quiet) return 0;
+  std::fprintf(stderr,
+               "live: %ld frames delivered in %.2f s, %ld processed (%.1f/s), %ld dropped; body in "
+               "%ld\n",
+               stats.grabbed, stats.wall_seconds, stats.processed,
+               stats.processed / (stats.wall_seconds > 0 ? stats.wall_seconds : 1.0), stats.dropped,
+               with_body);
+  std::fprintf(stderr,
+               "latency (frame delivered -> pose ready): mean %.1f ms, median %.1f, p95 %.1f, "
+               "max %.1f\n",
+               stats.latency_mean_ms, stats.latency_p50_ms, stats.latency_p95_ms,
+               stats.latency_max_ms);
+  timings.print(stderr);
+  std::fprintf(stderr, "output: %ld poses at %.0f fps%s%s\n", written, out_fps,
+               out_path.empty() ? "" : " -> ", out_path.c_str());
+  return 0;
+}
+
+}  // namespace avatarmap::cli
