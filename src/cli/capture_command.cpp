@@ -3,9 +3,12 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include "avatarmap/capture/estimator.hpp"
 #include "avatarmap/capture/video_source.hpp"
@@ -14,6 +17,7 @@
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/overlay_output.hpp"
+#include "cli/prefetch_ring.hpp"
 
 namespace avatarmap::cli {
 namespace {
@@ -108,72 +112,104 @@ int run_capture(int argc, char** argv) {
     return 1;
   }
 
+  // Frames are decoded on a second thread, a few ahead of the estimator (prefetch_ring):
+  // decoding then overlaps inference. With --loop the decoder reopens the input and keeps
+  // the clock running one frame period past the last frame.
+  struct decoded {
+    std::vector<std::uint8_t> pixels;
+    image_view view{};
+    double t = 0.0;
+    read_result kind = read_result::end;
+    std::string error;
+  };
+  const long passes = static_cast<long>(loops);
+  long pass = 0;
+  double t_offset = 0.0, t_last = 0.0;
+  auto decode = [&](decoded& d) {
+    for (;;) {
+      image_view v;
+      double t = 0.0;
+      d.kind = source.next(v, t);
+      if (d.kind == read_result::end && ++pass < passes) {
+        t_offset = t_last + (info.fps > 0 ? 1.0 / info.fps : 1.0 / 30.0);
+        const status o = source.open(input);
+        if (o.ok()) continue;
+        d.kind = read_result::error;
+        d.error = o.message();
+        return false;
+      }
+      if (d.kind == read_result::end) return false;
+      if (d.kind == read_result::error) {
+        d.error = source.error();
+        return true;
+      }
+      const size_t row = static_cast<size_t>(v.width) * 3;
+      if (d.pixels.size() < row * static_cast<size_t>(v.height))
+        d.pixels.resize(row * static_cast<size_t>(v.height));
+      for (int y = 0; y < v.height; ++y)
+        std::memcpy(d.pixels.data() + row * y, v.data + static_cast<size_t>(v.stride_bytes) * y,
+                    row);
+      d.view = {d.pixels.data(), v.width, v.height, static_cast<int>(row), v.format};
+      d.t = t + t_offset;
+      t_last = d.t;
+      return true;
+    }
+  };
+
   using clock_type = std::chrono::steady_clock;
   const auto t0 = clock_type::now();
   auto last = t0;
   long frames = 0, errors = 0, part_frames[k_frame_part_count] = {};
   long rss_warm = 0, rss_peak = 0;
   timing_totals timings;
-  image_view image;
-  double t = 0.0, t_offset = 0.0, t_last = 0.0;
   landmark_frame frame;
   estimate_args ea;
   ea.body = ec.body;
   ea.hands = ec.options.hands;
   ea.face = ec.options.face;
-  for (long pass = 0; pass < static_cast<long>(loops); ++pass) {
-    if (pass > 0) {
-      // The next pass continues the clock one frame period after the last frame.
-      t_offset = t_last + (info.fps > 0 ? 1.0 / info.fps : 1.0 / 30.0);
-      st = source.open(input);
-      if (!st.ok()) {
-        std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
-        return 1;
-      }
+  prefetch_ring<decoded> ring(3, decode);
+  for (;;) {
+    decoded& d = ring.next();
+    if (d.kind == read_result::end) break;
+    if (d.kind == read_result::error) {
+      ++errors;
+      std::fprintf(stderr, "warning: %s\n", d.error.c_str());
+      ring.release();
+      continue;
     }
-    for (;;) {
-      const read_result r = source.next(image, t);
-      if (r == read_result::end) break;
-      if (r == read_result::error) {
-        ++errors;
-        std::fprintf(stderr, "warning: %s\n", source.error().c_str());
-        continue;
-      }
-      ea.image = image;
-      ea.t = t + t_offset;
-      t_last = ea.t;
-      st = est->estimate(ea, frame);
-      if (!st.ok()) {
-        std::fprintf(stderr, "avatarmap capture: frame at %.3f s: %s\n", ea.t,
-                     st.message().c_str());
-        return 1;
-      }
-      frame.t = ea.t;
-      for (int p = 0; p < k_frame_part_count; ++p)
-        part_frames[p] += frame.has(static_cast<frame_part>(p));
-      if (const estimator_timings* et = est->last_timings()) timings.add(*et);
-      st = writer.write(frame);
-      if (st.ok() && overlay.is_open()) st = overlay.write(image, frame);
-      if (!st.ok()) {
-        std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
-        return 1;
-      }
-      ++frames;
-      if (frames == 100) rss_warm = resident_kib();
-      if (frames % 100 == 0) rss_peak = std::max(rss_peak, resident_kib());
-      if (progress) {
-        const auto now = clock_type::now();
-        if (std::chrono::duration<double>(now - last).count() > 0.5) {
-          last = now;
-          const double el = std::chrono::duration<double>(now - t0).count();
-          const double total = static_cast<double>(info.frame_count) * loops;
-          if (total > 0)
-            std::fprintf(stderr, "\rcapture: %ld/%.0f frames (%.0f%%), %.1f frames/s   ", frames,
-                         total, 100.0 * frames / total, frames / el);
-          else
-            std::fprintf(stderr, "\rcapture: %ld frames, %.1f frames/s   ", frames, frames / el);
-          std::fflush(stderr);
-        }
+    ea.image = d.view;
+    ea.t = d.t;
+    st = est->estimate(ea, frame);
+    if (!st.ok()) {
+      std::fprintf(stderr, "avatarmap capture: frame at %.3f s: %s\n", ea.t, st.message().c_str());
+      return 1;
+    }
+    frame.t = ea.t;
+    for (int p = 0; p < k_frame_part_count; ++p)
+      part_frames[p] += frame.has(static_cast<frame_part>(p));
+    if (const estimator_timings* et = est->last_timings()) timings.add(*et);
+    st = writer.write(frame);
+    if (st.ok() && overlay.is_open()) st = overlay.write(d.view, frame);
+    ring.release();
+    if (!st.ok()) {
+      std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
+      return 1;
+    }
+    ++frames;
+    if (frames == 100) rss_warm = resident_kib();
+    if (frames % 100 == 0) rss_peak = std::max(rss_peak, resident_kib());
+    if (progress) {
+      const auto now = clock_type::now();
+      if (std::chrono::duration<double>(now - last).count() > 0.5) {
+        last = now;
+        const double el = std::chrono::duration<double>(now - t0).count();
+        const double total = static_cast<double>(info.frame_count) * loops;
+        if (total > 0)
+          std::fprintf(stderr, "\rcapture: %ld/%.0f frames (%.0f%%), %.1f frames/s   ", frames,
+                       total, 100.0 * frames / total, frames / el);
+        else
+          std::fprintf(stderr, "\rcapture: %ld frames, %.1f frames/s   ", frames, frames / el);
+        std::fflush(stderr);
       }
     }
   }

@@ -11,8 +11,10 @@ const char* const k_estimator_options_help =
     "  --face / --no-face    estimate the face mesh (468 points)\n"
     "  --hand-model lite|full  hand landmark model (default full)\n"
     "  --mirrored            the input is mirrored (a selfie preview); sides stay the person's\n"
-    "  --threads N           ONNX Runtime threads per model (default 1: the decoder and the\n"
-    "                        other process on a 2-core machine keep the other core)\n"
+    "  --threads N           ONNX Runtime threads, one pool for all models (default 2; 1 is\n"
+    "                        better when another process keeps a core busy)\n"
+    "  --spin                let ONNX Runtime's threads spin between operators: faster on an\n"
+    "                        idle machine, much slower when another process is busy\n"
     "  --models DIR          converted models (default: $AVATARMAP_MODELS/onnx, else the cache\n"
     "                        scripts/prepare_capture.sh fills)\n"
     "  --static              detect on every frame (images unrelated to each other)\n";
@@ -38,10 +40,11 @@ bool parse_estimator_options(args& a, bool hands_face_default, estimator_cli& ou
   a.value("--model", model);
   a.value("--hand-model", hand_model);
   a.value("--models", o.source);
-  double threads = 1;
+  double threads = 2;
   a.number("--threads", threads);
   o.static_images = a.flag("--static");
   o.mirrored_input = a.flag("--mirrored");
+  o.spin = a.flag("--spin");
   o.hands = hands_face_default;
   o.face = hands_face_default;
   if (a.flag("--hands")) o.hands = true;

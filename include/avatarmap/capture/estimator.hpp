@@ -39,7 +39,10 @@ struct estimate_args {
 /// Options given when a backend is created; a struct for the same reason.
 struct estimator_options {
   std::string source;  // replay: the *.landmarks.jsonl path; onnx: the models folder
-  int threads = 1;
+  int threads = 1;     // onnx: ORT intra-op threads (one pool shared by all models)
+  /// onnx: let ORT's threads spin between operators: faster on an idle machine, much slower
+  /// when another process holds a core (docs/capture.md has the measurements).
+  bool spin = false;
   int model_complexity = 1;       // onnx: pose landmark model 0 lite, 1 full, 2 heavy
   bool static_images = false;     // onnx: detect on every frame (no tracking between frames)
   bool hands = false;             // onnx: load the hand models (estimate_args::hands then works)

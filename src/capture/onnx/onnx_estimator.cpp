@@ -81,6 +81,7 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
   pose_pipeline_options po;
   po.models_dir = options.source;
   po.intra_op_threads = threads;
+  po.allow_spinning = options.spin;
   po.complexity = static_cast<pose_model_complexity>(options.model_complexity);
   po.static_images = options.static_images;
   std::unique_ptr<pose_pipeline> pose;
@@ -94,6 +95,7 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
     ho.intra_op_threads = threads;
     ho.complexity = static_cast<hand_model_complexity>(options.hand_model_complexity);
     ho.mirrored_input = options.mirrored_input;
+    ho.allow_spinning = po.allow_spinning;
     ho.static_images = options.static_images;
     s = hand_pipeline::create(ho, hands);
     if (!s.ok()) return s;
@@ -103,6 +105,7 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
     face_pipeline_options fo;
     fo.models_dir = options.source;
     fo.intra_op_threads = threads;
+    fo.allow_spinning = po.allow_spinning;
     fo.static_images = options.static_images;
     s = face_pipeline::create(fo, face);
     if (!s.ok()) return s;

@@ -1,19 +1,60 @@
 #include "ort_model.hpp"
 
+#include <mutex>
+
 namespace avatarmap {
 
+namespace {
+
+// The process-wide environment and its global intra-op thread pool. ORT allows one Env per
+// process; the first call decides the pool's size and spinning. Sessions asking for exactly
+// that share the pool (one set of threads for every model, so that spinning threads of
+// idle sessions never compete with the running one); others get their own threads.
+struct env_state {
+  std::mutex m;
+  std::unique_ptr<Ort::Env> env;
+  int pool_threads = 0;
+  bool pool_spinning = false;
+};
+
+env_state& state() {
+  static env_state s;
+  return s;
+}
+
+void create_env_locked(env_state& s, int threads, bool spinning) {
+  Ort::ThreadingOptions tp;
+  tp.SetGlobalIntraOpNumThreads(threads);
+  tp.SetGlobalInterOpNumThreads(1);
+  tp.SetGlobalSpinControl(spinning ? 1 : 0);
+  s.env = std::make_unique<Ort::Env>(tp, ORT_LOGGING_LEVEL_WARNING, "avatarmap");
+  s.pool_threads = threads;
+  s.pool_spinning = spinning;
+}
+
+}  // namespace
+
 Ort::Env& ort_env() {
-  static Ort::Env env(ORT_LOGGING_LEVEL_WARNING, "avatarmap");
-  return env;
+  env_state& s = state();
+  std::lock_guard<std::mutex> lock(s.m);
+  if (!s.env) create_env_locked(s, 1, false);
+  return *s.env;
 }
 
 Ort::SessionOptions make_session_options(int threads, bool allow_spinning) {
+  env_state& s = state();
+  std::lock_guard<std::mutex> lock(s.m);
+  if (!s.env) create_env_locked(s, threads, allow_spinning);
   Ort::SessionOptions so;
-  so.SetIntraOpNumThreads(threads);
-  so.SetInterOpNumThreads(1);
   so.SetExecutionMode(ExecutionMode::ORT_SEQUENTIAL);
   so.SetGraphOptimizationLevel(GraphOptimizationLevel::ORT_ENABLE_ALL);
-  so.AddConfigEntry("session.intra_op.allow_spinning", allow_spinning ? "1" : "0");
+  if (threads == s.pool_threads && allow_spinning == s.pool_spinning) {
+    so.DisablePerSessionThreads();
+  } else {
+    so.SetIntraOpNumThreads(threads);
+    so.SetInterOpNumThreads(1);
+    so.AddConfigEntry("session.intra_op.allow_spinning", allow_spinning ? "1" : "0");
+  }
   return so;
 }
 

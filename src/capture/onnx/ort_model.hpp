@@ -22,11 +22,15 @@ inline double ms_since(std::chrono::steady_clock::time_point t0) {
 
 inline float sigmoid(float x) { return 1.f / (1.f + std::exp(-x)); }
 
-/// The process-wide ORT environment (created on first use).
+/// The process-wide ORT environment (created on first use, by make_session_options with its
+/// thread settings when that comes first).
 Ort::Env& ort_env();
 
-/// Sequential execution, full graph optimisation, `threads` intra-op threads; spinning off
-/// unless asked (a spinning pool doubles latency when another process holds a core).
+/// Sequential execution, full graph optimisation, `threads` intra-op threads, spinning as
+/// asked. The first call creates the environment with a global intra-op pool of these
+/// settings; every session asking for the same settings shares that pool, so the threads of
+/// idle models never compete with the running one (with per-session pools, five models'
+/// spinning threads halve the speed on 2 cores). Sessions with other settings get their own.
 Ort::SessionOptions make_session_options(int threads, bool allow_spinning);
 
 // One ORT session with its input and (a chosen subset of) outputs bound to buffers owned
