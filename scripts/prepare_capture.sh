@@ -38,4 +38,9 @@ hand_landmark_full
 face_detection_short_range
 face_landmark
 LIST
+# FLOPs per inference of each model, for bench/bench_models.cpp's share of the CPU's peak.
+if [ ! -f "$models/onnx/flops.json" ] || [ -n "$(find "$models/onnx" -name '*.onnx' -newer "$models/onnx/flops.json")" ]; then
+  /usr/bin/python3 "$root/tools/models/count_flops.py" "$models/onnx"/*.onnx \
+    --json "$models/onnx/flops.json" >/dev/null
+fi
 echo "prepare_capture: ONNX Runtime and $(ls "$models/onnx"/*.onnx | wc -l) ONNX models ready in $models/onnx"

@@ -59,7 +59,9 @@ status create_replay(const estimator_options& options, std::unique_ptr<estimator
 constexpr estimator_backend k_backends[] = {
     {"replay", "plays a recorded *.landmarks.jsonl file (always built)", &create_replay},
 #ifdef AVATARMAP_HAVE_ONNX
-    {"onnx", "MediaPipe's models under ONNX Runtime; source: the models folder (body only)",
+    {"onnx",
+     "MediaPipe's models under ONNX Runtime; source: the models folder (body; hands and face when "
+     "asked)",
      &create_onnx_estimator},
 #endif
 };

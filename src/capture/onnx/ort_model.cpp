@@ -108,7 +108,17 @@ std::string bound_model::load(const std::string& path, const Ort::SessionOptions
   return {};
 }
 
+namespace {
+thread_local int t_run_depth = 0;
+}
+
+int ort_run_depth() noexcept { return t_run_depth; }
+
 void bound_model::run() {
+  struct depth_guard {
+    depth_guard() { ++t_run_depth; }
+    ~depth_guard() { --t_run_depth; }
+  } guard;
   const char* in = input_name.c_str();
   session->Run(Ort::RunOptions{nullptr}, &in, &input_value, 1, output_name_ptrs.data(),
                output_values.data(), output_values.size());

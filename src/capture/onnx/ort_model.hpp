@@ -22,6 +22,10 @@ inline double ms_since(std::chrono::steady_clock::time_point t0) {
 
 inline float sigmoid(float x) { return 1.f / (1.f + std::exp(-x)); }
 
+/// How many bound_model::run() calls are under way on this thread (0 or 1): lets a test
+/// count the heap allocations of the pipelines outside ONNX Runtime.
+int ort_run_depth() noexcept;
+
 /// The process-wide ORT environment (created on first use, by make_session_options with its
 /// thread settings when that comes first).
 Ort::Env& ort_env();

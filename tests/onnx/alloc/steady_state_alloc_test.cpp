@@ -1,0 +1,67 @@
+// No heap allocation per frame in the capture pipelines' steady state outside ONNX Runtime:
+// the onnx estimator (body, hands, face; one thread, so ORT runs everything on this thread
+// inside bound_model::run) tracks pose.jpg frame after frame while a replaced global
+// operator new counts the allocations made outside ORT's Run. Its own executable, so the
+// replacement affects no other test.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+#include <string>
+
+#include "../onnx_support.hpp"
+#include "avatarmap/capture/estimator.hpp"
+#include "capture/onnx/ort_model.hpp"
+#include "support/test_data.hpp"
+
+namespace {
+std::atomic<long> g_outside{0};
+std::atomic<bool> g_counting{false};
+}  // namespace
+
+void* operator new(std::size_t n) {
+  if (g_counting.load(std::memory_order_relaxed) && avatarmap::ort_run_depth() == 0)
+    g_outside.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace avatarmap {
+namespace {
+
+TEST(steady_state, no_allocation_outside_onnx_runtime) {
+  const std::string models = test::models_dir();
+  if (models.empty()) GTEST_SKIP() << "AVATARMAP_MODELS is not set (folder of converted models)";
+  if (test::test_data_dir().empty()) GTEST_SKIP() << test::k_no_test_data;
+  test::loaded_image img;
+  ASSERT_TRUE(test::load_image(test::test_data_path("motion/tfjs-models/pose.jpg"), img));
+  estimator_options o;
+  o.source = models;
+  o.threads = 1;
+  o.hands = o.face = true;
+  std::unique_ptr<estimator> est;
+  const status s = create_estimator("onnx", o, est);
+  ASSERT_TRUE(s.ok()) << s.message();
+  landmark_frame f;
+  estimate_args a;
+  a.image = img.view();
+  int parts = 0;
+  for (int i = 0; i < 40; ++i) {
+    a.t = i / 30.0;
+    if (i == 10) g_counting = true;  // after warm-up: tracking, buffers sized
+    ASSERT_TRUE(est->estimate(a, f).ok());
+    parts |= static_cast<int>(f.parts);
+  }
+  g_counting = false;
+  EXPECT_TRUE(f.has(frame_part::pose));
+  EXPECT_TRUE(f.has(frame_part::face));
+  std::printf("[figures] parts seen: 0x%x; allocations outside ONNX Runtime in 30 frames: %ld\n",
+              parts, g_outside.load());
+  EXPECT_EQ(g_outside.load(), 0);
+}
+
+}  // namespace
+}  // namespace avatarmap
