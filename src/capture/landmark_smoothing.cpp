@@ -41,6 +41,47 @@ void mediapipe_one_euro::reset() noexcept {
   dx_ = {};
 }
 
+double mediapipe_velocity_filter::apply(double t, double value_scale, double value) noexcept {
+  if (has_ && !(t > last_t_)) return value;
+  double alpha = 1.0;
+  if (has_) {
+    const double distance = value * value_scale - last_value_ * last_scale_;
+    const double duration = t - last_t_;
+    double cum_distance = distance, cum_duration = duration;
+    // MediaPipe assumes 30 values a second: older steps count only while they fit in
+    // (1 + window) thirtieths of a second.
+    const double max_duration = (1 + window_count_) / 30.0;
+    for (int i = 0; i < window_count_; ++i) {
+      if (cum_duration + window_[i].duration > max_duration) break;
+      cum_distance += window_[i].distance;
+      cum_duration += window_[i].duration;
+    }
+    const double velocity = cum_distance / cum_duration;
+    alpha = 1.0 - 1.0 / (1.0 + params_.velocity_scale * std::fabs(velocity));
+    const int cap = std::clamp(params_.window_size, 1, k_capacity);
+    for (int i = std::min(window_count_, cap - 1); i > 0; --i) window_[i] = window_[i - 1];
+    window_[0] = {distance, duration};
+    window_count_ = std::min(window_count_ + 1, cap);
+  }
+  last_value_ = value;
+  last_scale_ = value_scale;
+  last_t_ = t;
+  stored_ = has_ ? alpha * value + (1.0 - alpha) * stored_ : value;
+  has_ = true;
+  return stored_;
+}
+
+void mediapipe_velocity_filter::reset() noexcept {
+  has_ = false;
+  window_count_ = 0;
+}
+
+landmark_smoother::landmark_smoother(const mediapipe_velocity_params& params) noexcept
+    : velocity_(true) {
+  for (auto& f : velocity_filters_)
+    for (auto& c : f) c.set_params(params);
+}
+
 landmark_smoother::landmark_smoother(const mediapipe_one_euro_params& params) noexcept
     : params_(params) {
   for (auto& f : filters_)
@@ -48,14 +89,19 @@ landmark_smoother::landmark_smoother(const mediapipe_one_euro_params& params) no
 }
 
 void landmark_smoother::reset() noexcept {
-  for (int i = 0; i < count_; ++i)
-    for (auto& c : filters_[i]) c.reset();
+  for (int i = 0; i < count_; ++i) {
+    if (velocity_) {
+      for (auto& c : velocity_filters_[i]) c.reset();
+    } else {
+      for (auto& c : filters_[i]) c.reset();
+    }
+  }
   count_ = 0;
 }
 
 void landmark_smoother::apply(double t, landmark* p, int count, bool normalized, int image_width,
                               int image_height) noexcept {
-  count = std::clamp(count, 0, k_max_smoothed_points);
+  count = std::clamp(count, 0, velocity_ ? k_max_velocity_points : k_max_smoothed_points);
   if (count != count_) reset();
   const double sx = normalized ? image_width : 1.0;
   const double sy = normalized ? image_height : 1.0;
@@ -81,6 +127,16 @@ void landmark_smoother::apply(double t, landmark* p, int count, bool normalized,
   // Object scale: the mean side of the bounding box (pixels for image landmarks).
   const double object_scale = ((x1 - x0) + (y1 - y0)) * 0.5;
   double value_scale = 1.0;
+  if (velocity_) {
+    if (object_scale < 1e-6) return;
+    value_scale = 1.0 / object_scale;
+    for (int i = 0; i < count; ++i) {
+      p[i].x = static_cast<float>(velocity_filters_[i][0].apply(t, value_scale, p[i].x * sx) / sx);
+      p[i].y = static_cast<float>(velocity_filters_[i][1].apply(t, value_scale, p[i].y * sy) / sy);
+      p[i].z = static_cast<float>(velocity_filters_[i][2].apply(t, value_scale, p[i].z * sz) / sz);
+    }
+    return;
+  }
   if (!params_.disable_value_scaling) {
     if (object_scale < params_.min_allowed_object_scale) return;  // too small: unfiltered
     value_scale = 1.0 / object_scale;

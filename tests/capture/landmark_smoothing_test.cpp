@@ -40,6 +40,33 @@ TEST(mediapipe_one_euro, speed_raises_the_cutoff) {
   EXPECT_GT(yf, 0.9);  // a fast move lifts the cutoff: little lag
 }
 
+TEST(mediapipe_velocity_filter, weight_follows_the_windowed_speed) {
+  mediapipe_velocity_filter f;
+  f.set_params({5, 10.f});
+  EXPECT_DOUBLE_EQ(f.apply(0.0, 1.0, 0.0), 0.0);  // the first value passes through
+  // Step to 1 in 1/30 s: speed 30 /s, weight 1 - 1 / (1 + 10 * 30) = 300 / 301.
+  const double y1 = 300.0 / 301.0;
+  EXPECT_NEAR(f.apply(1.0 / 30, 1.0, 1.0), y1, 1e-12);
+  // Still at 1: the window (2/30 s) holds both steps: speed 1 / (2/30) = 15 /s.
+  const double a2 = 1.0 - 1.0 / (1.0 + 10.0 * 15.0);
+  EXPECT_NEAR(f.apply(2.0 / 30, 1.0, 1.0), a2 + (1 - a2) * y1, 1e-12);
+  // A time that does not advance returns the value unfiltered.
+  EXPECT_DOUBLE_EQ(f.apply(2.0 / 30, 1.0, 5.0), 5.0);
+}
+
+TEST(mediapipe_velocity_filter, slow_frames_use_only_the_last_step_and_scale_matters) {
+  // At 5 frames/s a step (0.2 s) already fills the window's 1/30 s per element: only the
+  // newest step counts. value_scale divides the speed by the object's size.
+  mediapipe_velocity_filter f;
+  f.set_params({5, 10.f});
+  f.apply(0.0, 0.01, 0.0);
+  const double a1 = 1.0 - 1.0 / (1.0 + 10.0 * (100.0 * 0.01 / 0.2));
+  EXPECT_NEAR(f.apply(0.2, 0.01, 100.0), a1 * 100.0, 1e-9);
+  const double y1 = a1 * 100.0;
+  const double a2 = 1.0 - 1.0 / (1.0 + 10.0 * (0.0 / 0.2));  // no motion: holds
+  EXPECT_NEAR(f.apply(0.4, 0.01, 100.0), a2 * 100.0 + (1 - a2) * y1, 1e-9);
+}
+
 std::vector<landmark> points(float scale, float shift) {
   std::vector<landmark> p(5);
   for (int i = 0; i < 5; ++i) {
@@ -52,9 +79,16 @@ std::vector<landmark> points(float scale, float shift) {
 
 TEST(landmark_smoother, output_scales_with_the_object) {
   // Value scaling divides speeds by the object's size: the same motion at twice the size is
-  // filtered to exactly twice the output.
+  // filtered to exactly twice the output, with either filter.
   const mediapipe_one_euro_params prm{0.05f, 80.f, 1.f, false};
   landmark_smoother a(prm), b(prm);
+  landmark_smoother va(mediapipe_velocity_params{5, 10.f}), vb(mediapipe_velocity_params{5, 10.f});
+  for (int k = 0; k < 6; ++k) {
+    std::vector<landmark> p = points(1.f, 0.03f * k * k), q = points(2.f, 0.03f * k * k);
+    va.apply(0.2 * k, p.data(), 5, false, 0, 0);
+    vb.apply(0.2 * k, q.data(), 5, false, 0, 0);
+    for (int i = 0; i < 5; ++i) EXPECT_NEAR(q[i].y, 2 * p[i].y, 1e-5f);
+  }
   for (int k = 0; k < 6; ++k) {
     std::vector<landmark> p = points(1.f, 0.03f * k * k), q = points(2.f, 0.03f * k * k);
     a.apply(0.2 * k, p.data(), 5, false, 0, 0);

@@ -49,12 +49,44 @@ class mediapipe_one_euro {
   low_pass dx_;
 };
 
+/// MediaPipe's RelativeVelocityFilter (the "velocity_filter" of LandmarksSmoothingCalculator,
+/// which pose graphs used before the One Euro filter): a low-pass whose weight of the new
+/// value is 1 - 1 / (1 + velocity_scale * |speed|), the speed measured over up to
+/// window_size past steps (only as far back as 1/30 s per step) on values scaled by
+/// value_scale.
+struct mediapipe_velocity_params {
+  int window_size = 5;  // 1..16
+  float velocity_scale = 10.f;
+};
+
+class mediapipe_velocity_filter {
+ public:
+  double apply(double t, double value_scale, double value) noexcept;
+  void reset() noexcept;
+  void set_params(const mediapipe_velocity_params& p) noexcept { params_ = p; }
+
+ private:
+  struct step {
+    double distance = 0.0;
+    double duration = 0.0;
+  };
+  static constexpr int k_capacity = 16;
+  mediapipe_velocity_params params_{};
+  step window_[k_capacity];
+  int window_count_ = 0;  // newest first
+  bool has_ = false;
+  double last_t_ = 0.0, last_value_ = 0.0, last_scale_ = 1.0, stored_ = 0.0;
+};
+
 inline constexpr int k_max_smoothed_points = k_face_mesh_iris_count;
 
 /// Smooths a set of landmarks (x, y, z per point) over time.
 class landmark_smoother {
  public:
   explicit landmark_smoother(const mediapipe_one_euro_params& params = {}) noexcept;
+  /// The velocity filter instead of One Euro (at most k_max_velocity_points points).
+  explicit landmark_smoother(const mediapipe_velocity_params& params) noexcept;
+  static constexpr int k_max_velocity_points = 40;
   /// Filters `count` points (<= k_max_smoothed_points) in place at time `t` (seconds).
   /// `normalized`: x, y are fractions of the image and z is in units of its width (the
   /// object scale is then measured in pixels, as MediaPipe does, so image_width/height must
@@ -66,8 +98,10 @@ class landmark_smoother {
 
  private:
   mediapipe_one_euro_params params_;
+  bool velocity_ = false;
   int count_ = 0;
   mediapipe_one_euro filters_[k_max_smoothed_points][3];
+  mediapipe_velocity_filter velocity_filters_[k_max_velocity_points][3];
 };
 
 /// VisibilitySmoothingCalculator's low-pass on visibility (alpha: weight of the new value).

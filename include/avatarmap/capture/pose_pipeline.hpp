@@ -41,6 +41,19 @@ normalized_rect pose_detection_to_roi(const detection& d, int image_width, int i
 /// The landmark model file: pose_landmark_{lite,full,heavy}.onnx.
 enum class pose_model_complexity : std::uint8_t { lite = 0, full = 1, heavy = 2 };
 
+/// Temporal smoothing of the landmarks in video mode. World points get MediaPipe's One Euro
+/// (0.1 Hz, beta 40, unscaled) and visibility its low-pass (0.1) except with `none`.
+enum class pose_smoothing : std::uint8_t {
+  /// tfjs-models' BlazePose (and MediaPipe's graphs before 0.9): velocity filters (window 5,
+  /// velocity scale 10) on the image landmarks and on the two auxiliary points that steer the
+  /// next region. The default: it agrees best with Google's reference video landmarks.
+  velocity,
+  /// MediaPipe's current pose_landmark_filtering: One Euro (0.05 Hz, beta 80) on the image
+  /// landmarks, (0.01 Hz, beta 10) on the auxiliary points.
+  one_euro,
+  none,  // raw model output
+};
+
 struct pose_pipeline_options {
   /// Folder holding pose_detection.onnx and pose_landmark_<complexity>.onnx (converted with
   /// tools/convert/tflite2onnx.py; the landmark model may keep or drop its segmentation and
@@ -54,9 +67,9 @@ struct pose_pipeline_options {
   float nms_iou_threshold = 0.3f;    // weighted NMS overlap threshold, (0, 1]
   float min_presence = 0.5f;         // landmark model presence flag below this: lost
   bool static_images = false;        // true: run the detector on every frame
-  /// Video mode (static_images false): smooth the landmarks over time as MediaPipe's
-  /// pose_landmark_filtering does (landmark_smoothing.hpp), using the frame's time out.t.
-  bool smooth_landmarks = true;
+  /// Video mode (static_images false): how landmarks are smoothed over time
+  /// (landmark_smoothing.hpp), using the frame's time out.t.
+  pose_smoothing smoothing = pose_smoothing::velocity;
 };
 
 /// Time spent in the last process() call, milliseconds (0 for a stage that did not run).

@@ -80,9 +80,12 @@ struct pose_pipeline::impl {
   crop_options detector_crop;
   crop_options landmark_crop;
 
-  // Video-mode smoothing, as pose_landmark_filtering.pbtxt and the auxiliary-landmark
-  // filter of pose_landmark_cpu.pbtxt configure it.
+  // Video-mode smoothing (pose_pipeline_options::smoothing): tfjs-models' BlazePose
+  // configuration (velocity filters on the image and auxiliary points) or MediaPipe's
+  // current pose_landmark_filtering.pbtxt (One Euro); world points One Euro in both.
   landmark_smoother smooth_image{{0.05f, 80.f, 1.f, false}};
+  landmark_smoother smooth_image_velocity{mediapipe_velocity_params{5, 10.f}};
+  landmark_smoother smooth_aux_velocity{mediapipe_velocity_params{5, 10.f}};
   landmark_smoother smooth_world{{0.1f, 40.f, 1.f, true}};
   landmark_smoother smooth_aux{{0.01f, 10.f, 1.f, false}};
   visibility_smoother smooth_visibility{0.1f};
@@ -132,6 +135,8 @@ struct pose_pipeline::impl {
 
   void reset_smoothing() {
     smooth_image.reset();
+    smooth_image_velocity.reset();
+    smooth_aux_velocity.reset();
     smooth_world.reset();
     smooth_aux.reset();
     smooth_visibility.reset();
@@ -200,11 +205,13 @@ struct pose_pipeline::impl {
       aux[k].z = c.z;
     }
     if (smoothing) {
-      smooth_image.apply(t, out.pose.data(), k_pose_landmark_count, true, image.width,
-                         image.height);
+      const bool velocity = options.smoothing == pose_smoothing::velocity;
+      (velocity ? smooth_image_velocity : smooth_image)
+          .apply(t, out.pose.data(), k_pose_landmark_count, true, image.width, image.height);
       smooth_visibility.apply(out.pose.data(), k_pose_landmark_count);
       smooth_world.apply(t, out.pose_world.data(), k_pose_landmark_count, false, 0, 0);
-      smooth_aux.apply(t, aux, 2, true, image.width, image.height);
+      (velocity ? smooth_aux_velocity : smooth_aux)
+          .apply(t, aux, 2, true, image.width, image.height);
       for (int i = 0; i < k_pose_landmark_count; ++i)
         out.pose_world[i].visibility = out.pose[i].visibility;
     }
@@ -294,7 +301,7 @@ pose_result pose_pipeline::process(const image_view& image, landmark_frame& out)
       if (!m.detect(image, r)) return m.error.empty() ? pose_result::not_found : pose_result::error;
     }
     m.used_roi = r;
-    const bool smoothing = m.options.smooth_landmarks && !m.options.static_images;
+    const bool smoothing = m.options.smoothing != pose_smoothing::none && !m.options.static_images;
     if (!m.landmarks(image, r, out.t, smoothing, out)) {
       m.has_roi = false;  // lost: the next frame runs the detector
       m.reset_smoothing();
