@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "avatarmap/capture/pose_pipeline.hpp"
 #include "avatarmap/capture/video_source.hpp"
 #include "onnx_support.hpp"
 #include "support/test_data.hpp"
@@ -435,6 +436,59 @@ TEST(hand_video, asl_hand_vs_mediapipe_reference) {
 }
 
 // ---- latency ---------------------------------------------------------------------------------
+
+// With the body of our own pose pipeline on pose_squats.mp4 (5 frames/s, fast arm swings):
+// following the body's wrist motion keeps hands tracked (fewer landmark runs) and finds at
+// least as many; every hand found lies at its side's pose wrist (no reference hand
+// landmarks exist for this video, so the body's wrist is the independent check).
+TEST(hand_video, squats_follow_body_motion) {
+  HAND_SKIP_WITHOUT_DATA();
+  if (!video_source_available()) GTEST_SKIP() << "built without FFmpeg";
+  const std::string path = test::test_data_path("motion/tfjs-models/pose_squats.mp4");
+  struct result {
+    int found = 0, runs = 0;
+    std::vector<double> wrist_px;
+  } r[2];
+  for (int follow = 0; follow < 2; ++follow) {
+    pose_pipeline_options po;
+    po.models_dir = models_dir();
+    std::unique_ptr<pose_pipeline> pose;
+    ASSERT_TRUE(pose_pipeline::create(po, pose).ok());
+    hand_pipeline_options o;
+    o.follow_body_motion = follow == 1;
+    auto p = make(o);
+    ASSERT_NE(p, nullptr);
+    video_source src;
+    ASSERT_TRUE(src.open(path).ok());
+    image_view img;
+    double t = 0;
+    landmark_frame f;
+    while (src.next(img, t) == read_result::frame) {
+      f.clear();
+      f.t = t;
+      if (pose->process(img, f) != pose_result::found) continue;
+      ASSERT_NE(p->process(img, &f, f), hand_result::error) << p->last_error();
+      r[follow].runs += p->last_timings().landmark_runs;
+      for (int side = 0; side < 2; ++side) {
+        const frame_part part = side == 0 ? frame_part::left_hand : frame_part::right_hand;
+        if (!f.has(part)) continue;
+        ++r[follow].found;
+        const landmark& hw = side == 0 ? f.left_hand[0] : f.right_hand[0];
+        const landmark& pw = f.pose[idx(pose_landmark::left_wrist) + side];
+        r[follow].wrist_px.push_back(
+            std::hypot((hw.x - pw.x) * img.width, (hw.y - pw.y) * img.height));
+      }
+    }
+  }
+  std::printf(
+      "[figures] pose_squats.mp4 hands: follow body motion off: %d found, %d landmark runs, "
+      "wrist gap median %.1f px; on: %d found, %d runs, wrist gap median %.1f px\n",
+      r[0].found, r[0].runs, median(r[0].wrist_px), r[1].found, r[1].runs, median(r[1].wrist_px));
+  EXPECT_GE(r[1].found, r[0].found);
+  EXPECT_LT(r[1].runs, r[0].runs);
+  // The hand model's wrist and the body model's wrist agree to a few percent of the body.
+  EXPECT_LT(median(r[1].wrist_px), 25.0);
+}
 
 TEST(hand_pipeline, latency) {
   HAND_SKIP_WITHOUT_DATA();

@@ -145,6 +145,11 @@ struct hand_pipeline_options {
   bool refine_pose_roi = true;
   pose_hand_roi_options pose_roi{};
   bool static_images = false;  // true: nothing is tracked, every frame starts afresh
+  /// With a body: move a tracked hand's region by the body's wrist motion since the last
+  /// frame before running the landmark model (not in MediaPipe). At low frame rates a
+  /// moving hand leaves last frame's region; this keeps it tracked (one landmark run)
+  /// instead of lost and found again from the body (two runs).
+  bool follow_body_motion = true;
 };
 
 /// Time spent in the last process() call, milliseconds (0 for a stage that did not run).

@@ -96,7 +96,22 @@ struct hand_pipeline::impl {
     normalized_rect roi;
     bool side_known = false;
     body_side side = body_side::left;
+    bool has_wrist = false;  // the body's wrist of this side when the region was made
+    float wrist_x = 0.f, wrist_y = 0.f;
   };
+
+  // The body's wrist of `side` when it is seen well enough to follow.
+  bool body_wrist(const landmark_frame* body, body_side side, float& x, float& y) const {
+    if (body == nullptr || !body->has(frame_part::pose)) return false;
+    const landmark& w =
+        body->pose[idx(pose_landmark::left_wrist) + (side == body_side::left ? 0 : 1)];
+    if (!(w.visibility >= options.pose_roi.min_wrist_visibility) || !std::isfinite(w.x) ||
+        !std::isfinite(w.y))
+      return false;
+    x = w.x;
+    y = w.y;
+    return true;
+  }
 
   hand_pipeline_options options;
   bound_model palm;        // outputs: boxes [2016 x 18], scores [2016]
@@ -247,7 +262,14 @@ struct hand_pipeline::impl {
     //    tracked region against the body's likewise).
     int n = 0;
     for (int i = 0; i < slot_count && n < max; ++i) {
-      const slot& s = slots[i];
+      slot& s = slots[i];
+      // Follow the body: move the tracked region by the body's wrist motion since it was
+      // made (at low frame rates a hand moves out of last frame's region).
+      float wx = 0.f, wy = 0.f;
+      if (options.follow_body_motion && s.has_wrist && body_wrist(body, s.side, wx, wy)) {
+        s.roi.x_center += wx - s.wrist_x;
+        s.roi.y_center += wy - s.wrist_y;
+      }
       if (use_pose && has_body && s.side_known) {
         const landmark& w =
             body->pose[idx(pose_landmark::left_wrist) + (s.side == body_side::left ? 0 : 1)];
@@ -351,7 +373,9 @@ struct hand_pipeline::impl {
       wpts = h.world;
       out.set(left ? frame_part::left_hand : frame_part::right_hand, true);
       out.set(left ? frame_part::left_hand_world : frame_part::right_hand_world, true);
-      slots[slot_count++] = {next_rois[i], candidate_side_known[i], h.side};
+      slot& sl = slots[slot_count++];
+      sl = {next_rois[i], candidate_side_known[i], h.side, false, 0.f, 0.f};
+      sl.has_wrist = body_wrist(body, h.side, sl.wrist_x, sl.wrist_y);
     }
     return hand_count > 0 ? hand_result::found : hand_result::not_found;
   }
