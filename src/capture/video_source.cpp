@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "capture/frame_pattern.hpp"
+
 #if AVATARMAP_HAVE_FFMPEG
 extern "C" {
 #include <libavcodec/avcodec.h>
@@ -60,46 +62,6 @@ bool is_image_extension(std::string ext) {
   for (const char* e : k_exts)
     if (ext == e) return true;
   return false;
-}
-
-// A printf pattern with exactly one %d / %0Nd conversion ("%%" is a literal '%'). On
-// success `out_prefix`/`out_suffix` surround the number and `out_width` is N (0: none).
-bool parse_pattern(const std::string& path, std::string& out_prefix, std::string& out_suffix,
-                   int& out_width) {
-  std::string text;
-  bool found = false;
-  for (std::size_t i = 0; i < path.size(); ++i) {
-    if (path[i] != '%') {
-      text += path[i];
-      continue;
-    }
-    if (i + 1 < path.size() && path[i + 1] == '%') {
-      text += '%';
-      ++i;
-      continue;
-    }
-    if (found) return false;  // a second conversion
-    std::size_t j = i + 1;
-    int width = 0;
-    bool zero = false;
-    if (j < path.size() && path[j] == '0') {
-      zero = true;
-      ++j;
-    }
-    const std::size_t digits_begin = j;
-    while (j < path.size() && std::isdigit(static_cast<unsigned char>(path[j])) &&
-           j - digits_begin < 2)
-      width = width * 10 + (path[j++] - '0');
-    if (j >= path.size() || path[j] != 'd') return false;
-    if (zero && width == 0) return false;
-    out_prefix = text;
-    text.clear();
-    out_width = width;
-    found = true;
-    i = j;
-  }
-  out_suffix = text;
-  return found;
 }
 
 std::string pattern_name(const std::string& prefix, const std::string& suffix, int width,
@@ -553,7 +515,7 @@ status video_source::open(const std::string& path, const video_source_options& o
     int width = 0;
     if (path.find('%') == std::string::npos)
       return status::error(path + ": no such file or folder");
-    if (!parse_pattern(path, prefix, suffix, width))
+    if (!parse_frame_pattern(path, prefix, suffix, width))
       return status::error(path + ": not a file, and not a pattern with one %d or %0Nd");
     p->files = pattern_images(prefix, suffix, width);
     if (p->files.empty())

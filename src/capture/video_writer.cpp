@@ -18,6 +18,8 @@
 #include <utility>
 #include <vector>
 
+#include "capture/frame_pattern.hpp"
+
 #if AVATARMAP_HAVE_FFMPEG
 extern "C" {
 #include <libavcodec/avcodec.h>
@@ -86,49 +88,6 @@ std::string av_error_text(int err) {
   char buf[AV_ERROR_MAX_STRING_SIZE] = {};
   av_strerror(err, buf, sizeof buf);
   return buf;
-}
-
-// A printf pattern with exactly one %d / %0Nd conversion (N up to two digits; "%%" is a
-// literal '%'). On success `out_prefix`/`out_suffix` surround the number (with "%%" turned
-// into '%') and `out_width` is N (0: none). Returns false for a '%' that is not part of
-// exactly one such conversion; `out_found` says whether there was any '%'.
-bool parse_pattern(const std::string& path, std::string& out_prefix, std::string& out_suffix,
-                   int& out_width, bool& out_found) {
-  std::string text;
-  bool found = false;
-  out_found = path.find('%') != std::string::npos;
-  for (std::size_t i = 0; i < path.size(); ++i) {
-    if (path[i] != '%') {
-      text += path[i];
-      continue;
-    }
-    if (i + 1 < path.size() && path[i + 1] == '%') {
-      text += '%';
-      ++i;
-      continue;
-    }
-    if (found) return false;
-    std::size_t j = i + 1;
-    int width = 0;
-    bool zero = false;
-    if (j < path.size() && path[j] == '0') {
-      zero = true;
-      ++j;
-    }
-    const std::size_t digits_begin = j;
-    while (j < path.size() && std::isdigit(static_cast<unsigned char>(path[j])) &&
-           j - digits_begin < 2)
-      width = width * 10 + (path[j++] - '0');
-    if (j >= path.size() || path[j] != 'd') return false;
-    if (zero && width == 0) return false;
-    out_prefix = text;
-    text.clear();
-    out_width = width;
-    found = true;
-    i = j;
-  }
-  out_suffix = text;
-  return found;
 }
 
 // Writes all of [data, data + size) to fd; false with errno set on failure.
@@ -518,7 +477,8 @@ status video_writer::open(const std::string& path, int width, int height, double
   bool numbered = false;
   if (!video) {
     bool has_percent = false;
-    numbered = parse_pattern(path, p->prefix, p->suffix, p->number_width, has_percent);
+    has_percent = path.find('%') != std::string::npos;
+    numbered = parse_frame_pattern(path, p->prefix, p->suffix, p->number_width);
     if (has_percent && !numbered)
       return status::error(path +
                            ": a '%' in a PNG path must be one %d or %0Nd (a pattern for one "

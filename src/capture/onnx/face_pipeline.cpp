@@ -137,14 +137,11 @@ face_pipeline::~face_pipeline() = default;
 status face_pipeline::create(const face_pipeline_options& options,
                              std::unique_ptr<face_pipeline>& out) {
   out.reset();
-  if (options.intra_op_threads < 1)
-    return status::error("face_pipeline: intra_op_threads must be >= 1");
-  if (!(options.min_detection_score > 0.f && options.min_detection_score < 1.f))
-    return status::error("face_pipeline: min_detection_score must be in (0, 1)");
-  if (!(options.nms_iou_threshold > 0.f && options.nms_iou_threshold <= 1.f))
-    return status::error("face_pipeline: nms_iou_threshold must be in (0, 1]");
-  if (!(options.min_presence >= 0.f && options.min_presence <= 1.f))
-    return status::error("face_pipeline: min_presence must be in [0, 1]");
+  if (const std::string e = check_pipeline_options("face_pipeline", options.intra_op_threads,
+                                                   options.min_detection_score,
+                                                   options.nms_iou_threshold, options.min_presence);
+      !e.empty())
+    return status::error(e);
   if (!(options.pose_region_scale > 0.f && options.pose_region_scale <= 100.f))
     return status::error("face_pipeline: pose_region_scale must be in (0, 100]");
   const std::string dir = options.models_dir.empty() ? "." : options.models_dir;

@@ -389,14 +389,11 @@ status hand_pipeline::create(const hand_pipeline_options& options,
   out.reset();
   if (options.max_hands < 1 || options.max_hands > k_max_hands)
     return status::error("hand_pipeline: max_hands must be 1 or 2");
-  if (options.intra_op_threads < 1)
-    return status::error("hand_pipeline: intra_op_threads must be >= 1");
-  if (!(options.min_detection_score > 0.f && options.min_detection_score < 1.f))
-    return status::error("hand_pipeline: min_detection_score must be in (0, 1)");
-  if (!(options.nms_iou_threshold > 0.f && options.nms_iou_threshold <= 1.f))
-    return status::error("hand_pipeline: nms_iou_threshold must be in (0, 1]");
-  if (!(options.min_presence >= 0.f && options.min_presence <= 1.f))
-    return status::error("hand_pipeline: min_presence must be in [0, 1]");
+  if (const std::string e = check_pipeline_options("hand_pipeline", options.intra_op_threads,
+                                                   options.min_detection_score,
+                                                   options.nms_iou_threshold, options.min_presence);
+      !e.empty())
+    return status::error(e);
   if (!(options.max_overlap > 0.f && options.max_overlap <= 1.f))
     return status::error("hand_pipeline: max_overlap must be in (0, 1]");
   if (!(options.pose_roi.scale > 0.f) || !std::isfinite(options.pose_roi.scale) ||

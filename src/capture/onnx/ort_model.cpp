@@ -34,6 +34,18 @@ void create_env_locked(env_state& s, int threads, bool spinning) {
 
 }  // namespace
 
+std::string check_pipeline_options(const char* who, int threads, float min_detection_score,
+                                   float nms_iou_threshold, float min_presence) {
+  const std::string w = who;
+  if (threads < 1) return w + ": intra_op_threads must be >= 1";
+  if (!(min_detection_score > 0.f && min_detection_score < 1.f))
+    return w + ": min_detection_score must be in (0, 1)";
+  if (!(nms_iou_threshold > 0.f && nms_iou_threshold <= 1.f))
+    return w + ": nms_iou_threshold must be in (0, 1]";
+  if (!(min_presence >= 0.f && min_presence <= 1.f)) return w + ": min_presence must be in [0, 1]";
+  return {};
+}
+
 Ort::Env& ort_env() {
   env_state& s = state();
   std::lock_guard<std::mutex> lock(s.m);

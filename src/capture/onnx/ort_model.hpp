@@ -26,6 +26,12 @@ inline float sigmoid(float x) { return 1.f / (1.f + std::exp(-x)); }
 /// count the heap allocations of the pipelines outside ONNX Runtime.
 int ort_run_depth() noexcept;
 
+/// Checks the options every detect-then-track pipeline has (threads >= 1, detection score in
+/// (0, 1), NMS threshold in (0, 1], presence in [0, 1]); the message starts with `who`, or
+/// "" when they are fine.
+std::string check_pipeline_options(const char* who, int threads, float min_detection_score,
+                                   float nms_iou_threshold, float min_presence);
+
 /// The process-wide ORT environment (created on first use, by make_session_options with its
 /// thread settings when that comes first).
 Ort::Env& ort_env();

@@ -229,14 +229,11 @@ pose_pipeline::~pose_pipeline() = default;
 status pose_pipeline::create(const pose_pipeline_options& options,
                              std::unique_ptr<pose_pipeline>& out) {
   out.reset();
-  if (options.intra_op_threads < 1)
-    return status::error("pose_pipeline: intra_op_threads must be >= 1");
-  if (!(options.min_detection_score > 0.f && options.min_detection_score < 1.f))
-    return status::error("pose_pipeline: min_detection_score must be in (0, 1)");
-  if (!(options.nms_iou_threshold > 0.f && options.nms_iou_threshold <= 1.f))
-    return status::error("pose_pipeline: nms_iou_threshold must be in (0, 1]");
-  if (!(options.min_presence >= 0.f && options.min_presence <= 1.f))
-    return status::error("pose_pipeline: min_presence must be in [0, 1]");
+  if (const std::string e = check_pipeline_options("pose_pipeline", options.intra_op_threads,
+                                                   options.min_detection_score,
+                                                   options.nms_iou_threshold, options.min_presence);
+      !e.empty())
+    return status::error(e);
   const std::string dir = options.models_dir.empty() ? "." : options.models_dir;
   const std::string det_path = dir + "/pose_detection.onnx";
   const std::string lm_path =
