@@ -60,7 +60,7 @@ int run_capture(int argc, char** argv) {
   if (a.flag("--progress")) progress = true;
   const bool quiet = a.flag("--quiet");
   if (quiet) progress = false;
-  estimator_cli ec;
+  estimator_options ec;
   if (!parse_estimator_options(a, false, ec, error)) {
     std::fprintf(stderr, "avatarmap capture: %s\n", error.c_str());
     return 2;
@@ -164,9 +164,8 @@ int run_capture(int argc, char** argv) {
   timing_totals timings;
   landmark_frame frame;
   estimate_args ea;
-  ea.body = ec.body;
-  ea.hands = ec.options.hands;
-  ea.face = ec.options.face;
+  ea.hands = ec.hands;
+  ea.face = ec.face;
   prefetch_ring<decoded> ring(3, decode);
   for (;;) {
     decoded& d = ring.next();

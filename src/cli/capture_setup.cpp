@@ -32,9 +32,9 @@ std::string default_models_dir() {
 
 }  // namespace
 
-bool parse_estimator_options(args& a, bool hands_face_default, estimator_cli& out,
+bool parse_estimator_options(args& a, bool hands_face_default, estimator_options& out,
                              std::string& error) {
-  estimator_options& o = out.options;
+  estimator_options& o = out;
   o.source = default_models_dir();
   std::string model = "full", hand_model = "full";
   a.value("--model", model);
@@ -69,8 +69,8 @@ bool parse_estimator_options(args& a, bool hands_face_default, estimator_cli& ou
   return true;
 }
 
-status make_estimator(const estimator_cli& cli, std::unique_ptr<estimator>& out) {
-  status st = create_estimator("onnx", cli.options, out);
+status make_estimator(const estimator_options& options, std::unique_ptr<estimator>& out) {
+  status st = create_estimator("onnx", options, out);
   if (!st.ok())
     return status::error(st.message() +
                          " (scripts/prepare_capture.sh fetches and converts the "

@@ -14,19 +14,14 @@ namespace avatarmap::cli {
 /// The options' help lines (for the commands' --help texts).
 extern const char* const k_estimator_options_help;
 
-struct estimator_cli {
-  estimator_options options;
-  bool body = true;
-};
-
 /// Reads --model, --hand-model, --threads, --models, --static, --hands, --face, --body-only,
 /// --mirrored. `hands_face_default` is what --hands/--face default to (animate: on). Returns
 /// false with a message for a bad value.
-bool parse_estimator_options(args& a, bool hands_face_default, estimator_cli& out,
+bool parse_estimator_options(args& a, bool hands_face_default, estimator_options& out,
                              std::string& error);
 
 /// Creates the ONNX estimator; the error says how to get the models.
-status make_estimator(const estimator_cli& cli, std::unique_ptr<estimator>& out);
+status make_estimator(const estimator_options& options, std::unique_ptr<estimator>& out);
 
 /// Sums of estimator_timings over frames, for the summary line.
 struct timing_totals {

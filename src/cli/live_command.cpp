@@ -59,7 +59,7 @@ int run_live_command(int argc, char** argv) {
   const bool unpaced = a.flag("--unpaced");
   const bool quiet = a.flag("--quiet");
   const bool progress = !quiet && isatty(STDERR_FILENO);
-  estimator_cli ec;
+  estimator_options ec;
   if (!parse_estimator_options(a, false, ec, error)) {
     std::fprintf(stderr, "avatarmap live: %s\n", error.c_str());
     return 2;
@@ -135,8 +135,8 @@ int run_live_command(int argc, char** argv) {
   landmark_frame frame;
   proxy_pose pose;
   estimate_args ea;
-  ea.hands = ec.options.hands;
-  ea.face = ec.options.face;
+  ea.hands = ec.hands;
+  ea.face = ec.face;
   timing_totals timings;
   long with_body = 0;
   auto last_progress = clock_type::now();

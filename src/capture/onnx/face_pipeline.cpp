@@ -60,14 +60,7 @@ struct face_pipeline::impl {
     ran_detector = true;
     search_region = region;
     crop_transform tr;
-    image_crop_job job;
-    job.image = image;
-    job.roi = region;
-    job.options = detector_crop;
-    job.output = detector.input.data();
-    job.output_size = detector.input.size();
-    job.out_transform = &tr;
-    if (!job.run()) {
+    if (!detector.crop_input(image, region, detector_crop, &tr)) {
       // A degenerate body region (e.g. all face points on one spot) is not an error.
       if (keypoint_roi) return false;
       error = "face detector: the image could not be cropped";
@@ -93,14 +86,7 @@ struct face_pipeline::impl {
   bool landmarks(const image_view& image, const normalized_rect& r, landmark_frame& out) {
     const auto t0 = std::chrono::steady_clock::now();
     crop_transform tr;
-    image_crop_job job;
-    job.image = image;
-    job.roi = r;
-    job.options = mesh_crop;
-    job.output = mesh.input.data();
-    job.output_size = mesh.input.size();
-    job.out_transform = &tr;
-    if (!job.run()) {
+    if (!mesh.crop_input(image, r, mesh_crop, &tr)) {
       error = "face mesh: the region could not be cropped";
       return false;
     }

@@ -39,43 +39,6 @@ constexpr int k_out_presence = 1;
 constexpr int k_out_handedness = 2;
 constexpr int k_out_world = 3;
 
-// Loads `path` into `m` binding outputs 0..counts.size()-1 by position; each must have the
-// given element count. Throws Ort::Exception; returns a message on a shape mismatch.
-std::string load_by_position(bound_model& m, const std::string& path, const Ort::SessionOptions& so,
-                             const std::vector<int64_t>& input_shape,
-                             const std::vector<int64_t>& counts) {
-  m.session = std::make_unique<Ort::Session>(ort_env(), path.c_str(), so);
-  Ort::AllocatorWithDefaultOptions alloc;
-  if (m.session->GetInputCount() != 1) return path + ": expected one input";
-  m.input_name = m.session->GetInputNameAllocated(0, alloc).get();
-  if (m.session->GetInputTypeInfo(0).GetTensorTypeAndShapeInfo().GetShape() != input_shape)
-    return path + ": unexpected input shape";
-  if (m.session->GetOutputCount() < counts.size())
-    return path + ": expected " + std::to_string(counts.size()) + " outputs";
-  const Ort::MemoryInfo mem = Ort::MemoryInfo::CreateCpu(OrtArenaAllocator, OrtMemTypeDefault);
-  size_t in_count = 1;
-  for (int64_t d : input_shape) in_count *= static_cast<size_t>(d);
-  m.input.assign(in_count, 0.f);
-  m.input_value = Ort::Value::CreateTensor<float>(mem, m.input.data(), m.input.size(),
-                                                  input_shape.data(), input_shape.size());
-  m.outputs.reserve(counts.size());
-  for (size_t i = 0; i < counts.size(); ++i) {
-    const std::vector<int64_t> s =
-        m.session->GetOutputTypeInfo(i).GetTensorTypeAndShapeInfo().GetShape();
-    int64_t n = 1;
-    for (int64_t d : s) n *= d;
-    if (n != counts[i])
-      return path + ": output " + std::to_string(i) + " has " + std::to_string(n) +
-             " values, expected " + std::to_string(counts[i]);
-    m.output_names.push_back(m.session->GetOutputNameAllocated(i, alloc).get());
-    m.outputs.emplace_back(static_cast<size_t>(n), 0.f);
-    m.output_values.push_back(Ort::Value::CreateTensor<float>(
-        mem, m.outputs.back().data(), m.outputs.back().size(), s.data(), s.size()));
-  }
-  for (const std::string& n : m.output_names) m.output_name_ptrs.push_back(n.c_str());
-  return {};
-}
-
 float sq_distance_px(float ax, float ay, float bx, float by, int w, int h) {
   const float dx = (ax - bx) * static_cast<float>(w), dy = (ay - by) * static_cast<float>(h);
   return dx * dx + dy * dy;
@@ -142,14 +105,8 @@ struct hand_pipeline::impl {
     const auto t0 = std::chrono::steady_clock::now();
     ran_palm = true;
     crop_transform tr;
-    image_crop_job job;
-    job.image = image;
-    job.roi = normalized_rect{};  // the whole image, letterboxed
-    job.options = palm_crop;
-    job.output = palm.input.data();
-    job.output_size = palm.input.size();
-    job.out_transform = &tr;
-    if (!job.run()) {
+    // The whole image, letterboxed.
+    if (!palm.crop_input(image, normalized_rect{}, palm_crop, &tr)) {
       error = "hand_pipeline: palm detector: the image could not be cropped";
       return -1;
     }
@@ -190,14 +147,7 @@ struct hand_pipeline::impl {
     const auto t0 = std::chrono::steady_clock::now();
     ++timings.landmark_runs;
     crop_transform tr;
-    image_crop_job job;
-    job.image = image;
-    job.roi = r;
-    job.options = landmark_crop;
-    job.output = hand_model.input.data();
-    job.output_size = hand_model.input.size();
-    job.out_transform = &tr;
-    if (!job.run()) {
+    if (!hand_model.crop_input(image, r, landmark_crop, &tr)) {
       error = "hand_pipeline: hand landmarks: the region could not be cropped";
       return false;
     }
@@ -423,8 +373,8 @@ status hand_pipeline::create(const hand_pipeline_options& options,
                                  {k_palm_boxes * k_palm_coords, k_palm_boxes});
     if (e.empty()) {
       current = &lm_path;
-      e = load_by_position(m->hand_model, lm_path, so, {1, k_landmark_size, k_landmark_size, 3},
-                           {3 * k_hand_landmark_count, 1, 1, 3 * k_hand_landmark_count});
+      e = m->hand_model.load_in_order(lm_path, so, {1, k_landmark_size, k_landmark_size, 3},
+                                      {3 * k_hand_landmark_count, 1, 1, 3 * k_hand_landmark_count});
     }
     if (!e.empty()) return status::error("hand_pipeline: " + e);
   } catch (const Ort::Exception& ex) {

@@ -70,24 +70,53 @@ Ort::SessionOptions make_session_options(int threads, bool allow_spinning) {
   return so;
 }
 
-std::string bound_model::load(const std::string& path, const Ort::SessionOptions& so,
-                              const std::vector<int64_t>& input_shape,
-                              const std::vector<int64_t>& counts,
-                              const std::vector<int64_t>& optional,
-                              std::vector<bool>* optional_found) {
+std::string bound_model::open(const std::string& path, const Ort::SessionOptions& so,
+                              const std::vector<int64_t>& input_shape) {
   session = std::make_unique<Ort::Session>(ort_env(), path.c_str(), so);
   Ort::AllocatorWithDefaultOptions alloc;
   if (session->GetInputCount() != 1) return path + ": expected one input";
   input_name = session->GetInputNameAllocated(0, alloc).get();
-  std::vector<int64_t> in_shape =
-      session->GetInputTypeInfo(0).GetTensorTypeAndShapeInfo().GetShape();
-  if (in_shape != input_shape) return path + ": unexpected input shape";
+  if (session->GetInputTypeInfo(0).GetTensorTypeAndShapeInfo().GetShape() != input_shape)
+    return path + ": unexpected input shape";
   const Ort::MemoryInfo mem = Ort::MemoryInfo::CreateCpu(OrtArenaAllocator, OrtMemTypeDefault);
   size_t in_count = 1;
   for (int64_t d : input_shape) in_count *= static_cast<size_t>(d);
   input.assign(in_count, 0.f);
   input_value = Ort::Value::CreateTensor<float>(mem, input.data(), input.size(), input_shape.data(),
                                                 input_shape.size());
+  return {};
+}
+
+int64_t bound_model::output_count(size_t index, std::vector<int64_t>* shape) const {
+  std::vector<int64_t> s = session->GetOutputTypeInfo(index).GetTensorTypeAndShapeInfo().GetShape();
+  int64_t n = 1;
+  for (int64_t d : s) n *= d;
+  if (shape) *shape = std::move(s);
+  return n;
+}
+
+void bound_model::bind_output(size_t index) {
+  Ort::AllocatorWithDefaultOptions alloc;
+  const Ort::MemoryInfo mem = Ort::MemoryInfo::CreateCpu(OrtArenaAllocator, OrtMemTypeDefault);
+  std::vector<int64_t> shape;
+  const int64_t n = output_count(index, &shape);
+  output_names.push_back(session->GetOutputNameAllocated(index, alloc).get());
+  outputs.emplace_back(static_cast<size_t>(n), 0.f);
+  output_values.push_back(Ort::Value::CreateTensor<float>(
+      mem, outputs.back().data(), outputs.back().size(), shape.data(), shape.size()));
+}
+
+void bound_model::finish_binding() {
+  output_name_ptrs.clear();
+  for (const std::string& n : output_names) output_name_ptrs.push_back(n.c_str());
+}
+
+std::string bound_model::load(const std::string& path, const Ort::SessionOptions& so,
+                              const std::vector<int64_t>& input_shape,
+                              const std::vector<int64_t>& counts,
+                              const std::vector<int64_t>& optional,
+                              std::vector<bool>* optional_found) {
+  if (std::string e = open(path, so, input_shape); !e.empty()) return e;
   std::vector<int64_t> all = counts;
   all.insert(all.end(), optional.begin(), optional.end());
   if (optional_found) optional_found->assign(optional.size(), false);
@@ -95,29 +124,49 @@ std::string bound_model::load(const std::string& path, const Ort::SessionOptions
     const int64_t want = all[w];
     const bool is_optional = w >= counts.size();
     int found = -1;
-    std::vector<int64_t> shape;
     for (size_t i = 0; i < session->GetOutputCount(); ++i) {
-      std::vector<int64_t> s = session->GetOutputTypeInfo(i).GetTensorTypeAndShapeInfo().GetShape();
-      int64_t n = 1;
-      for (int64_t d : s) n *= d;
-      if (n == want) {
-        if (found >= 0) return path + ": two outputs with " + std::to_string(want) + " values";
-        found = static_cast<int>(i);
-        shape = s;
-      }
+      if (output_count(i) != want) continue;
+      if (found >= 0) return path + ": two outputs with " + std::to_string(want) + " values";
+      found = static_cast<int>(i);
     }
     if (found < 0) {
       if (is_optional) continue;
       return path + ": no output with " + std::to_string(want) + " values";
     }
     if (is_optional) (*optional_found)[w - counts.size()] = true;
-    output_names.push_back(session->GetOutputNameAllocated(found, alloc).get());
-    outputs.emplace_back(static_cast<size_t>(want), 0.f);
-    output_values.push_back(Ort::Value::CreateTensor<float>(
-        mem, outputs.back().data(), outputs.back().size(), shape.data(), shape.size()));
+    bind_output(static_cast<size_t>(found));
   }
-  for (const std::string& n : output_names) output_name_ptrs.push_back(n.c_str());
+  finish_binding();
   return {};
+}
+
+std::string bound_model::load_in_order(const std::string& path, const Ort::SessionOptions& so,
+                                       const std::vector<int64_t>& input_shape,
+                                       const std::vector<int64_t>& counts) {
+  if (std::string e = open(path, so, input_shape); !e.empty()) return e;
+  if (session->GetOutputCount() < counts.size())
+    return path + ": expected " + std::to_string(counts.size()) + " outputs";
+  for (size_t i = 0; i < counts.size(); ++i) {
+    const int64_t n = output_count(i);
+    if (n != counts[i])
+      return path + ": output " + std::to_string(i) + " has " + std::to_string(n) +
+             " values, expected " + std::to_string(counts[i]);
+    bind_output(i);
+  }
+  finish_binding();
+  return {};
+}
+
+bool bound_model::crop_input(const image_view& image, const normalized_rect& roi,
+                             const crop_options& options, crop_transform* transform) {
+  image_crop_job job;
+  job.image = image;
+  job.roi = roi;
+  job.options = options;
+  job.output = input.data();
+  job.output_size = input.size();
+  job.out_transform = transform;
+  return job.run();
 }
 
 namespace {

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "avatarmap/capture/image_crop.hpp"
+
 namespace avatarmap {
 
 /// Milliseconds since t0.
@@ -68,8 +70,27 @@ struct bound_model {
                    const std::vector<int64_t>& optional = {},
                    std::vector<bool>* optional_found = nullptr);
 
+  /// Like load(), for a model whose outputs cannot be told apart by size: binds outputs
+  /// 0..counts.size()-1 in the model's order, each with its given element count.
+  std::string load_in_order(const std::string& path, const Ort::SessionOptions& so,
+                            const std::vector<int64_t>& input_shape,
+                            const std::vector<int64_t>& counts);
+
+  /// Crops `roi` of `image` into `input` (MediaPipe's ImageToTensor, image_crop.hpp); the
+  /// transform back to the image goes to `transform` when non-null. False when the image
+  /// cannot be cropped.
+  bool crop_input(const image_view& image, const normalized_rect& roi, const crop_options& options,
+                  crop_transform* transform);
+
   /// Runs the session on `input` into `outputs`. Throws Ort::Exception.
   void run();
+
+ private:
+  std::string open(const std::string& path, const Ort::SessionOptions& so,
+                   const std::vector<int64_t>& input_shape);
+  int64_t output_count(size_t index, std::vector<int64_t>* shape = nullptr) const;
+  void bind_output(size_t index);
+  void finish_binding();
 };
 
 }  // namespace avatarmap

@@ -83,11 +83,10 @@ struct pose_pipeline::impl {
   // Video-mode smoothing (pose_pipeline_options::smoothing): tfjs-models' BlazePose
   // configuration (velocity filters on the image and auxiliary points) or MediaPipe's
   // current pose_landmark_filtering.pbtxt (One Euro); world points One Euro in both.
-  landmark_smoother smooth_image{{0.05f, 80.f, 1.f, false}};
-  landmark_smoother smooth_image_velocity{mediapipe_velocity_params{5, 10.f}};
-  landmark_smoother smooth_aux_velocity{mediapipe_velocity_params{5, 10.f}};
+  // smooth_image and smooth_aux get their filter in create(), from options.smoothing.
+  landmark_smoother smooth_image;
+  landmark_smoother smooth_aux;
   landmark_smoother smooth_world{{0.1f, 40.f, 1.f, true}};
-  landmark_smoother smooth_aux{{0.01f, 10.f, 1.f, false}};
   visibility_smoother smooth_visibility{0.1f};
 
   bool has_roi = false;
@@ -102,14 +101,8 @@ struct pose_pipeline::impl {
   bool detect(const image_view& image, normalized_rect& out_roi) {
     const auto t0 = std::chrono::steady_clock::now();
     crop_transform tr;
-    image_crop_job job;
-    job.image = image;
-    job.roi = normalized_rect{};  // the whole image, letterboxed
-    job.options = detector_crop;
-    job.output = detector.input.data();
-    job.output_size = detector.input.size();
-    job.out_transform = &tr;
-    if (!job.run()) {
+    // The whole image, letterboxed.
+    if (!detector.crop_input(image, normalized_rect{}, detector_crop, &tr)) {
       error = "pose detector: the image could not be cropped";
       return false;
     }
@@ -135,8 +128,6 @@ struct pose_pipeline::impl {
 
   void reset_smoothing() {
     smooth_image.reset();
-    smooth_image_velocity.reset();
-    smooth_aux_velocity.reset();
     smooth_world.reset();
     smooth_aux.reset();
     smooth_visibility.reset();
@@ -148,14 +139,7 @@ struct pose_pipeline::impl {
                  landmark_frame& out) {
     const auto t0 = std::chrono::steady_clock::now();
     crop_transform tr;
-    image_crop_job job;
-    job.image = image;
-    job.roi = r;
-    job.options = landmark_crop;
-    job.output = landmark.input.data();
-    job.output_size = landmark.input.size();
-    job.out_transform = &tr;
-    if (!job.run()) {
+    if (!landmark.crop_input(image, r, landmark_crop, &tr)) {
       error = "pose landmarks: the region could not be cropped";
       return false;
     }
@@ -205,13 +189,11 @@ struct pose_pipeline::impl {
       aux[k].z = c.z;
     }
     if (smoothing) {
-      const bool velocity = options.smoothing == pose_smoothing::velocity;
-      (velocity ? smooth_image_velocity : smooth_image)
-          .apply(t, out.pose.data(), k_pose_landmark_count, true, image.width, image.height);
+      smooth_image.apply(t, out.pose.data(), k_pose_landmark_count, true, image.width,
+                         image.height);
       smooth_visibility.apply(out.pose.data(), k_pose_landmark_count);
       smooth_world.apply(t, out.pose_world.data(), k_pose_landmark_count, false, 0, 0);
-      (velocity ? smooth_aux_velocity : smooth_aux)
-          .apply(t, aux, 2, true, image.width, image.height);
+      smooth_aux.apply(t, aux, 2, true, image.width, image.height);
       for (int i = 0; i < k_pose_landmark_count; ++i)
         out.pose_world[i].visibility = out.pose[i].visibility;
     }
@@ -260,6 +242,13 @@ status pose_pipeline::create(const pose_pipeline_options& options,
     if (!e.empty()) return status::error("pose_pipeline: " + e);
   } catch (const Ort::Exception& ex) {
     return status::error("pose_pipeline: ONNX Runtime: " + std::string(ex.what()));
+  }
+  if (options.smoothing == pose_smoothing::velocity) {
+    m->smooth_image = landmark_smoother(mediapipe_velocity_params{5, 10.f});
+    m->smooth_aux = landmark_smoother(mediapipe_velocity_params{5, 10.f});
+  } else {
+    m->smooth_image = landmark_smoother(mediapipe_one_euro_params{0.05f, 80.f, 1.f, false});
+    m->smooth_aux = landmark_smoother(mediapipe_one_euro_params{0.01f, 10.f, 1.f, false});
   }
   generate_ssd_anchors(pose_detection_anchor_options(), m->anchors);
   m->decode.min_score_thresh = options.min_detection_score;
