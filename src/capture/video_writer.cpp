@@ -1,5 +1,6 @@
 // video_writer: RGB8 -> (swscale) -> encoder -> muxer or PNG files, written to temporary
-// files renamed into place by close(); a stub without FFmpeg.
+// files renamed into place by close() (io/atomic_file.hpp: unique names, never through a
+// symlink, modes kept, removed on failure and on SIGINT/SIGTERM); a stub without FFmpeg.
 #include "avatarmap/capture/video_writer.hpp"
 
 #include <fcntl.h>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "capture/frame_pattern.hpp"
+#include "io/atomic_file.hpp"
 
 #if AVATARMAP_HAVE_FFMPEG
 extern "C" {
@@ -104,24 +106,6 @@ bool write_all(int fd, const std::uint8_t* data, std::size_t size) {
   return true;
 }
 
-// Creates `final_path` + ".tmp.XXXXXX" (unique) with the mode of the file it will replace,
-// or 0644. Returns the open descriptor (or -1 with out_error set) and the name.
-int make_temp_file(const std::string& final_path, std::string& out_temp, std::string& out_error) {
-  std::string tmpl = final_path + ".tmp.XXXXXX";
-  std::vector<char> name(tmpl.begin(), tmpl.end());
-  name.push_back('\0');
-  const int fd = ::mkstemp(name.data());
-  if (fd < 0) {
-    out_error = final_path + ": cannot create a file in its folder: " + std::strerror(errno);
-    return -1;
-  }
-  struct stat st;
-  const mode_t mode = ::stat(final_path.c_str(), &st) == 0 ? (st.st_mode & 07777) : 0644;
-  ::fchmod(fd, mode);
-  out_temp.assign(name.data());
-  return fd;
-}
-
 }  // namespace
 
 struct video_writer::impl {
@@ -150,7 +134,7 @@ struct video_writer::impl {
   AVFormatContext* fmt = nullptr;
   AVStream* stream = nullptr;
   bool header_written = false;
-  std::string temp_path;
+  io_detail::atomic_file out;  // FFmpeg writes to out.temp_path() by name
   SwsContext* sws = nullptr;
   std::uint8_t* padded = nullptr;  // out_width x out_height RGB, for odd input sizes
   int padded_stride = 0;
@@ -160,7 +144,10 @@ struct video_writer::impl {
   std::string suffix;  // after it
   int number_width = 0;
   bool numbered = false;
-  std::string token;  // the temporary files' unique suffix
+  // Frame 0's temporary file is temp_base (unique, beside it); frame i's is temp_base + ".i",
+  // so that one registration removes them all on a signal.
+  std::string temp_base;
+  std::unique_ptr<io_detail::temp_file_registration> temp_registration;
   std::vector<char> final_name;
   std::vector<char> temp_name;
   int first_fd = -1;           // the temporary file of the first PNG, created by open()
@@ -179,16 +166,14 @@ struct video_writer::impl {
       fmt = nullptr;
       stream = nullptr;
     }
-    if (!temp_path.empty()) {
-      ::unlink(temp_path.c_str());
-      temp_path.clear();
-    }
+    out.discard();  // after FFmpeg has closed it
     if (first_fd >= 0) {
       ::close(first_fd);
       first_fd = -1;
     }
     for (std::int64_t i = 0; i < png_temps; ++i) ::unlink(png_temp(i));
     png_temps = 0;
+    temp_registration.reset();
     avcodec_free_context(&enc);
     av_frame_free(&frame);
     av_packet_free(&packet);
@@ -206,7 +191,9 @@ struct video_writer::impl {
     return final_name.data();
   }
   const char* png_temp(std::int64_t i) {
-    std::snprintf(temp_name.data(), temp_name.size(), "%s.tmp.%s", png_final(i), token.c_str());
+    if (i == 0) return temp_base.c_str();
+    std::snprintf(temp_name.data(), temp_name.size(), "%s.%lld", temp_base.c_str(),
+                  static_cast<long long>(i));
     return temp_name.data();
   }
   int first_number = 0;
@@ -255,7 +242,8 @@ struct video_writer::impl {
         err = av_interleaved_write_frame(fmt, packet);  // takes the packet's data
         if (err >= 0 && fmt->pb && fmt->pb->error < 0) err = fmt->pb->error;
         if (err < 0)
-          return fail(path + ": cannot write to " + temp_path + " (" + av_error_text(err) + ")");
+          return fail(path + ": cannot write to " + out.temp_path() + " (" + av_error_text(err) +
+                      ")");
       } else {
         status st = write_png(packet->data, static_cast<std::size_t>(packet->size));
         if (!st) return st;  // fail() has freed the packet with everything else
@@ -269,9 +257,14 @@ struct video_writer::impl {
     int fd = first_fd;
     first_fd = -1;
     if (fd < 0) {
-      fd = ::open(png_temp(png_temps), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-      if (fd < 0)
-        return fail(path + ": cannot create " + png_temp(png_temps) + ": " + std::strerror(errno));
+      // Registered before it exists, so a signal right after the open() still removes it.
+      temp_registration->set_sequence_count(png_temps + 1);
+      fd = ::open(png_temp(png_temps), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
+      if (fd < 0) {
+        const int e = errno;
+        temp_registration->set_sequence_count(png_temps);
+        return fail(path + ": cannot create " + png_temp(png_temps) + ": " + std::strerror(e));
+      }
       ++png_temps;
     }
     const bool ok = write_all(fd, data, size);
@@ -367,14 +360,13 @@ struct video_writer::impl {
     }
 
     // The temporary file, then the container's header.
-    std::string error;
-    const int fd = make_temp_file(path, temp_path, error);
-    if (fd < 0) return status::error(error);
-    ::close(fd);
-    const std::string url = "file:" + temp_path;
+    // `out` keeps its descriptor open (unused) until commit() fsyncs and renames the file.
+    if (status st = out.open(path); !st) return st;
+    const std::string url = "file:" + out.temp_path();
     err = avio_open(&fmt->pb, url.c_str(), AVIO_FLAG_WRITE);
     if (err < 0)
-      return status::error(path + ": cannot open " + temp_path + " (" + av_error_text(err) + ")");
+      return status::error(path + ": cannot open " + out.temp_path() + " (" + av_error_text(err) +
+                           ")");
     av_freep(&fmt->url);
     fmt->url = av_strdup(url.c_str());  // +faststart reopens the file by this name
     AVDictionary* mux_options = nullptr;
@@ -415,17 +407,15 @@ struct video_writer::impl {
 
     numbered = is_numbered;
     final_name.assign(prefix.size() + suffix.size() + 32, '\0');
-    // The first file's temporary name comes from mkstemp; its unique suffix then names the
-    // temporary files of all later frames.
-    std::string first_temp;
-    std::string error;
+    // The first file's temporary name is unique (create_temp_file); the later frames' names
+    // are derived from it.
     const std::string first_final = png_final(0);
-    const int fd = make_temp_file(first_final, first_temp, error);
-    if (fd < 0) return status::error(error);
+    int fd = -1;
+    if (status st = io_detail::create_temp_file(first_final, fd, temp_base); !st) return st;
     first_fd = fd;
     png_temps = 1;
-    token = first_temp.substr(first_temp.size() - 6);
-    temp_name.assign(final_name.size() + token.size() + 8, '\0');
+    temp_registration = std::make_unique<io_detail::temp_file_registration>(temp_base);
+    temp_name.assign(temp_base.size() + 24, '\0');
     kind = numbered ? video_writer_kind::png_sequence : video_writer_kind::png_single;
     return {};
   }
@@ -565,23 +555,19 @@ status video_writer::close() {
     const int close_err = avio_closep(&s.fmt->pb);
     if (err >= 0) err = close_err;
     if (err < 0)
-      return s.fail(s.path + ": cannot finish " + s.temp_path + " (" + av_error_text(err) + ")");
-    if (std::rename(s.temp_path.c_str(), s.path.c_str()) != 0)
-      return s.fail(s.path + ": cannot rename " + s.temp_path +
-                    " over it: " + std::strerror(errno));
-    s.temp_path.clear();
+      return s.fail(s.path + ": cannot finish " + s.out.temp_path() + " (" + av_error_text(err) +
+                    ")");
+    if (status st = s.out.commit(); !st) return s.fail(st.message());
     return {};
   }
 
   // PNG: every file was closed after its frame; rename them in order.
   const std::int64_t n = s.png_temps;
   for (std::int64_t i = 0; i < n; ++i) {
-    const char* from = s.png_temp(i);  // formats png_final(i) on the way
-    const char* to = s.png_final(i);
-    if (std::rename(from, to) != 0) {
-      const int e = errno;
-      std::string message =
-          s.path + ": cannot rename " + from + " to " + to + ": " + std::strerror(e);
+    const std::string from = s.png_temp(i);
+    const std::string to = s.png_final(i);
+    if (status st = io_detail::commit_temp_file(from, to); !st) {
+      std::string message = st.message();
       if (i > 0) message += " (" + std::to_string(i) + " file(s) renamed before it stay)";
       for (std::int64_t j = i; j < n; ++j) ::unlink(s.png_temp(j));
       s.png_temps = 0;
@@ -589,6 +575,7 @@ status video_writer::close() {
     }
   }
   s.png_temps = 0;
+  s.temp_registration.reset();
   return {};
 }
 

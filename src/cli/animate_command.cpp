@@ -3,14 +3,18 @@
 // and retargets; both stages keep their own options and messages.
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "cli/capture_setup.hpp"
 #include "cli/commands.hpp"
+#include "io/atomic_file.hpp"
 
 namespace avatarmap::cli {
 namespace {
@@ -172,9 +176,11 @@ int run_animate(int argc, char** argv) {
     if (!face_given) cap.push_back("--face");
   }
 
-  // The landmarks: --keep-landmarks, else a private temporary file removed at the end.
+  // The landmarks: --keep-landmarks, else a private temporary file removed at the end, or by
+  // the signal handlers (main.cpp) when the run is interrupted.
   std::string landmarks = keep;
   bool temporary = false;
+  std::unique_ptr<io_detail::temp_file_registration> registration;
   if (landmarks.empty()) {
     std::error_code ec;
     std::filesystem::path dir = std::filesystem::temp_directory_path(ec);
@@ -182,10 +188,11 @@ int run_animate(int argc, char** argv) {
     std::string tmpl = (dir / "avatarmap-animate-XXXXXX.landmarks.jsonl").string();
     const int fd = mkstemps(tmpl.data(), static_cast<int>(std::string(".landmarks.jsonl").size()));
     if (fd < 0) {
-      std::fprintf(stderr, "avatarmap animate: cannot create a temporary file in %s\n",
-                   dir.string().c_str());
+      std::fprintf(stderr, "avatarmap animate: cannot create a temporary file in %s: %s\n",
+                   dir.string().c_str(), std::strerror(errno));
       return 1;
     }
+    registration = std::make_unique<io_detail::temp_file_registration>(tmpl);
     close(fd);
     landmarks = tmpl;
     temporary = true;

@@ -2,12 +2,14 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <string>
 
 #include "avatarmap/version.hpp"
 #include "cli/commands.hpp"
+#include "io/atomic_file.hpp"
 
 namespace {
 
@@ -41,6 +43,12 @@ const char* k_usage =
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Ctrl-C, kill or a closed terminal remove the temporary files of outputs being written
+  // (the previous outputs stay as they were) before the process dies by the signal.
+  avatarmap::io_detail::install_temp_cleanup_handlers();
+  // Over a file-size limit (ulimit -f) a write then fails with EFBIG and the tool reports it
+  // like a full disk, keeping the previous output, instead of dying by SIGXFSZ.
+  std::signal(SIGXFSZ, SIG_IGN);
   if (argc < 2) {
     std::fputs(k_usage, stderr);
     return 2;

@@ -1,9 +1,10 @@
-// Internal: buffered, atomic text output for the *.jsonl writers. Data goes to a temporary
-// file `PATH.tmp.XXXXXX` beside the target (so the rename stays on one file system);
-// commit() flushes, fsyncs and renames it over PATH. Destroying an uncommitted output
-// removes the temporary file and leaves PATH untouched. "-" writes to standard output
-// (not atomic; commit() only flushes). Numbers are written with std::to_chars (shortest
-// text that reads back to the same value); non-finite numbers are written as null.
+// Internal: buffered, atomic text output for the text writers (*.jsonl, .vrma, .bvh). The
+// bytes go through atomic_file (atomic_file.hpp: a unique temporary file beside the target,
+// fsynced and renamed over PATH by commit(), the replaced file's mode kept, removed on
+// failure and on SIGINT/SIGTERM). Destroying an uncommitted output removes the temporary
+// file and leaves PATH untouched. "-" writes to standard output (not atomic; commit() only
+// flushes). Numbers are written with std::to_chars (shortest text that reads back to the
+// same value); non-finite numbers are written as null.
 #pragma once
 
 #include <charconv>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "avatarmap/core/status.hpp"
+#include "io/atomic_file.hpp"
 
 namespace avatarmap::io_detail {
 
@@ -24,8 +26,12 @@ class text_output {
   text_output(const text_output&) = delete;
   text_output& operator=(const text_output&) = delete;
 
+  /// Creates the temporary file (atomic_file::open's errors), or selects standard output
+  /// for "-".
   status open(const std::string& path);
-  bool is_open() const { return fd_ >= 0; }
+  /// True from a successful open() until commit(), also after a failed write (then every
+  /// call fails with error()).
+  bool is_open() const { return open_; }
   const std::string& path() const { return path_; }
 
   /// Makes sure `n` bytes fit in the buffer (flushing first if needed); false on a write
@@ -63,19 +69,21 @@ class text_output {
 
   /// Writes the buffer out; false on error.
   bool flush();
-  /// Flush, fsync, rename over the target. After it, the output is closed.
+  /// Flush, fsync, rename over the target (atomic_file::commit). After it, the output is
+  /// closed; on failure the target is as it was.
   status commit();
-  /// Last write error ("PATH: write failed: ...").
+  /// First write error ("PATH: write failed: No space left on device; the previous file is
+  /// unchanged").
   const std::string& error() const { return error_; }
 
  private:
   void discard();
 
-  int fd_ = -1;
+  atomic_file file_;
+  bool open_ = false;
   bool is_stdout_ = false;
   bool failed_ = false;
   std::string path_;
-  std::string temp_path_;
   std::string error_;
   std::vector<char> buf_;
   std::size_t pos_ = 0;
