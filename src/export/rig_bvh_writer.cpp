@@ -152,6 +152,20 @@ status write_impl(const std::string& path, const rig& r, const std::vector<rig_p
     rest_pos[j] = glm::dvec3(rest_world[j][3]);
     rest_inverse[j] = glm::inverse(glm::dmat3(rest_world[j]));
   }
+  // No writer emits nan: a rest transform with no inverse (a zero scale) is refused before
+  // anything is written (build_rig refuses it too; a hand-made rig may not have been built).
+  for (int j : layout.joints) {
+    const glm::dmat3& inv = rest_inverse[j];
+    bool finite = std::isfinite(rest_pos[j].x) && std::isfinite(rest_pos[j].y) &&
+                  std::isfinite(rest_pos[j].z);
+    for (int c = 0; c < 3; ++c)
+      finite =
+          finite && std::isfinite(inv[c].x) && std::isfinite(inv[c].y) && std::isfinite(inv[c].z);
+    if (!finite)
+      return status::error(path + ": joint '" + r.names[j] +
+                           "' has a singular or non-finite rest transform (a zero scale?); "
+                           "nothing written");
+  }
 
   io_detail::text_output out;
   if (status s = out.open(path); !s) return s;
@@ -185,7 +199,12 @@ status write_impl(const std::string& path, const rig& r, const std::vector<rig_p
       const int j = layout.joints[k];
       delta[k] = rotation_of(glm::dmat3(world[j]) * rest_inverse[j]);
     }
-    append_vec(text, glm::dvec3(world[hips][3]), scale);
+    const glm::dvec3 hips_position(world[hips][3]);
+    if (!std::isfinite(hips_position.x) || !std::isfinite(hips_position.y) ||
+        !std::isfinite(hips_position.z))
+      return status::error(path + ": frame " + std::to_string(&p - frames.data()) +
+                           ": the hips position is not finite; nothing written");
+    append_vec(text, hips_position, scale);
     for (int k : order) {
       const int parent = layout.bvh_parent[k];
       const glm::dquat local = parent < 0 ? delta[k] : glm::conjugate(delta[parent]) * delta[k];
@@ -195,6 +214,10 @@ status write_impl(const std::string& path, const rig& r, const std::vector<rig_p
       constexpr double k_deg = 180.0 / 3.14159265358979323846;
       const double zxy[3] = {xyz.z * k_deg, xyz.x * k_deg, xyz.y * k_deg};
       for (double a : zxy) {
+        if (!std::isfinite(a))
+          return status::error(path + ": frame " + std::to_string(&p - frames.data()) +
+                               ": joint '" + r.names[layout.joints[k]] +
+                               "' has a non-finite rotation; nothing written");
         text.push_back(' ');
         append_fixed(text, a);
       }

@@ -1,5 +1,7 @@
-// .vrma reader: tinygltf parses the GLB; everything after parsing (accessors, the extension,
+// .vrma reader: the file is opened and checked by gltf_detail (container, JSON depth, index
+// ranges, URIs) and parsed by tinygltf; everything after parsing (accessors, the extension,
 // the node tree) is checked here, because a malformed file must give an error, never a crash.
+// The extension is read from the checked JSON (tinygltf truncates big integers to int).
 #include <tiny_gltf.h>
 
 #include <algorithm>
@@ -12,6 +14,8 @@
 #include <vector>
 
 #include "avatarmap/export/vrma.hpp"
+#include "avatarmap/time/resample_clip.hpp"
+#include "rig/gltf_document.hpp"
 
 namespace avatarmap {
 namespace {
@@ -201,13 +205,22 @@ bool all_finite(const std::vector<double>& v) {
   return true;
 }
 
-// Reads {"node": int} from an extension object; -1 when absent or malformed.
-int node_of(const tinygltf::Value& entry) {
-  if (!entry.IsObject() || !entry.Has("node")) return -1;
-  const tinygltf::Value& n = entry.Get("node");
-  if (!n.IsNumber()) return -1;
-  double d = n.GetNumberAsDouble();
-  if (!(d >= 0.0 && d < 1e9) || d != std::floor(d)) return -1;
+using json = nlohmann::json;
+
+// Member `key` of an object, or nullptr.
+const json* member(const json& v, const char* key) {
+  if (!v.is_object()) return nullptr;
+  const auto it = v.find(key);
+  return it == v.end() ? nullptr : &*it;
+}
+
+// Reads {"node": int} from an extension object: the index, or -1 when absent or not a whole
+// number in [0, node_count) (2^40 is out of range, never wrapped to a valid node).
+int node_of(const json& entry, int node_count) {
+  const json* n = member(entry, "node");
+  if (!n || !n->is_number()) return -1;
+  const double d = n->get<double>();
+  if (!(d >= 0.0 && d < static_cast<double>(node_count)) || d != std::floor(d)) return -1;
   return static_cast<int>(d);
 }
 
@@ -218,38 +231,39 @@ status read_impl(const std::string& path, vrma_clip& out, const vrma_read_option
   if (!std::isfinite(options.hips_height) || options.hips_height < 0.f)
     return fail("hips_height must be 0 (keep) or positive");
 
-  tinygltf::TinyGLTF loader;
+  gltf_detail::gltf_document doc;
+  if (status s = gltf_detail::open_gltf_document(path, doc); !s) return s;
   tinygltf::Model model;
-  std::string err, warn;
-  bool glb = path.size() < 5 || path.compare(path.size() - 5, 5, ".gltf") != 0;
-  bool ok = glb ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                : loader.LoadASCIIFromFile(&model, &err, &warn, path);
-  if (!ok) return fail("not a readable glTF binary (GLB): " + (err.empty() ? warn : err));
+  if (status s = gltf_detail::parse_gltf_model(doc, model); !s) return s;
 
   // ---- the extension ----
-  auto ext_it = model.extensions.find(k_extension);
-  if (ext_it == model.extensions.end() || !ext_it->second.IsObject())
+  const json* extensions = member(doc.json, "extensions");
+  const json* ext_ptr = extensions ? member(*extensions, k_extension) : nullptr;
+  if (!ext_ptr || !ext_ptr->is_object())
     return fail("no VRMC_vrm_animation extension (not a VRM animation)");
-  const tinygltf::Value& ext = ext_it->second;
-  if (!ext.Has("specVersion") || !ext.Get("specVersion").IsString())
-    return fail("VRMC_vrm_animation has no specVersion");
-  const std::string spec = ext.Get("specVersion").Get<std::string>();
+  const json& ext = *ext_ptr;
+  const json* spec_value = member(ext, "specVersion");
+  if (!spec_value || !spec_value->is_string()) return fail("VRMC_vrm_animation has no specVersion");
+  const std::string spec = spec_value->get<std::string>();
   if (spec != "1.0" && spec != "1.0-draft")
     return fail("unsupported VRMC_vrm_animation specVersion \"" + spec + "\" (expected 1.0)");
-  if (!ext.Has("humanoid") || !ext.Get("humanoid").IsObject() ||
-      !ext.Get("humanoid").Has("humanBones") || !ext.Get("humanoid").Get("humanBones").IsObject())
+  const json* humanoid = member(ext, "humanoid");
+  const json* bones_ptr = humanoid ? member(*humanoid, "humanBones") : nullptr;
+  if (!bones_ptr || !bones_ptr->is_object())
     return fail("VRMC_vrm_animation has no humanoid.humanBones object");
   const int node_count = static_cast<int>(model.nodes.size());
-  const tinygltf::Value& bones = ext.Get("humanoid").Get("humanBones");
+  const json& bones = *bones_ptr;
 
   vrma_clip clip;
   clip.generator = model.asset.generator;
   std::array<int, k_bone_count> bone_node;
   bone_node.fill(-1);
-  for (const std::string& name : bones.Keys()) {
-    int node = node_of(bones.Get(name));
-    if (node < 0 || node >= node_count)
-      return fail("humanoid.humanBones." + name + " does not name a valid node");
+  for (auto it = bones.begin(); it != bones.end(); ++it) {
+    const std::string& name = it.key();
+    const int node = node_of(it.value(), node_count);
+    if (node < 0)
+      return fail("humanoid.humanBones." + name + " does not name a valid node (a whole number " +
+                  "below the file's " + std::to_string(node_count) + " nodes)");
     auto b = bone_from_name(name);
     if (!b || !is_vrma_bone(*b)) continue;  // unknown names and eyes: ignored
     bone_node[idx(*b)] = node;
@@ -259,14 +273,14 @@ status read_impl(const std::string& path, vrma_clip& out, const vrma_read_option
 
   std::array<int, k_expression_count> expr_node;
   expr_node.fill(-1);
-  if (ext.Has("expressions") && ext.Get("expressions").IsObject()) {
-    const tinygltf::Value& exprs = ext.Get("expressions");
+  if (const json* exprs = member(ext, "expressions"); exprs && exprs->is_object()) {
     for (const char* group : {"preset", "custom"}) {
-      if (!exprs.Has(group) || !exprs.Get(group).IsObject()) continue;
-      const tinygltf::Value& g = exprs.Get(group);
-      for (const std::string& name : g.Keys()) {
-        int node = node_of(g.Get(name));
-        if (node < 0 || node >= node_count)
+      const json* g = member(*exprs, group);
+      if (!g || !g->is_object()) continue;
+      for (auto it = g->begin(); it != g->end(); ++it) {
+        const std::string& name = it.key();
+        const int node = node_of(it.value(), node_count);
+        if (node < 0)
           return fail(std::string("expressions.") + group + "." + name +
                       " does not name a valid node");
         clip.expression_names.push_back(name);
@@ -409,8 +423,10 @@ status read_impl(const std::string& path, vrma_clip& out, const vrma_read_option
   if (times.empty()) return fail("the first animation has no channel that moves a node");
   clip.duration = times.back();
   if (options.fps > 0.0) {
-    double t0 = times.front(), span = times.back() - t0;
-    auto count = static_cast<std::size_t>(std::floor(span * options.fps + 1e-6)) + 1;
+    // Bounded like every resampling: a key at 1e9 s must not ask for 3e10 frames.
+    const double t0 = times.front();
+    std::size_t count = 0;
+    if (status s = resampled_frame_count(t0, times.back(), options.fps, path, count); !s) return s;
     times.resize(count);
     for (std::size_t k = 0; k < count; ++k) times[k] = t0 + static_cast<double>(k) / options.fps;
   }

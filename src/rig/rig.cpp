@@ -13,6 +13,17 @@ int rig::find(const std::string& name) const {
 }
 
 namespace {
+// Smallest |scale| a rest transform may have on any axis. Real rigs use 0.01 (centimetre
+// rigs) at the smallest; 1e-6 is far below that and far above float's denormals.
+constexpr float k_min_rest_scale = 1e-6f;
+
+bool finite_matrix(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
+}
+
 bool finite_transform(const transform& t) {
   return is_finite(t.translation) && is_finite(t.rotation) && is_finite(t.scale);
 }
@@ -36,10 +47,20 @@ status build_rig(const raw_rig& raw, rig& out) {
       return status::error(where + ": node " + std::to_string(i) + " '" + node.name +
                            "' has an invalid parent " + std::to_string(node.parent));
     if (!finite_transform(node.rest))
-      return status::error(where + ": node '" + node.name + "' has a non-finite transform");
+      return status::error(where + ": node " + std::to_string(i) + " '" + node.name +
+                           "' has a non-finite rest transform (inf or nan); fix the file");
     const glm::quat& q = node.rest.rotation;
     if (!(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w > 1e-12f))
-      return status::error(where + ": node '" + node.name + "' has a zero rotation");
+      return status::error(where + ": node " + std::to_string(i) + " '" + node.name +
+                           "' has a zero rotation");
+    // A zero scale collapses everything below the node to a point: its world matrix has no
+    // inverse, and every rotation computed through it (retargeting, BVH offsets) is nan.
+    const glm::vec3& sc = node.rest.scale;
+    for (int c = 0; c < 3; ++c)
+      if (!(std::fabs(sc[c]) >= k_min_rest_scale))
+        return status::error(where + ": node " + std::to_string(i) + " '" + node.name +
+                             "' has a zero (or near-zero) scale " + std::to_string(sc[c]) +
+                             " on axis " + "xyz"[c] + "; a rig bone must have a non-zero scale");
   }
   // Depth-first order from the roots; a node never reached sits on a cycle.
   std::vector<std::vector<int>> children(static_cast<size_t>(n));
@@ -84,14 +105,31 @@ status build_rig(const raw_rig& raw, rig& out) {
     out.rest_local[k].rotation = glm::normalize(node.rest.rotation);
     const glm::mat4 local = to_matrix(out.rest_local[k]);
     out.rest_world[k] = out.parents[k] < 0 ? local : out.rest_world[out.parents[k]] * local;
+    // Finite, non-zero local transforms can still overflow or underflow down a long chain.
+    const float det = glm::determinant(glm::mat3(out.rest_world[k]));
+    if (!finite_matrix(out.rest_world[k]) || !std::isfinite(det) || std::fabs(det) < 1e-30f) {
+      const std::string message = where + ": node " + std::to_string(order[k]) + " '" + node.name +
+                                  "' has a singular or non-finite world rest transform (the "
+                                  "product of its ancestors' scales); fix the file";
+      out = rig{};
+      return status::error(message);
+    }
     // Rotation of the world matrix with scale removed (columns normalised).
     glm::mat3 r(out.rest_world[k]);
     for (int c = 0; c < 3; ++c) r[c] = normalize_or(r[c], glm::vec3(c == 0, c == 1, c == 2));
     out.rest_world_rotation[k] = glm::normalize(glm::quat_cast(r));
   }
   for (int b = 0; b < k_bone_count; ++b) {
-    int src = raw.declared_humanoid[b];
-    out.declared_humanoid[b] = (src >= 0 && src < n) ? new_index[static_cast<size_t>(src)] : -1;
+    const int src = raw.declared_humanoid[b];
+    if (src < -1 || src >= n) {
+      const std::string message = where + ": humanoid bone '" +
+                                  std::string(bone_name(static_cast<bone>(b))) + "' names node " +
+                                  std::to_string(src) + ", out of range (the rig has " +
+                                  std::to_string(n) + " nodes)";
+      out = rig{};
+      return status::error(message);
+    }
+    out.declared_humanoid[b] = src >= 0 ? new_index[static_cast<size_t>(src)] : -1;
   }
   out.expressions = raw.expressions;
   out.source = raw.source;
