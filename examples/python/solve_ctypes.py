@@ -3,7 +3,7 @@
 
 Usage:
     solve_ctypes.py [--library PATH] [--mirror] [--avatar FILE [--rig auto|NAME|FILE.json]]
-                    [--mappings DIR] [--output OUT] [FILE.landmarks.jsonl]
+                    [--mappings DIR] [--output OUT [--fps N]] [FILE.landmarks.jsonl]
 
 The shared library is taken from --library, else from the environment variable
 AVATARMAP_C_LIBRARY, else from the system search path (libavatarmap_c). Without a landmark
@@ -11,8 +11,11 @@ file, a built-in synthetic T-pose is solved. Prints the hips rotation {x, y, z, 
 frame, then a summary. With --avatar, every pose is also retargeted onto the avatar's rig
 (avm_retargeter; --rig as for `avatarmap convert`, tables from --mappings or
 $AVATARMAP_MAPPINGS) and the hips joint's rotation printed. With --output, the poses are
-collected in an avm_clip and written (.vrma, .bvh, .pose.jsonl, or .glb with --avatar).
-Exits with status 1 on any avm error, 2 on bad usage.
+collected in an avm_clip and written (.vrma, .bvh, .pose.jsonl, or .glb with --avatar) at the
+frames' own times, or resampled at --fps N; frames whose time is not after the previous
+frame's cannot go into a clip and are skipped with a warning (as `avatarmap solve --fps` does).
+Every failure, of the C API (its status and message) or of the input, is reported as one
+"error: ..." line, never a traceback: exits with status 1 on any error, 2 on bad usage.
 """
 
 import argparse
@@ -94,6 +97,12 @@ class AvmError(RuntimeError):
     pass
 
 
+def text(c_string):
+    """A message from the C API as str (bytes that are not UTF-8, e.g. of a file name, shown
+    as replacement characters rather than failing)."""
+    return (c_string or b"").decode("utf-8", errors="replace")
+
+
 def load_library(path):
     if not path:
         path = os.environ.get("AVATARMAP_C_LIBRARY") or ctypes.util.find_library("avatarmap_c")
@@ -155,14 +164,14 @@ class Solver:
         st = lib.avm_solver_create(ctypes.byref(options), ctypes.byref(self.handle))
         if st != AVM_OK:
             raise AvmError("avm_solver_create: %s: %s" % (
-                self._status(st), lib.avm_last_create_error().decode()))
+                self._status(st), text(lib.avm_last_create_error())))
 
     def _status(self, st):
-        return self.lib.avm_status_string(st).decode()
+        return text(self.lib.avm_status_string(st))
 
     def _check(self, st, what):
         if st != AVM_OK:
-            msg = self.lib.avm_solver_last_error(self.handle).decode()
+            msg = text(self.lib.avm_solver_last_error(self.handle))
             raise AvmError("%s: %s: %s" % (what, self._status(st), msg))
 
     def push(self, frame):
@@ -194,20 +203,20 @@ class Retargeter:
                                        ctypes.byref(self.handle))
         if st != AVM_OK:
             raise AvmError("avm_retargeter_create: %s: %s" % (
-                lib.avm_status_string(st).decode(), lib.avm_last_create_error().decode()))
+                text(lib.avm_status_string(st)), text(lib.avm_last_create_error())))
         self.joints = lib.avm_retargeter_joint_count(self.handle)
         self.rotations = (ctypes.c_float * (4 * self.joints))()
         self.hips_translation = (ctypes.c_float * 3)()
 
     def description(self):
-        return self.lib.avm_retargeter_binding_description(self.handle).decode()
+        return text(self.lib.avm_retargeter_binding_description(self.handle))
 
     def apply(self, pose):
         """Returns (rotations as a flat list of x, y, z, w per joint, hips translation)."""
         st = self.lib.avm_retargeter_apply(self.handle, ctypes.byref(pose), self.rotations,
                                            self.hips_translation)
         if st != AVM_OK:
-            raise AvmError("retarget: %s" % self.lib.avm_retargeter_last_error(self.handle).decode())
+            raise AvmError("retarget: %s" % text(self.lib.avm_retargeter_last_error(self.handle)))
         return list(self.rotations), list(self.hips_translation)
 
     def close(self):
@@ -223,11 +232,11 @@ class Clip:
         self.lib = lib
         self.handle = ctypes.c_void_p()
         if lib.avm_clip_create(ctypes.byref(self.handle)) != AVM_OK:
-            raise AvmError("avm_clip_create: %s" % lib.avm_last_create_error().decode())
+            raise AvmError("avm_clip_create: %s" % text(lib.avm_last_create_error()))
 
     def add(self, pose):
         if self.lib.avm_clip_add(self.handle, ctypes.byref(pose)) != AVM_OK:
-            raise AvmError("clip: %s" % self.lib.avm_clip_last_error(self.handle).decode())
+            raise AvmError("clip: %s" % text(self.lib.avm_clip_last_error(self.handle)))
 
     def write(self, path, fps=0.0, avatar=None, rig=None):
         err = ctypes.create_string_buffer(1024)
@@ -235,8 +244,8 @@ class Clip:
                                      os.fsencode(avatar) if avatar else None,
                                      rig.encode() if rig else None, err, len(err))
         if st != AVM_OK:
-            raise AvmError("write: %s: %s" % (self.lib.avm_status_string(st).decode(),
-                                              err.value.decode()))
+            raise AvmError("write: %s: %s" % (text(self.lib.avm_status_string(st)),
+                                              text(err.value)))
 
     def close(self):
         if self.handle:
@@ -284,11 +293,18 @@ def read_landmark_file(path):
                 continue
             try:
                 obj = json.loads(line)
-            except json.JSONDecodeError as e:
-                raise AvmError("%s:%d: %s" % (path, number, e))
+            except ValueError as e:  # json.JSONDecodeError, or a number Python cannot hold
+                raise AvmError("%s:%d: not valid JSON: %s" % (path, number, e))
+            except RecursionError:
+                raise AvmError("%s:%d: JSON nested too deeply" % (path, number))
+            if not isinstance(obj, dict):
+                raise AvmError("%s:%d: expected a JSON object (a frame)" % (path, number))
             if number == 1 and obj.get("format") == "avatarmap.landmarks":
                 header = obj
                 continue
+            if not isinstance(obj.get("t"), (int, float)) or isinstance(obj.get("t"), bool):
+                raise AvmError('%s:%d: missing "t" or not a number (the frame time in seconds)'
+                               % (path, number))
             frames.append(obj)
     return header, frames
 
@@ -342,6 +358,8 @@ def main(argv):
     parser.add_argument("--rig", help="auto (default), a mapping table name or FILE.json")
     parser.add_argument("--mappings", help="folder of the mapping tables (or AVATARMAP_MAPPINGS)")
     parser.add_argument("--output", help="write the poses: .vrma, .bvh, .pose.jsonl, .glb")
+    parser.add_argument("--fps", type=float, default=0.0,
+                        help="resample the written clip at N frames per second (0: own times)")
     args = parser.parse_args(argv)
     if args.output and args.output.lower().endswith(".glb") and not args.avatar:
         parser.error("--output *.glb needs --avatar")
@@ -380,7 +398,7 @@ def main(argv):
                                                 retargeter.description()))
         if args.output:
             clip = Clip(lib)
-        max_angle, last_t = 0.0, None
+        max_angle, last_t, clip_last_t, skipped = 0.0, None, None, 0
         for obj in frames:
             frame, _keep = to_avm_frame(obj)
             solver.push(frame)
@@ -398,7 +416,14 @@ def main(argv):
                     raise AvmError("non-finite joint rotation at t=%g" % pose.t)
                 print("           avatar hips joint [x y z w] = [% .4f % .4f % .4f % .4f]" % tuple(j))
             if clip is not None:
-                clip.add(pose)
+                if clip_last_t is not None and not pose.t > clip_last_t:
+                    skipped += 1
+                    if skipped <= 5:
+                        print("warning: t=%g is not after the previous frame's t=%g: not added to "
+                              "the clip" % (pose.t, clip_last_t), file=sys.stderr)
+                else:
+                    clip.add(pose)
+                    clip_last_t = pose.t
             if last_t is not None:  # a render time between the last two captures
                 mid = solver.sample(0.5 * (last_t + pose.t))
                 if not all(math.isfinite(v) for v in mid.rotations[hips]):
@@ -406,11 +431,17 @@ def main(argv):
             last_t = pose.t
         print("summary: %d frame(s), largest hips rotation %.2f deg" % (len(frames), max_angle))
         if clip is not None:
-            clip.write(args.output, 0.0, args.avatar, args.rig)
+            if skipped:
+                print("skipped %d frame(s) out of time order" % skipped, file=sys.stderr)
+            clip.write(args.output, args.fps, args.avatar, args.rig)
             print("wrote %s (%d frames)" % (args.output, lib.avm_clip_frame_count(clip.handle)))
         return 0
     except (AvmError, OSError, ValueError, KeyError, TypeError) as e:
         print("error: %s" % e, file=sys.stderr)
+        return 1
+    except MemoryError:
+        print("error: out of memory (is the input file far larger than a capture?)",
+              file=sys.stderr)
         return 1
     finally:
         for handle in (solver, retargeter, clip):

@@ -17,6 +17,7 @@
 #include "avatarmap/synth/synth_skeleton.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
 #include "avatarmap/time/resample_clip.hpp"
+#include "avatarmap/time/seconds_text.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/rig_select.hpp"
@@ -301,8 +302,25 @@ int run_convert(int argc, char** argv) {
     return 1;
   }
   const double out_fps = fps_given ? fps : 30.0;
-  std::vector<proxy_pose> sampled =
-      (to_pose && !fps_given) ? frames : resample_clip(frames, out_fps, true);
+  // Resampling needs the frames in time order; landmark and pose files need not be (a capture
+  // may end with a frame stamped before its first). Sorted here (stably, so at equal times the
+  // later line wins), with a warning; the span and the output size are bounded by
+  // resample_clip (k_max_clip_seconds, k_max_resampled_frames).
+  std::vector<proxy_pose> sampled;
+  if (to_pose && !fps_given) {
+    sampled = frames;
+  } else {
+    if (const std::size_t moved = sort_clip_by_time(frames); moved > 0)
+      std::fprintf(stderr,
+                   "avatarmap convert: warning: %zu frame(s) of %s were out of time order; "
+                   "sorted by time before resampling\n",
+                   moved, a.rest()[0].c_str());
+    st = resample_clip(frames, out_fps, true, sampled, a.rest()[0]);
+    if (!st.ok()) {
+      std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
+      return 1;
+    }
+  }
 
   // Avatar outputs (.glb, and .bvh with --avatar) write the retargeted rig poses.
   const bool to_rig = to_glb || (to_bvh && !avatar.empty());
@@ -342,11 +360,11 @@ int run_convert(int argc, char** argv) {
   const double secs =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (!quiet) {
-    std::fprintf(
-        stderr, "converted %zu input frames (%.2f s) into %zu frames%s in %.3f s\n", frames.size(),
-        frames.back().t - frames.front().t, sampled.size(),
-        (to_pose && !fps_given) ? "" : (" at " + std::to_string(int(out_fps)) + " fps").c_str(),
-        secs);
+    char fps_text[48];  // --fps is within (0, 1000]: "%g" stays short
+    std::snprintf(fps_text, sizeof fps_text, " at %g fps", out_fps);
+    std::fprintf(stderr, "converted %zu input frames (%s s) into %zu frames%s in %.3f s\n",
+                 frames.size(), seconds_text(frames.back().t - frames.front().t, 2).c_str(),
+                 sampled.size(), (to_pose && !fps_given) ? "" : fps_text, secs);
     if (!avatar.empty())
       std::fprintf(stderr, "avatar %s: %d joints; %s\n", avatar.c_str(), r.joint_count(),
                    selection.description.c_str());

@@ -31,6 +31,18 @@ status select_rig_binding(const rig& r, const std::string& option, rig_selection
   out.binding = out.choice.binding;
   out.bound = out.choice.bound;
   out.description = out.choice.description;
+  // The library says what did not fit; the command line says what to do about it.
+  if (!st.ok() && out.choice.failure == rig_binding_failure::no_fit) {
+    const std::string avatar = r.file.empty() ? std::string("AVATAR") : r.file;
+    return status::error(st.message() +
+                         "\nTo drive this rig with convert or animate: name a table that fits "
+                         "with --rig NAME (a table in " +
+                         mappings_folder() +
+                         ") or --rig FILE.json (your own, see docs/mappings.md), or bind the "
+                         "bones yourself with --bind BONE=JOINT (repeatable, e.g. --bind "
+                         "hips=Pelvis; `avatarmap inspect " +
+                         avatar + "` lists the joints)");
+  }
   return st;
 }
 

@@ -10,6 +10,8 @@
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
+#include "avatarmap/time/resample_clip.hpp"
+#include "avatarmap/time/seconds_text.hpp"
 #include "cli/frame_prefetcher.hpp"
 
 namespace avatarmap::cli {
@@ -66,7 +68,12 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
   const bool show_progress = job.progress == progress_mode::on ||
                              (job.progress == progress_mode::automatic && isatty(STDERR_FILENO));
   auto last_progress = t0;
-  double next_render_t = 0.0;
+  // --fps: poses are written at t_render0 + j / fps for j = 0, 1, 2, ... (t_render0 = the first
+  // frame's time); j_next is the next one to write. A counted j (not a time advanced by 1 / fps)
+  // keeps the number of poses per frame exact and bounded whatever the times' magnitude.
+  const double fps = job.output_fps;
+  double t_render0 = 0.0, t_newest = 0.0;
+  long j_next = 0;
   bool have_render = false;
   s.hips_height_min = 1e9f;
   s.hips_height_max = -1e9f;
@@ -86,6 +93,28 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
         continue;
       }
       const landmark_frame& frame = src.frame();
+      const long index = s.frames + s.out_of_order;  // 0-based among the good frames
+      if (fps > 0.0 && have_render) {
+        if (frame.t < t_newest) {
+          // Resampling cannot go back in time. The frame is left out entirely (solving it would
+          // also restart the pose filter), with a warning.
+          ++s.out_of_order;
+          if (s.out_of_order <= 5)
+            std::fprintf(stderr,
+                         "warning: frame %ld (t = %s s) is earlier than the frame before it "
+                         "(t = %s s); skipped (--fps needs times in order)\n",
+                         index, seconds_text(frame.t).c_str(), seconds_text(t_newest).c_str());
+          src.release();
+          continue;
+        }
+        if (frame.t - t_render0 > k_max_clip_seconds)
+          return status::error(job.input + ": frame " + std::to_string(index) +
+                               " (t = " + seconds_text(frame.t) + " s) is " +
+                               seconds_text(frame.t - t_render0, 2) +
+                               " s after the first frame; --fps resamples at most " +
+                               seconds_text(k_max_clip_seconds, 0) +
+                               " s (24 h): check the times or solve without --fps");
+      }
       if (s.frames == 0) s.t_first = frame.t;
       s.t_last = frame.t;
       ++s.frames;
@@ -104,21 +133,38 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
       filter.apply(solved, filtered);
       s.hips_height_min = std::min(s.hips_height_min, filtered.hips_position.y);
       s.hips_height_max = std::max(s.hips_height_max, filtered.hips_position.y);
-      if (job.output_fps > 0.0) {
+      if (fps > 0.0) {
         if (!resampler.push(filtered)) continue;
         if (!have_render) {
-          next_render_t = filtered.t;
+          t_render0 = filtered.t;
           have_render = true;
         }
-        long k = 0;
-        const double base = next_render_t;
-        for (double rt = base; rt <= filtered.t + 1e-9; rt = base + double(++k) / job.output_fps) {
+        t_newest = filtered.t;
+        // The last render time at or before this frame (1e-9 s of tolerance): an estimate,
+        // then at most a step or two to settle rounding (times are within
+        // k_max_clip_seconds of t_render0, so j stays far below LONG_MAX).
+        auto at_or_before = [&](long j) {
+          return t_render0 + static_cast<double>(j) / fps <= filtered.t + 1e-9;
+        };
+        // Checked as a double before any cast: an absurd rate must not overflow the count.
+        const double estimate = std::floor((filtered.t - t_render0) * fps) + 2.0;
+        if (!(estimate - static_cast<double>(j_next) + static_cast<double>(s.poses_written) <=
+              static_cast<double>(k_max_resampled_frames)))
+          return status::error(job.input + ": --fps " + seconds_text(fps, 2) + " up to frame " +
+                               std::to_string(index) + " (t = " + seconds_text(filtered.t) +
+                               " s) would write more than " +
+                               std::to_string(k_max_resampled_frames) +
+                               " poses; lower --fps or split the input");
+        long j_last = static_cast<long>(estimate) - 2;
+        for (int step = 0; step < 2 && at_or_before(j_last + 1); ++step) ++j_last;
+        for (int step = 0; step < 2 && j_last >= j_next && !at_or_before(j_last); ++step) --j_last;
+        for (; j_next <= j_last; ++j_next) {
+          const double rt = t_render0 + static_cast<double>(j_next) / fps;
           if (!resampler.sample(rt, sampled)) break;
           sampled.t = rt;
           status w = emit(sampled);
           if (!w.ok()) return w;
           ++s.poses_written;
-          next_render_t = base + double(k + 1) / job.output_fps;
         }
       } else {
         status w = emit(filtered);
@@ -130,8 +176,9 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
         if (std::chrono::duration<double>(now - last_progress).count() > 0.25) {
           last_progress = now;
           double el = seconds_since(t0);
-          std::fprintf(stderr, "\rsolve: %ld frames, %.1f s of capture, %.0f frames/s   ", s.frames,
-                       s.t_last - s.t_first, s.frames / std::max(el, 1e-9));
+          std::fprintf(stderr, "\rsolve: %ld frames, %s s of capture, %.0f frames/s   ", s.frames,
+                       seconds_text(s.t_last - s.t_first, 1).c_str(),
+                       s.frames / std::max(el, 1e-9));
           std::fflush(stderr);
         }
       }
@@ -163,9 +210,9 @@ status run_solve_job(const solve_job& job, solve_summary& s) {
 }
 
 void print_summary(const solve_job& job, const solve_summary& s, std::FILE* to) {
-  std::fprintf(to,
-               "solved %ld frames (%.2f s of capture, t = %.3f .. %.3f) in %.3f s: %.0f frames/s\n",
-               s.frames, s.t_last - s.t_first, s.t_first, s.t_last, s.seconds,
+  std::fprintf(to, "solved %ld frames (%s s of capture, t = %s .. %s) in %.3f s: %.0f frames/s\n",
+               s.frames, seconds_text(s.t_last - s.t_first, 2).c_str(),
+               seconds_text(s.t_first).c_str(), seconds_text(s.t_last).c_str(), s.seconds,
                s.frames / std::max(s.seconds, 1e-9));
   std::fprintf(to, "parts seen: pose %ld, pose_world %ld, left hand %ld, right hand %ld, face %ld",
                s.part_frames[0], s.part_frames[1], std::max(s.part_frames[2], s.part_frames[3]),
@@ -179,6 +226,11 @@ void print_summary(const solve_job& job, const solve_summary& s, std::FILE* to) 
                  "warning: the input has no image_size header and no --image-size was given: "
                  "square pixels assumed (face ratios and root motion may be off)\n");
   if (s.bad_lines > 0) std::fprintf(to, "skipped %ld malformed lines\n", s.bad_lines);
+  if (s.out_of_order > 0)
+    std::fprintf(to,
+                 "skipped %ld frames earlier than the frame before them (--fps needs times in "
+                 "order)\n",
+                 s.out_of_order);
   std::fprintf(to, "wrote %ld poses to %s%s\n", s.poses_written, job.output.c_str(),
                job.output_fps > 0.0 ? " (resampled)" : "");
 }

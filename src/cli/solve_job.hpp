@@ -30,7 +30,11 @@ struct solve_job {
     o.enabled = false;  // off unless asked for (--filter landmarks|both)
     return o;
   }();
-  double output_fps = 0.0;  // 0 = one pose per input frame
+  /// 0 = one pose per input frame, in the file's order. > 0: poses at t_first + j / fps; a frame
+  /// earlier than the one before it is skipped with a warning (counted in out_of_order), and a
+  /// frame more than k_max_clip_seconds after the first, or more than k_max_resampled_frames
+  /// poses in all, fail the job (avatarmap/time/resample_clip.hpp).
+  double output_fps = 0.0;
   bool skip_bad_lines = false;
   bool write_confidence = false;
   progress_mode progress = progress_mode::automatic;
@@ -42,6 +46,8 @@ struct solve_summary {
   long frames = 0;
   long poses_written = 0;
   long bad_lines = 0;
+  /// With output_fps > 0: frames left out because their time was earlier than the frame before.
+  long out_of_order = 0;
   long part_frames[k_frame_part_count] = {};
   long face_iris_frames = 0;
   double t_first = 0.0;

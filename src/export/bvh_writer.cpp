@@ -74,7 +74,9 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
   if (status s = export_detail::check_frames(path, frames, options.fps); !s) return s;
   if (!std::isfinite(options.height) || options.height <= 0.f)
     return status::error(path + ": height must be positive, got " + std::to_string(options.height));
-  const std::vector<proxy_pose> keys = export_detail::frames_to_write(frames, options.fps, true);
+  std::vector<proxy_pose> keys;
+  if (status s = export_detail::frames_to_write(path, frames, options.fps, true, keys); !s)
+    return s;
   double frame_time = 1.0 / 30.0;
   if (options.fps > 0.0)
     frame_time = 1.0 / options.fps;

@@ -73,8 +73,11 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
     return status::error(path +
                          ": frame 0 has a negative time (glTF times start at 0); set "
                          "start_at_zero");
-  const std::vector<proxy_pose> keys =
-      export_detail::frames_to_write(frames, options.fps, options.start_at_zero);
+  std::vector<proxy_pose> keys;
+  if (status s = export_detail::frames_to_write(path, frames, options.fps, options.start_at_zero,
+                                                keys);
+      !s)
+    return s;
   const std::size_t n = keys.size();
 
   const synth_skeleton skeleton = make_synth_skeleton(options.height);

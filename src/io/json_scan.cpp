@@ -63,6 +63,30 @@ std::string describe_char(const char* p, const char* end) {
   return s;
 }
 
+const char* json_number_end(const char* p, const char* end) {
+  auto digit = [end](const char* q) { return q < end && *q >= '0' && *q <= '9'; };
+  if (p < end && *p == '-') ++p;
+  if (!digit(p)) return nullptr;
+  if (*p == '0') {
+    ++p;
+    if (digit(p)) return nullptr;  // a leading zero: "00.5", "01"
+  } else {
+    while (digit(p)) ++p;
+  }
+  if (p < end && *p == '.') {
+    ++p;
+    if (!digit(p)) return nullptr;  // "1." and "1.e5"
+    while (digit(p)) ++p;
+  }
+  if (p < end && (*p == 'e' || *p == 'E')) {
+    ++p;
+    if (p < end && (*p == '+' || *p == '-')) ++p;
+    if (!digit(p)) return nullptr;  // "1e", "1e+"
+    while (digit(p)) ++p;
+  }
+  return p;
+}
+
 bool json_cursor::fail(std::string_view message) {
   if (error.empty()) {
     error.assign(message);
@@ -116,14 +140,21 @@ bool json_cursor::parse_special(double& out, bool* was_null, bool as_float) {
   }
   if (p < end &&
       ((*p >= '0' && *p <= '9') || (*p == '-' && p + 1 < end && p[1] >= '0' && p[1] <= '9'))) {
+    // from_chars accepts more than JSON ("00.5", "1.", "1.e5"): the token must be a JSON
+    // number, read in full.
+    const char* token_end = json_number_end(p, end);
+    if (token_end == nullptr)
+      return fail("not a JSON number (no leading zeros; digits must follow '.' and 'e')");
     std::from_chars_result r;
     if (as_float) {
       float f = 0.f;
-      r = std::from_chars(p, end, f);
+      r = std::from_chars(p, token_end, f);
       out = f;
     } else {
-      r = std::from_chars(p, end, out);
+      r = std::from_chars(p, token_end, out);
     }
+    if (r.ec == std::errc() && r.ptr != token_end)
+      return fail("not a JSON number (no leading zeros; digits must follow '.' and 'e')");
     if (r.ec == std::errc::result_out_of_range) {
       out = out_of_range_value(p, r.ptr);
       p = r.ptr;
@@ -267,8 +298,11 @@ bool json_cursor::parse_string(std::string_view& out, std::string& scratch) {
 }
 
 bool json_cursor::skip_value(int depth) {
-  if (depth > k_max_json_depth) return fail("nesting too deep (at most 256 levels)");
   char c = peek();
+  // `depth` containers are open around this value; opening one more must stay within the
+  // limit (a scalar inside the deepest allowed array is fine).
+  if ((c == '{' || c == '[') && depth >= k_max_json_depth)
+    return fail("nesting too deep (at most 256 levels of arrays and objects)");
   switch (c) {
     case '"': {
       std::string_view s;

@@ -14,8 +14,14 @@
 
 namespace avatarmap::io_detail {
 
-/// Deepest nesting skip_value() accepts inside an unknown key's value.
+/// Deepest nesting of arrays and objects skip_value() accepts in an unknown key's value: a
+/// value of 256 nested arrays passes, 257 fail ("[]" is one level).
 inline constexpr int k_max_json_depth = 256;
+
+/// End of the JSON number token starting at `p` (RFC 8259 grammar: optional '-', no leading
+/// zeros, digits after '.' and after 'e'), or nullptr when the text there is not one. Digits
+/// that follow a valid token (the "1" of "01") make it invalid.
+const char* json_number_end(const char* p, const char* end);
 
 struct json_cursor {
   const char* p = nullptr;
@@ -62,11 +68,14 @@ struct json_cursor {
       if (was_null) *was_null = false;
       return true;
     }
-    // Otherwise a JSON number that std::from_chars reads correctly rounded.
+    // Otherwise a JSON number that std::from_chars reads correctly rounded (from_chars alone
+    // would also take "00.5" or "1.": the token is checked against JSON's grammar first).
     if (p < end &&
         ((*p >= '0' && *p <= '9') || (*p == '-' && p + 1 < end && p[1] >= '0' && p[1] <= '9'))) {
-      auto r = std::from_chars(p, end, out);
-      if (r.ec == std::errc()) {
+      const char* token_end = json_number_end(p, end);
+      auto r = token_end ? std::from_chars(p, token_end, out)
+                         : std::from_chars_result{p, std::errc::invalid_argument};
+      if (r.ec == std::errc() && r.ptr == token_end) {
         p = r.ptr;
         if (was_null) *was_null = false;
         return true;
@@ -78,8 +87,10 @@ struct json_cursor {
     skip_ws();
     if (p < end &&
         ((*p >= '0' && *p <= '9') || (*p == '-' && p + 1 < end && p[1] >= '0' && p[1] <= '9'))) {
-      auto r = std::from_chars(p, end, out);
-      if (r.ec == std::errc()) {
+      const char* token_end = json_number_end(p, end);
+      auto r = token_end ? std::from_chars(p, token_end, out)
+                         : std::from_chars_result{p, std::errc::invalid_argument};
+      if (r.ec == std::errc() && r.ptr == token_end) {
         p = r.ptr;
         if (was_null) *was_null = false;
         return true;

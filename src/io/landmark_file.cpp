@@ -286,6 +286,14 @@ struct landmark_reader::impl {
     if (ok && !has_t) {
       if (header.fps > 0) {
         out.t = static_cast<double>(index) / header.fps;
+        if (!std::isfinite(out.t)) {
+          // A subnormal "fps" such as 1e-310 overflows index / fps.
+          core.set_error(
+              "the frame time (line index / the header's \"fps\") is not finite: \"fps\" is "
+              "too small; give each frame a \"t\" or the real frame rate");
+          out.clear();
+          return read_result::error;
+        }
       } else {
         core.set_error(
             "missing \"t\" (expected the frame time in seconds; it may only be "

@@ -1,23 +1,33 @@
 #include "avatarmap/io/tfjs_import.hpp"
 
-#include <fstream>
+#include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
 
 #include "avatarmap/io/landmark_file.hpp"
+#include "io/json_text.hpp"
 
 namespace avatarmap {
 
 namespace {
 
+// The recordings are a few MB; the limits (io/json_limits.hpp) keep a hostile file from
+// nesting nlohmann's recursion into a stack overflow or reading without bound.
 status load_json(const std::string& path, nlohmann::json& out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return status::error(path + ": cannot open for reading");
-  out = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (out.is_discarded()) return status::error(path + ": not valid JSON");
+  if (status s = io_detail::read_json_file(path, out); !s) return s;
   if (!out.is_array())
-    return status::error(path + ": expected a JSON array of frames (tfjs-models test format)");
+    return status::error(path +
+                         ": expected a JSON array of frames (tfjs-models test format), got " +
+                         io_detail::json_type_text(out));
   return {};
+}
+
+// `d` as a float; beyond the float range it becomes +-inf ("not seen" in a landmark file)
+// instead of the undefined behaviour of a plain cast.
+float to_float(double d) {
+  if (std::fabs(d) > static_cast<double>(std::numeric_limits<float>::max()))
+    return d > 0 ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+  return static_cast<float>(d);
 }
 
 // Reads 33 points of 3 numbers from frame `i` of `doc`.
@@ -26,12 +36,16 @@ status read_frame(const nlohmann::json& doc, std::size_t i, const std::string& p
   const nlohmann::json& f = doc[i];
   if (!f.is_array() || f.size() != static_cast<std::size_t>(k_pose_landmark_count))
     return status::error(path + ": frame " + std::to_string(i) +
-                         ": expected an array of 33 points");
+                         ": expected an array of 33 points, got " +
+                         (f.is_array() ? "an array of " + std::to_string(f.size())
+                                       : std::string(io_detail::json_type_text(f))));
   for (int k = 0; k < k_pose_landmark_count; ++k) {
     const nlohmann::json& p = f[static_cast<std::size_t>(k)];
     if (!p.is_array() || p.size() < 3)
       return status::error(path + ": frame " + std::to_string(i) + " point " + std::to_string(k) +
-                           ": expected [x, y, z]");
+                           ": expected [x, y, z], got " +
+                           (p.is_array() ? "an array of " + std::to_string(p.size())
+                                         : std::string(io_detail::json_type_text(p))));
     for (int c = 0; c < 3; ++c) {
       const nlohmann::json& v = p[static_cast<std::size_t>(c)];
       out[k][c] = v.is_number() ? v.get<double>() : std::numeric_limits<double>::quiet_NaN();
@@ -47,7 +61,9 @@ status import_tfjs_pose(const std::string& image_json, const std::string& world_
                         const std::string& out_landmarks_path) {
   if (image_width <= 0 || image_height <= 0)
     return status::error("import_tfjs_pose: image_width and image_height must be > 0");
-  if (!(fps > 0)) return status::error("import_tfjs_pose: fps must be > 0");
+  if (!(fps > 0) || !std::isfinite(fps))
+    return status::error("import_tfjs_pose: fps must be a positive finite number, got " +
+                         std::to_string(fps));
   nlohmann::json image, world;
   if (status s = load_json(image_json, image); !s) return s;
   if (status s = load_json(world_json, world); !s) return s;
@@ -55,6 +71,9 @@ status import_tfjs_pose(const std::string& image_json, const std::string& world_
     return status::error(image_json + " has " + std::to_string(image.size()) + " frames but " +
                          world_json + " has " + std::to_string(world.size()) +
                          " (expected the same number)");
+  if (!image.empty() && !std::isfinite(static_cast<double>(image.size() - 1) / fps))
+    return status::error("import_tfjs_pose: fps " + std::to_string(fps) +
+                         " is too small: the last frame's time would not be finite");
 
   landmark_file_header header;
   header.present = true;
@@ -72,10 +91,10 @@ status import_tfjs_pose(const std::string& image_json, const std::string& world_
     frame.clear();
     frame.t = static_cast<double>(i) / fps;
     for (int k = 0; k < k_pose_landmark_count; ++k) {
-      frame.pose[k] = landmark{static_cast<float>(img[k][0] / w), static_cast<float>(img[k][1] / h),
-                               static_cast<float>(img[k][2] / w), 1.f, 1.f};
-      frame.pose_world[k] = landmark{static_cast<float>(wld[k][0]), static_cast<float>(wld[k][1]),
-                                     static_cast<float>(wld[k][2]), 1.f, 1.f};
+      frame.pose[k] = landmark{to_float(img[k][0] / w), to_float(img[k][1] / h),
+                               to_float(img[k][2] / w), 1.f, 1.f};
+      frame.pose_world[k] =
+          landmark{to_float(wld[k][0]), to_float(wld[k][1]), to_float(wld[k][2]), 1.f, 1.f};
     }
     frame.set(frame_part::pose, true);
     frame.set(frame_part::pose_world, true);

@@ -4,14 +4,13 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 
 #include "avatarmap/skeleton/expression.hpp"
+#include "io/json_text.hpp"
 
 namespace avatarmap {
 
@@ -99,7 +98,8 @@ status check_keys(const context& c, const std::string& key, const json& object,
 
 status get_string(const context& c, const std::string& key, const json& v, std::string& out,
                   bool allow_empty = false) {
-  if (!v.is_string()) return c.error(key, "expected a string");
+  if (!v.is_string())
+    return c.error(key, std::string("expected a string, got ") + io_detail::json_type_text(v));
   out = v.get<std::string>();
   if (out.empty() && !allow_empty) return c.error(key, "must not be empty");
   return {};
@@ -108,7 +108,9 @@ status get_string(const context& c, const std::string& key, const json& v, std::
 status get_string_list(const context& c, const std::string& key, const json& v,
                        std::vector<std::string>& out, bool allow_empty_strings = false) {
   out.clear();
-  if (!v.is_array()) return c.error(key, "expected an array of strings");
+  if (!v.is_array())
+    return c.error(
+        key, std::string("expected an array of strings, got ") + io_detail::json_type_text(v));
   for (std::size_t i = 0; i < v.size(); ++i) {
     std::string s;
     if (status st =
@@ -121,7 +123,9 @@ status get_string_list(const context& c, const std::string& key, const json& v,
 }
 
 status parse_order(const context& c, const std::string& key, const json& v, euler_order& out) {
-  if (!v.is_string()) return c.error(key, "expected an Euler order string such as \"ZXY\"");
+  if (!v.is_string())
+    return c.error(key, std::string("expected an Euler order string such as \"ZXY\", got ") +
+                            io_detail::json_type_text(v));
   auto o = euler_order_from_name(v.get<std::string>());
   if (!o)
     return c.error(key, "bad Euler order " + quote(v.get<std::string>()) +
@@ -163,7 +167,9 @@ status check_duplicates(const context& c, const std::string& bones_key, const ma
 }
 
 status parse_bone(const context& c, const std::string& key, const json& v, mapping_bone& out) {
-  if (!v.is_object()) return c.error(key, "expected an object {\"rig\": ...}");
+  if (!v.is_object())
+    return c.error(
+        key, std::string("expected an object {\"rig\": ...}, got ") + io_detail::json_type_text(v));
   if (status s = check_keys(c, key, v, {"rig", "order", "target_order", "f", "rest"}); !s) return s;
   auto rig_it = v.find("rig");
   if (rig_it == v.end()) return c.error(key, "missing \"rig\" (the rig joint name)");
@@ -204,12 +210,16 @@ status parse_bone(const context& c, const std::string& key, const json& v, mappi
 }
 
 status parse_table(const context& c, const json& doc, mapping_table& t) {
-  if (!doc.is_object()) return c.error("", "expected a JSON object");
+  if (!doc.is_object())
+    return c.error("", std::string("expected a JSON object (a mapping table), got ") +
+                           io_detail::json_type_text(doc));
   auto ver = doc.find("format_version");
   if (ver == doc.end())
     return c.error("", "missing \"format_version\" (this reader reads version " +
                            std::to_string(k_mapping_format_version) + ")");
-  if (!ver->is_number_integer()) return c.error("format_version", "expected an integer");
+  if (!ver->is_number_integer())
+    return c.error("format_version",
+                   std::string("expected an integer, got ") + io_detail::json_type_text(*ver));
   const long long version = ver->get<long long>();
   if (version > k_mapping_format_version)
     return c.error("format_version",
@@ -241,7 +251,9 @@ status parse_table(const context& c, const json& doc, mapping_table& t) {
       return c.error("rest_pose", "expected \"t_pose\", \"a_pose\" or \"file\", got " + quote(r));
   }
   if (auto it = doc.find("units_scale"); it != doc.end()) {
-    if (!it->is_number()) return c.error("units_scale", "expected a number");
+    if (!it->is_number())
+      return c.error("units_scale",
+                     std::string("expected a number, got ") + io_detail::json_type_text(*it));
     if (!finite_float(*it, t.units_scale) || !(t.units_scale > 0.f))
       return c.error("units_scale", "must be a positive finite number");
     t.has_units_scale = true;
@@ -322,13 +334,14 @@ status parse_table(const context& c, const json& doc, mapping_table& t) {
   return {};
 }
 
-bool read_file(const std::string& path, std::string& out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  out = ss.str();
-  return !in.bad();
+// The table in `doc` into `out` (left empty on failure); `name` is recorded as its file.
+status table_from_json(const context& c, const json& doc, const std::string& name,
+                       mapping_table& out) {
+  mapping_table t;
+  t.file = name;
+  if (status s = parse_table(c, doc, t); !s) return s;
+  out = std::move(t);
+  return {};
 }
 
 // SysMocap binding key -> bone. PascalCase keys are VRM 0.x humanoid names (three-vrm 0.x's
@@ -361,24 +374,17 @@ int mapping_table::mapped_count() const {
 status load_mapping_json(std::string_view text, const std::string& name, mapping_table& out) {
   out = mapping_table{};
   context c{name.empty() ? std::string("<mapping>") : name};
+  // Depth and size limits first, then the parse, errors in our words (io/json_text.hpp).
   json doc;
-  try {
-    doc = json::parse(text.begin(), text.end());
-  } catch (const json::exception& e) {  // parse_error, out_of_range (a number like 1e400)
-    return c.error("", std::string("invalid JSON: ") + e.what());
-  }
-  mapping_table t;
-  t.file = name;
-  if (status s = parse_table(c, doc, t); !s) return s;
-  out = std::move(t);
-  return {};
+  if (status s = io_detail::parse_json_text(text, c.file, doc); !s) return s;
+  return table_from_json(c, doc, name, out);
 }
 
 status load_mapping(const std::string& path, mapping_table& out) {
   out = mapping_table{};
-  std::string text;
-  if (!read_file(path, text)) return status::error(path + ": cannot read the file");
-  return load_mapping_json(text, path, out);
+  json doc;
+  if (status s = io_detail::read_json_file(path, doc); !s) return s;
+  return table_from_json(context{path}, doc, path, out);
 }
 
 status load_mapping_folder(const std::string& folder, std::vector<mapping_table>& out) {
@@ -527,8 +533,8 @@ status auto_detect(const std::vector<mapping_table>& tables, const rig& r, int& 
 status import_sysmocap_binding(std::string_view text, mapping_table& out) {
   out = mapping_table{};
   context c{"SysMocap binding"};
-  json doc = json::parse(text.begin(), text.end(), nullptr, false);
-  if (doc.is_discarded()) return c.error("", "invalid JSON");
+  json doc;
+  if (status s = io_detail::parse_json_text(text, c.file, doc); !s) return s;
   const json* model = nullptr;
   std::string key_base = "binding";
   if (doc.is_array()) {

@@ -151,6 +151,43 @@ TEST(bvh, malformed_files_give_errors) {
   std::string bad_channel = good;
   bad_channel.replace(bad_channel.find("Zrotation"), 9, "Wrotation");
   expect_error("channel.bvh", bad_channel, "unknown channel");
+  // Hostile numbers and sizes (issue 8): doubles beyond the float range, non-finite tokens, a
+  // "Frames:" line far larger than the file, deep nesting: errors, not infinities or huge
+  // allocations.
+  auto with_value = [&](const std::string& value) {
+    std::string text = good;
+    const std::size_t frame_time = text.find("Frame Time:");
+    const std::size_t line_end = text.find('\n', frame_time);
+    const std::size_t first_value_end = text.find(' ', line_end + 1);
+    text.replace(line_end + 1, first_value_end - line_end - 1, value);
+    return text;
+  };
+  expect_error("value_1e300.bvh", with_value("1e300"), "within the float range");
+  expect_error("value_nan.bvh", with_value("nan"), "bad motion value \"nan\"");
+  expect_error("value_inf.bvh", with_value("-inf"), "bad motion value");
+  std::string big_offset = good;
+  big_offset.replace(big_offset.find("OFFSET") + 7, 1, "1e39 ");
+  expect_error("offset_1e39.bvh", big_offset, "within the float range");
+  std::string many = good;
+  const std::size_t frames_at = many.find("Frames:");
+  many.replace(frames_at, many.find('\n', frames_at) - frames_at, "Frames: 1000000");
+  expect_error("many_frames.bvh", many, "need 168000000 values, but the rest of the file holds");
+  std::string too_many = good;
+  too_many.replace(frames_at, too_many.find('\n', frames_at) - frames_at, "Frames: 1e12");
+  expect_error("too_many_frames.bvh", too_many, "Frames: expects a whole number");
+  auto nested = [](int levels) {
+    std::string t = "HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 0\n";
+    for (int i = 1; i < levels; ++i) t += "JOINT j" + std::to_string(i) + "\n{\nOFFSET 0 1 0\n";
+    t += "End Site\n{\nOFFSET 0 1 0\n}\n";
+    for (int i = 0; i < levels; ++i) t += "}\n";
+    return t + "MOTION\nFrames: 1\nFrame Time: 0.1\n\n";
+  };
+  test::write_text(dir.file("deep256.bvh"), nested(256));
+  status deep_ok = read_bvh(dir.file("deep256.bvh"), clip);
+  EXPECT_TRUE(deep_ok.ok()) << deep_ok.message();
+  EXPECT_EQ(clip.joints.size(), 256u);
+  expect_error("deep257.bvh", nested(257), "nested deeper than 256 levels");
+  expect_error("deep100k.bvh", nested(100000), "nested deeper than 256 levels");
   for (int trial = 0; trial < 300; ++trial) {
     std::string bad = good.substr(0, rng() % good.size());
     for (int k = 0; k < 4 && !bad.empty(); ++k) bad[rng() % bad.size()] = static_cast<char>(rng());

@@ -111,6 +111,83 @@ TEST(json_scan, skip_value_skips_any_value) {
   }
 }
 
+// Nesting: the documented limit is 256 levels of arrays/objects (k_max_json_depth); a value
+// with exactly 256 passes and 257 fails, whether the innermost container is empty or holds a
+// scalar, for arrays, objects and a mix.
+TEST(json_scan, nesting_limit_is_exactly_256_levels) {
+  auto arrays = [](int levels, const std::string& inner) {
+    return std::string(static_cast<std::size_t>(levels), '[') + inner +
+           std::string(static_cast<std::size_t>(levels), ']');
+  };
+  auto objects = [](int levels) {
+    std::string s;
+    for (int i = 0; i < levels; ++i) s += i + 1 < levels ? "{\"k\":" : "{}";
+    return s + std::string(static_cast<std::size_t>(levels - 1), '}');
+  };
+  auto mixed = [](int levels) {
+    std::string open, close;
+    for (int i = 0; i < levels; ++i) {
+      const bool object = i % 2 == 1;
+      open += object ? "{\"k\":" : "[";
+      close = std::string(object ? "}" : "]") + close;
+    }
+    return open + "1" + close;
+  };
+  ASSERT_EQ(k_max_json_depth, 256);
+  for (const std::string& inner : {std::string(), std::string("1"), std::string("\"s\"")}) {
+    for (int levels : {1, 255, 256, 257, 300}) {
+      const std::string s = arrays(levels, inner);
+      json_cursor c(s.data(), s.data() + s.size());
+      const bool ok = c.skip_value() && c.at_end();
+      EXPECT_EQ(ok, levels <= 256) << levels << " arrays around '" << inner << "'";
+      if (levels > 256) EXPECT_NE(c.error.find("nesting too deep"), std::string::npos) << c.error;
+    }
+  }
+  for (int levels : {1, 256, 257}) {
+    const std::string o = objects(levels);
+    json_cursor c(o.data(), o.data() + o.size());
+    EXPECT_EQ(c.skip_value() && c.at_end(), levels <= 256) << levels << " objects";
+    const std::string m = mixed(levels);
+    json_cursor d(m.data(), m.data() + m.size());
+    EXPECT_EQ(d.skip_value() && d.at_end(), levels <= 256) << levels << " mixed";
+  }
+}
+
+// JSON numbers (RFC 8259): no leading zeros, digits after '.' and after 'e'. std::from_chars,
+// which the slow paths use, would accept "00.5" and "1."; the scanner must not.
+TEST(json_scan, numbers_follow_the_json_grammar) {
+  for (std::string good : {"0", "-0", "0.5", "-0.5e-3", "0e0", "10", "1E+2", "123.456e7", "1e400",
+                           "0.0000000000000000000000000000000000000000000001"}) {
+    json_cursor f(good.data(), good.data() + good.size());
+    float x;
+    EXPECT_TRUE(f.parse_float(x) && f.at_end()) << good << ": " << f.error;
+    json_cursor d(good.data(), good.data() + good.size());
+    double y;
+    EXPECT_TRUE(d.parse_double(y) && d.at_end()) << good << ": " << d.error;
+    json_cursor v(good.data(), good.data() + good.size());
+    EXPECT_TRUE(v.skip_value() && v.at_end()) << good << ": " << v.error;
+  }
+  for (std::string bad : {"00.5", "00", "01", "-01", "-00.5", "0123456789012345678901234", "1.",
+                          "1.e5", "-1.", "1e", "1e+", "1E-", "007e400", "00.5e-400"}) {
+    json_cursor f(bad.data(), bad.data() + bad.size());
+    float x;
+    EXPECT_FALSE(f.parse_float(x) && f.at_end()) << bad;
+    json_cursor d(bad.data(), bad.data() + bad.size());
+    double y;
+    EXPECT_FALSE(d.parse_double(y) && d.at_end()) << bad;
+    json_cursor v(bad.data(), bad.data() + bad.size());
+    EXPECT_FALSE(v.skip_value() && v.at_end()) << bad;
+  }
+  const std::string list = "12,";
+  EXPECT_EQ(json_number_end(list.data(), list.data() + list.size()), list.data() + 2);
+  const std::string lead = "00.5";
+  EXPECT_EQ(json_number_end(lead.data(), lead.data() + lead.size()), nullptr);
+  json_cursor c(lead.data(), lead.data() + lead.size());
+  double y;
+  ASSERT_FALSE(c.parse_double(y));
+  EXPECT_NE(c.error.find("not a JSON number"), std::string::npos) << c.error;
+}
+
 TEST(line_source, lines_across_blocks) {
   std::string text = "a\nbb\r\n\nccc\r\nlast";
   std::vector<std::string> expected = {"a", "bb", "", "ccc", "last"};

@@ -330,6 +330,12 @@ TEST(landmark_file, malformed_lines_name_file_line_and_problem_and_reading_goes_
       {"control char", std::string("{\"t\":0,\"a\x01\":1}"), "control character"},
       {"deep nesting", "{\"t\":0,\"x\":" + std::string(300, '[') + std::string(300, ']') + "}",
        "nesting too deep"},
+      // One level over the documented 256, with an empty innermost array (this passed before).
+      {"257 levels", "{\"t\":0,\"x\":" + std::string(257, '[') + std::string(257, ']') + "}",
+       "nesting too deep"},
+      {"leading zero t", "{\"t\":00.5}", "in \"t\": not a JSON number"},
+      {"leading zero point", "{\"t\":0,\"pose\":[[01,0,0]]}", "not a JSON number"},
+      {"dot without digits", "{\"t\":1.}", "not a JSON number"},
   };
   // Each bad line sits between good lines; the reader reports it and goes on.
   std::string text = "{\"format\":\"avatarmap.landmarks\",\"version\":1}\n";
@@ -358,6 +364,32 @@ TEST(landmark_file, malformed_lines_name_file_line_and_problem_and_reading_goes_
   EXPECT_EQ(f.t, 2.0);
   EXPECT_TRUE(r.error().empty());
   EXPECT_EQ(r.next(f), read_result::end);
+}
+
+TEST(landmark_file, unknown_values_nest_up_to_256_levels) {
+  for (int levels : {255, 256}) {
+    const std::string text = "{\"t\":0.5,\"x\":" + std::string(levels, '[') +
+                             std::string(levels, ']') + ",\"y\":" + std::string(levels, '[') + "1" +
+                             std::string(levels, ']') + "}\n";
+    landmark_reader r;
+    ASSERT_TRUE(r.open_memory(text.data(), text.size()).ok());
+    landmark_frame f;
+    ASSERT_EQ(r.next(f), read_result::frame) << levels << ": " << r.error();
+    EXPECT_EQ(f.t, 0.5);
+  }
+}
+
+TEST(landmark_file, header_fps_too_small_for_the_frame_times) {
+  // index / fps overflows to +inf from the second frame on: an error, not an infinite time.
+  std::string text = "{\"format\":\"avatarmap.landmarks\",\"fps\":1e-310}\n{}\n{}\n";
+  landmark_reader r;
+  ASSERT_TRUE(r.open_memory(text.data(), text.size(), "tiny.jsonl").ok());
+  landmark_frame f;
+  ASSERT_EQ(r.next(f), read_result::frame);
+  EXPECT_EQ(f.t, 0.0);
+  ASSERT_EQ(r.next(f), read_result::error);
+  EXPECT_NE(r.error().find("tiny.jsonl:3: the frame time"), std::string::npos) << r.error();
+  EXPECT_NE(r.error().find("\"fps\" is too small"), std::string::npos) << r.error();
 }
 
 TEST(landmark_file, missing_t_uses_header_fps) {

@@ -143,6 +143,17 @@ TEST(pose_file, missing_t_uses_header_fps) {
   EXPECT_DOUBLE_EQ(p.t, 0.1);
 }
 
+TEST(pose_file, header_fps_too_small_for_the_frame_times) {
+  std::string text = "{\"format\":\"avatarmap.pose\",\"fps\":1e-310}\n{}\n{}\n";
+  pose_reader r;
+  ASSERT_TRUE(r.open_memory(text.data(), text.size(), "tiny.pose.jsonl").ok());
+  proxy_pose p;
+  ASSERT_EQ(r.next(p), read_result::frame);
+  EXPECT_EQ(p.t, 0.0);
+  ASSERT_EQ(r.next(p), read_result::error);
+  EXPECT_NE(r.error().find("\"fps\" is too small"), std::string::npos) << r.error();
+}
+
 TEST(pose_file, malformed_lines) {
   struct bad_case {
     std::string line;
@@ -164,6 +175,9 @@ TEST(pose_file, malformed_lines) {
       {"{\"bones\":{}}", "missing \"t\""},
       {"[]", "expected '{'"},
       {"{\"t\":0,\"bones\":{\"hips\":[0,0,0,1]", "expected ',' or '}'"},
+      {"{\"t\":00.5}", "not a JSON number"},
+      {"{\"t\":0,\"hips_position\":[0,01,0]}", "not a JSON number"},
+      {"{\"t\":0,\"x\":" + std::string(257, '[') + std::string(257, ']') + "}", "nesting too deep"},
   };
   std::string text = "{\"format\":\"avatarmap.pose\",\"version\":1}\n";
   for (auto& c : cases) text += "{\"t\":1}\n" + c.line + "\n";

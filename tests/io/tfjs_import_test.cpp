@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -150,6 +151,37 @@ TEST(tfjs_import, rejects_bad_arguments_and_files) {
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("frame 0: expected an array of 33 points"), std::string::npos)
       << s.message();
+  // Messages in our words, never nlohmann's ("[json.exception.out_of_range.406] ...").
+  auto message_for = [&](const std::string& text) {
+    std::ofstream(bad, std::ios::trunc | std::ios::binary) << text;
+    const status st = import_tfjs_pose(bad, bad, 10, 10, 5, out);
+    EXPECT_FALSE(st.ok()) << text.substr(0, 40);
+    EXPECT_EQ(st.message().find("json.exception"), std::string::npos) << st.message();
+    return st.message();
+  };
+  EXPECT_NE(message_for("[[[1e400,0,0]]]")
+                .find(": invalid JSON at line 1, column 4: the number "
+                      "1e400 is too large"),
+            std::string::npos)
+      << message_for("[[[1e400,0,0]]]");
+  EXPECT_NE(message_for("[[[1,2,3]],\n [").find("invalid JSON at line 2"), std::string::npos);
+  EXPECT_NE(message_for(std::string(100000, '[')).find("JSON nests deeper than 128 levels"),
+            std::string::npos);
+  EXPECT_NE(message_for("{\"frames\":[]}")
+                .find("expected a JSON array of frames (tfjs-models "
+                      "test format), got an object"),
+            std::string::npos);
+  EXPECT_NE(message_for("[[1,2,3]]")
+                .find("frame 0: expected an array of 33 points, got an array "
+                      "of 3"),
+            std::string::npos);
+  // The frame rate: positive and finite, and large enough for the last frame's time.
+  std::ofstream(bad, std::ios::trunc) << "[[],[]]";
+  s = import_tfjs_pose(bad, bad, 10, 10, std::numeric_limits<double>::infinity(), out);
+  EXPECT_NE(s.message().find("fps must be a positive finite number"), std::string::npos)
+      << s.message();
+  s = import_tfjs_pose(bad, bad, 10, 10, 1e-310, out);
+  EXPECT_NE(s.message().find("is too small"), std::string::npos) << s.message();
   std::remove(bad.c_str());
   std::ifstream check(out);
   EXPECT_FALSE(check.good());  // nothing written on failure

@@ -207,6 +207,44 @@ TEST(mapping, errors_name_file_key_and_column) {
   EXPECT_CONTAINS(s.message(), "none.json: cannot read the file");
 }
 
+// Errors in our words, never nlohmann's ("[json.exception.out_of_range.406] ..."): what is
+// wrong, where (line and column, or the key) and what was found.
+TEST(mapping, json_errors_are_in_our_words) {
+  auto check = [](const std::string& message, const std::string& words) {
+    EXPECT_CONTAINS(message, words);
+    EXPECT_EQ(message.find("json.exception"), std::string::npos) << message;
+    EXPECT_EQ(message.find("[json"), std::string::npos) << message;
+  };
+  // A number beyond a double (nlohmann's out_of_range.406), on line 2.
+  check(error_of("{\"format_version\": 1,\n \"units_scale\": 1e400, \"name\": \"t\"}"),
+        "test.json: invalid JSON at line 2, column");
+  check(error_of("{\"format_version\": 1, \"units_scale\": -1e400}"),
+        "the number -1e400 is too large");
+  check(error_of("{\"format_version\": 1, \"name\": \"t\" \"bones\": {}}"),
+        "invalid JSON at line 1, column 35: unexpected \"bones\"");
+  check(error_of("{\"format_version\": 1,"), "test.json: invalid JSON at line 1");
+  check(error_of("{\"format_version\": 1,"), "ends too early");
+  check(error_of("{\"name\": \"\\uZZZZ\"}"), "bad \\u escape");
+  // Types: what was expected and what was found.
+  check(
+      error_of(
+          R"({"format_version": 1, "name": "t", "bones": {"hips": {"rig": "H", "f": [1, "y", "z"]}}})"),
+      "test.json: bones.hips.f[0]: expected a string, got a number");
+  check(error_of(R"({"format_version": 1, "name": 7, "bones": {}})"),
+        "name: expected a string, got a number");
+  check(error_of(R"({"format_version": 1.5, "name": "t", "bones": {}})"),
+        "format_version: expected an integer, got a number");
+  check(error_of(R"([1, 2])"), "test.json: expected a JSON object (a mapping table), got an array");
+  check(error_of(R"({"format_version": 1, "name": "t", "bones": {"hips": "H"}})"),
+        "bones.hips: expected an object {\"rig\": ...}, got a string");
+  // Nesting beyond the limit is refused before nlohmann builds (and recurses through) a tree.
+  check(error_of("{\"x\":" + std::string(5000, '[') + std::string(5000, ']') + "}"),
+        "test.json: JSON nests deeper than 128 levels");
+  mapping_table t;
+  status s = import_sysmocap_binding("{\"Hips\": {\"name\": 1e999}}", t);
+  check(s.message(), "SysMocap binding: invalid JSON at line 1");
+}
+
 TEST(mapping, match_strips_prefixes_and_falls_back_to_case_insensitive) {
   auto tables = shipped();
   const mapping_table& mix = *by_name(tables, "mixamo");

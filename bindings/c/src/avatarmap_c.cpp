@@ -859,7 +859,11 @@ avm_status retarget_clip(const std::vector<am::proxy_pose>& frames, double fps,
                          std::string& msg) {
   const avm_status code = load_bound_avatar(avatar_path, mapping, out.rig, out.choice, msg);
   if (code != AVM_OK) return code;
-  const std::vector<am::proxy_pose> sampled = am::resample_clip(frames, fps, true);
+  std::vector<am::proxy_pose> sampled;
+  if (am::status st = am::resample_clip(frames, fps, true, sampled, "avm_clip_write"); !st.ok()) {
+    msg = st.message();
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
   if (sampled.empty()) {
     msg = "avm_clip_write: resampling gave no frames";
     return AVM_ERROR_INTERNAL;
@@ -912,13 +916,28 @@ avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::stri
     msg = path + ": .glb output needs avatar_path (the avatar to animate)";
     return AVM_ERROR_INVALID_ARGUMENT;
   }
+  {
+    // The clip's span and resampled size are bounded (avatarmap/time/resample_clip.hpp) for
+    // every format, before any work: an avatar output at fps 0 is resampled at 30 fps, the
+    // others keep one frame per added frame (1 fps stands in for the span check alone).
+    const bool rig_output = fmt == format::glb || (fmt == format::bvh && avatar_path != nullptr);
+    const double checked_fps = fps > 0.0 ? fps : rig_output ? k_default_rig_fps : 1.0;
+    std::size_t count = 0;
+    const am::status st =
+        am::resampled_frame_count(frames.front().t, frames.back().t, checked_fps, path, count);
+    if (!st.ok()) {
+      msg = st.message();
+      return AVM_ERROR_INVALID_ARGUMENT;
+    }
+  }
 
   am::status st;
   switch (fmt) {
     case format::vrma: {
       am::vrma_write_options o;
-      st = fps > 0.0 ? am::write_vrma(path, am::resample_clip(frames, fps, true), o)
-                     : am::write_vrma(path, frames, o);
+      // fps > 0: the writer resamples (bounded, see check_frames) from the frames' own times.
+      o.fps = fps;
+      st = am::write_vrma(path, frames, o);
       break;
     }
     case format::bvh: {
@@ -933,8 +952,7 @@ avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::stri
       }
       am::bvh_write_options o;
       o.fps = fps;
-      st = fps > 0.0 ? am::write_bvh(path, am::resample_clip(frames, fps, true), o)
-                     : am::write_bvh(path, frames, o);
+      st = am::write_bvh(path, frames, o);  // resamples at o.fps > 0 (bounded)
       break;
     }
     case format::pose: {
@@ -942,8 +960,13 @@ avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::stri
       am::pose_file_header h;
       h.present = true;
       h.fps = fps;
-      const std::vector<am::proxy_pose> resampled =
-          fps > 0.0 ? am::resample_clip(frames, fps, true) : std::vector<am::proxy_pose>();
+      std::vector<am::proxy_pose> resampled;
+      if (fps > 0.0) {
+        if (am::status rs = am::resample_clip(frames, fps, true, resampled, path); !rs.ok()) {
+          msg = rs.message();
+          return AVM_ERROR_INVALID_ARGUMENT;
+        }
+      }
       const std::vector<am::proxy_pose>& out = fps > 0.0 ? resampled : frames;
       st = w.open(path, h);
       for (std::size_t i = 0; st.ok() && i < out.size(); ++i) st = w.write(out[i]);

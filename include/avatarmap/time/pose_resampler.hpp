@@ -11,6 +11,7 @@
 #include <cmath>
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <limits>
 
 #include "avatarmap/core/rotation.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
@@ -98,6 +99,8 @@ class pose_resampler {
   ///   linear velocity, slerp_shortest(a, b, 1 + h / (t_b - t_a)) with h = min(t - t_b,
   ///   max_extrapolation_seconds), hips position likewise, expressions likewise but clamped to
   ///   [0, 1], confidence min(a, b); with only one frame kept: that frame.
+  /// Whatever was pushed, the result is finite: a value the blend cannot give finite (frames
+  /// too close in time to divide by, values near the float limits) is the later frame's.
   bool sample(double t, proxy_pose& out) const noexcept {
     if (count_ == 0 || !std::isfinite(t)) return false;
     const proxy_pose& first = at(0);
@@ -110,7 +113,14 @@ class pose_resampler {
     if (t > last.t) {
       const proxy_pose& a = at(count_ - 2);
       const double h = std::fmin(t - last.t, std::fmax(0.0, options_.max_extrapolation_seconds));
-      blend(a, last, static_cast<float>(1.0 + h / (last.t - a.t)), out);
+      // Frames a denormal apart give a factor beyond the float range, whose cast would be
+      // undefined: infinity makes blend hold the newest frame.
+      const double u = 1.0 + h / (last.t - a.t);
+      blend(a, last,
+            u <= static_cast<double>(std::numeric_limits<float>::max())
+                ? static_cast<float>(u)
+                : std::numeric_limits<float>::infinity(),
+            out);
       out.t = t;
       return true;
     }
@@ -155,14 +165,32 @@ class pose_resampler {
   const proxy_pose& newest() const noexcept { return at(count_ - 1); }
 
   // out = a + u (b - a) in each channel (u may exceed 1 when extrapolating). Does not set t.
+  // What could still come out non-finite holds b's value instead: everything when u is not
+  // finite (two frames closer in time than the division can resolve, an infinite extrapolation
+  // limit), a hips axis that overflows (values near the float limits). Rotations are
+  // renormalised because slerp's two weights at a large u lose the unit length to rounding.
+  // The hips lerp is written (1 - u) a + u b so that it cannot overflow for u in [0, 1].
   static void blend(const proxy_pose& a, const proxy_pose& b, float u, proxy_pose& out) noexcept {
+    if (!std::isfinite(u)) {
+      out = b;  // the caller sets t
+      for (int i = 0; i < k_bone_count; ++i)
+        out.confidence[i] = a.confidence[i] < b.confidence[i] ? a.confidence[i] : b.confidence[i];
+      return;
+    }
+    const float v = 1.f - u;
     for (int i = 0; i < k_bone_count; ++i) {
-      out.rotations[i] = slerp_shortest(a.rotations[i], b.rotations[i], u);
+      const glm::quat q = slerp_shortest(a.rotations[i], b.rotations[i], u);
+      const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+      out.rotations[i] =
+          n2 > 1e-12f && std::isfinite(n2) ? q * (1.f / std::sqrt(n2)) : b.rotations[i];
       out.confidence[i] = a.confidence[i] < b.confidence[i] ? a.confidence[i] : b.confidence[i];
     }
-    out.hips_position = a.hips_position + u * (b.hips_position - a.hips_position);
-    for (int e = 0; e < k_expression_count; ++e)
-      out.expressions[e] = clamp01(a.expressions[e] + u * (b.expressions[e] - a.expressions[e]));
+    for (int k = 0; k < 3; ++k) {
+      const float p = v * a.hips_position[k] + u * b.hips_position[k];
+      out.hips_position[k] = std::isfinite(p) ? p : b.hips_position[k];
+    }
+    for (int e = 0; e < k_expression_count; ++e)  // clamp01 also turns NaN into 0
+      out.expressions[e] = clamp01(v * a.expressions[e] + u * b.expressions[e]);
   }
 
   pose_resampler_options options_;

@@ -498,7 +498,8 @@ AVATARMAP_C_API int avm_clip_frame_count(const avm_clip* clip);
  * the same message.
  * Failures: AVM_ERROR_INVALID_ARGUMENT (clip or path NULL, the clip has no frames, fps
  *     negative, above 1000 or not finite, an unknown extension, .glb without avatar_path,
- *     `mapping` names no table),
+ *     `mapping` names no table, the clip spans more than 24 hours (86400 s from its first
+ *     frame to its last) or would be more than 4194304 frames at the rate written),
  *   AVM_ERROR_IO (cannot write `path`; the avatar, table or mappings folder cannot be read,
  *     or no mappings folder is set when one is needed),
  *   AVM_ERROR_PARSE (the avatar or a table is malformed, or does not fit the avatar; no hips
