@@ -22,6 +22,7 @@
 #include "cli/commands.hpp"
 #include "cli/rig_select.hpp"
 #include "cli/solve_job.hpp"
+#include "io/atomic_file.hpp"
 
 namespace avatarmap::cli {
 namespace {
@@ -168,11 +169,7 @@ status dump_positions(const std::string& path, double fps, const std::vector<pro
     }
   }
   s += "]}\n";
-  std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) return status::error(path + ": cannot open for writing");
-  const bool ok = std::fwrite(s.data(), 1, s.size(), file) == s.size();
-  if (std::fclose(file) != 0 || !ok) return status::error(path + ": write failed");
-  return {};
+  return io_detail::write_file_atomically(path, s);
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <exception>
+#include <new>
 #include <string>
 
 #include "avatarmap/version.hpp"
@@ -40,6 +42,21 @@ const char* k_usage =
     "      Prints an avatar file's format, joints, humanoid bones, hips height, expressions.\n"
     "  avatarmap --version | --help | COMMAND --help\n";
 
+// Runs the command `cmd`; -1 when there is no such command.
+int dispatch(const std::string& cmd, int argc, char** argv) {
+  if (cmd == "solve") return avatarmap::cli::run_solve(argc, argv);
+  if (cmd == "convert") return avatarmap::cli::run_convert(argc, argv);
+  if (cmd == "capture") return avatarmap::cli::run_capture(argc, argv);
+  if (cmd == "animate") return avatarmap::cli::run_animate(argc, argv);
+  if (cmd == "live") return avatarmap::cli::run_live_command(argc, argv);
+  if (cmd == "synth") return avatarmap::cli::run_synth(argc, argv);
+  if (cmd == "demo") return avatarmap::cli::run_demo(argc, argv);
+  if (cmd == "import-tfjs") return avatarmap::cli::run_import_tfjs(argc, argv);
+  if (cmd == "backends") return avatarmap::cli::run_backends(argc, argv);
+  if (cmd == "inspect") return avatarmap::cli::run_inspect(argc, argv);
+  return -1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -62,16 +79,22 @@ int main(int argc, char** argv) {
     std::printf("avatarmap %s\n", AVATARMAP_VERSION_STRING);
     return 0;
   }
-  if (cmd == "solve") return avatarmap::cli::run_solve(argc, argv);
-  if (cmd == "convert") return avatarmap::cli::run_convert(argc, argv);
-  if (cmd == "capture") return avatarmap::cli::run_capture(argc, argv);
-  if (cmd == "animate") return avatarmap::cli::run_animate(argc, argv);
-  if (cmd == "live") return avatarmap::cli::run_live_command(argc, argv);
-  if (cmd == "synth") return avatarmap::cli::run_synth(argc, argv);
-  if (cmd == "demo") return avatarmap::cli::run_demo(argc, argv);
-  if (cmd == "import-tfjs") return avatarmap::cli::run_import_tfjs(argc, argv);
-  if (cmd == "backends") return avatarmap::cli::run_backends(argc, argv);
-  if (cmd == "inspect") return avatarmap::cli::run_inspect(argc, argv);
+  // Every library call reports through a status; an exception reaching here is either memory
+  // running out (an input too large for this machine) or a defect. Either way the stack
+  // unwinds, so outputs being written are discarded and the previous files stay as they were.
+  try {
+    if (const int code = dispatch(cmd, argc, argv); code >= 0) return code;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr,
+                 "avatarmap %s: out of memory (the input is too large for this machine; split it "
+                 "into shorter files)\n",
+                 cmd.c_str());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "avatarmap %s: internal error (%s); please report it with the input\n",
+                 cmd.c_str(), e.what());
+    return 1;
+  }
   std::fprintf(stderr, "avatarmap: unknown command '%s'\n\n%s", cmd.c_str(), k_usage);
   return 2;
 }

@@ -325,7 +325,7 @@ status write_animated_glb(const std::string& avatar_path, const rig& r,
   try {
     return write_impl(avatar_path, r, frames, options, out_path);
   } catch (const std::bad_alloc&) {
-    return status::error(out_path + ": not enough memory to write the animated avatar");
+    return status::out_of_memory(out_path + ": not enough memory to write the animated avatar");
   } catch (const std::exception&) {
     return status::error(out_path +
                          ": cannot write the animated avatar (unexpected internal "

@@ -249,7 +249,7 @@ status read_bvh(const std::string& path, bvh_clip& out) {
     parser p(path, text);
     return p.parse(out);
   } catch (const std::bad_alloc&) {
-    return status::error(path + ": not enough memory to read the file");
+    return status::out_of_memory(path + ": not enough memory to read the file");
   } catch (const std::exception&) {
     return status::error(path + ": could not be read (an unexpected failure; please report it)");
   }

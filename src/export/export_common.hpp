@@ -75,8 +75,8 @@ inline status frames_to_write(const std::string& path, const std::vector<proxy_p
   try {
     clean.resize(frames.size());
   } catch (const std::bad_alloc&) {
-    return status::error(path + ": not enough memory for " + std::to_string(frames.size()) +
-                         " frames; split the clip");
+    return status::out_of_memory(path + ": not enough memory for " + std::to_string(frames.size()) +
+                                 " frames; split the clip");
   }
   for (std::size_t i = 0; i < frames.size(); ++i)
     clean_frame(frames[i], i ? &clean[i - 1] : nullptr, clean[i]);

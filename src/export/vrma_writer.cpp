@@ -74,8 +74,8 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
                          ": frame 0 has a negative time (glTF times start at 0); set "
                          "start_at_zero");
   std::vector<proxy_pose> keys;
-  if (status s = export_detail::frames_to_write(path, frames, options.fps, options.start_at_zero,
-                                                keys);
+  if (status s =
+          export_detail::frames_to_write(path, frames, options.fps, options.start_at_zero, keys);
       !s)
     return s;
   const std::size_t n = keys.size();

@@ -159,8 +159,8 @@ status parse_json_text(std::string_view text, const std::string& what, nlohmann:
     return status::error(what + ": " + describe(text, finder));
   } catch (const std::bad_alloc&) {
     out = nullptr;
-    return status::error(what + ": not enough memory to read " + std::to_string(text.size()) +
-                         " bytes of JSON");
+    return status::out_of_memory(what + ": not enough memory to read " +
+                                 std::to_string(text.size()) + " bytes of JSON");
   } catch (const std::exception&) {
     // Not expected with allow_exceptions off; kept so that no library text reaches a user.
     out = nullptr;
@@ -191,7 +191,7 @@ status read_json_file(const std::string& path, nlohmann::json& out, const json_l
                              " bytes a JSON file may have here; is it the right file?");
     }
   } catch (const std::bad_alloc&) {
-    return status::error(path + ": not enough memory to read the file");
+    return status::out_of_memory(path + ": not enough memory to read the file");
   }
   if (in.bad()) return status::error(path + ": read error");
   return parse_json_text(text, path, out, limits);

@@ -58,7 +58,10 @@ absent() { if [ ! -e "$1" ]; then ok; else fail "$1 was written"; fi; }
 kept() { if [ "$(cat "$1")" = "$2" ]; then ok; else fail "$1 was replaced"; fi; }
 # no_temp: no temporary file was left beside the outputs.
 no_temp() {
-  if ls ./*.tmp* >/dev/null 2>&1; then fail "temporary files left: $(ls ./*.tmp*)"; else ok; fi
+  # The writers' temporary files are hidden (.NAME.tmp.XXXXXX): look at dot files too.
+  local left
+  left=$(find . -maxdepth 1 -name '*.tmp.*' | head -3)
+  if [ -n "$left" ]; then fail "temporary files left: $left"; else ok; fi
 }
 
 # lines FILE: number of lines.
@@ -189,6 +192,29 @@ if command -v python3 >/dev/null && [ -f "$library" ]; then
   expect_in err.txt "error: push: invalid argument"
 else
   echo "python3 or $library not found: the Python example cases are skipped"
+fi
+
+# --- memory running out: an error, never an abort --------------------------------------------
+# Two poses 80,000 s apart resampled at 50 fps: 4,000,001 frames (within the limits) of about
+# 1 KB each, under a 512 MiB address-space cap. The tool must say so and exit 1, not abort.
+printf '{"format":"avatarmap.pose"}\n{"t":0}\n{"t":80000}\n' >oom.pose.jsonl
+echo precious >oom.vrma
+(
+  ulimit -v 524288 2>/dev/null || exit 3
+  "$exe" convert oom.pose.jsonl -o oom.vrma --fps 50 >out.txt 2>err.txt
+)
+got=$?
+if grep -qa __asan_init "$exe"; then
+  echo "AddressSanitizer build (its shadow memory needs no address-space cap): the out-of-memory case is skipped"
+elif [ "$got" -eq 3 ]; then
+  echo "ulimit -v is not available here: the out-of-memory case is skipped"
+elif [ "$got" -eq 1 ]; then
+  ok
+  expect_in err.txt "not enough memory"
+  kept oom.vrma precious
+  no_temp
+else
+  fail "convert under a 512 MiB cap exited $got, expected 1: $(head -c 300 err.txt)"
 fi
 
 echo "$passed passed, $failed failed"

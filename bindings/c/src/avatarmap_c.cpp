@@ -1,5 +1,5 @@
 // The C API (bindings/c/include/avatarmap/avatarmap.h) over the C++ core. Rules kept here:
-// no exception leaves an avm_* function (each body is wrapped by guarded()); quaternions are
+// no exception leaves an avm_* function (each body that can throw runs in guard()); quaternions are
 // copied component by component through store_xyzw (never memcpy'd); the per-frame calls
 // (push, get_pose, sample) allocate nothing on success.
 #include <algorithm>
@@ -122,18 +122,53 @@ avm_status fail(const avm_solver* s, avm_status code, const char* msg) noexcept 
   return code;
 }
 
-// Runs `body` (returning avm_status) with every exception mapped to a status; the message
-// goes to the handle `s` when there is one.
-template <class Body>
-avm_status guarded(const avm_solver* s, Body&& body) noexcept {
+void set_error(const avm_retargeter* r, const char* msg) noexcept;  // defined with the handle
+void set_error(const avm_clip* c, const char* msg) noexcept;        // defined with the handle
+
+// The status code for a failed library call: AVM_ERROR_OUT_OF_MEMORY when memory ran out,
+// else `otherwise` (the entry point's code for that step: I/O, parse, invalid argument).
+avm_status code_for(const am::status& st, avm_status otherwise) {
+  return st.is_out_of_memory() ? AVM_ERROR_OUT_OF_MEMORY : otherwise;
+}
+
+// Reporters for guard(): where an entry point's error message goes. None of them throws or
+// allocates beyond the handle's own message string.
+avm_status to_create_error(avm_status code, const char* msg) noexcept {
+  set_create_error(msg);
+  return code;
+}
+avm_status silently(avm_status code, const char*) noexcept { return code; }
+template <class Handle>
+auto to_handle(const Handle* h) noexcept {
+  return [h](avm_status code, const char* msg) noexcept {
+    set_error(h, msg);
+    return code;
+  };
+}
+
+// The one exception boundary of the C API: every avm_* function that can throw runs its body
+// here. Each exception becomes a status and a message in our words (composed in a fixed
+// buffer, so reporting out of memory cannot itself fail) handed to `report(code, message)`;
+// `fn` names the entry point in the message.
+template <class Report, class Body>
+avm_status guard(const char* fn, Report&& report, Body&& body) noexcept {
+  char msg[k_error_capacity];
   try {
     return body();
   } catch (const std::bad_alloc&) {
-    return fail(s, AVM_ERROR_OUT_OF_MEMORY, "out of memory");
+    std::snprintf(msg, sizeof msg,
+                  "%s: out of memory (the input is too large for this process; split it or "
+                  "free memory)",
+                  fn);
+    return report(AVM_ERROR_OUT_OF_MEMORY, msg);
   } catch (const std::exception& e) {
-    return fail(s, AVM_ERROR_INTERNAL, e.what());
+    std::snprintf(msg, sizeof msg, "%s: internal error (%s); please report it with the input", fn,
+                  e.what());
+    return report(AVM_ERROR_INTERNAL, msg);
   } catch (...) {
-    return fail(s, AVM_ERROR_INTERNAL, "unknown internal error");
+    std::snprintf(msg, sizeof msg, "%s: unknown internal error; please report it with the input",
+                  fn);
+    return report(AVM_ERROR_INTERNAL, msg);
   }
 }
 
@@ -389,7 +424,7 @@ AVATARMAP_C_API int avm_expression_from_name(const char* name) {
 
 AVATARMAP_C_API avm_status avm_solver_options_init(avm_solver_options* options) {
   if (options == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
-  return guarded(nullptr, [&] {
+  return guard("avm_solver_options_init", silently, [&]() -> avm_status {
     *options = default_options();
     return AVM_OK;
   });
@@ -405,7 +440,7 @@ AVATARMAP_C_API avm_status avm_solver_create(const avm_solver_options* options,
     return AVM_ERROR_INVALID_ARGUMENT;
   }
   *out_solver = nullptr;
-  try {
+  return guard("avm_solver_create", to_create_error, [&]() -> avm_status {
     core_options o;
     std::string msg;
     if (!read_options(options, o, msg)) {
@@ -418,16 +453,7 @@ AVATARMAP_C_API avm_status avm_solver_create(const avm_solver_options* options,
     s->last_error.reserve(128);
     *out_solver = s;
     return AVM_OK;
-  } catch (const std::bad_alloc&) {
-    set_create_error("avm_solver_create: out of memory");
-    return AVM_ERROR_OUT_OF_MEMORY;
-  } catch (const std::exception& e) {
-    set_create_error(e.what());
-    return AVM_ERROR_INTERNAL;
-  } catch (...) {
-    set_create_error("avm_solver_create: unknown internal error");
-    return AVM_ERROR_INTERNAL;
-  }
+  });
 }
 
 AVATARMAP_C_API void avm_solver_destroy(avm_solver* solver) { delete solver; }
@@ -435,7 +461,7 @@ AVATARMAP_C_API void avm_solver_destroy(avm_solver* solver) { delete solver; }
 AVATARMAP_C_API avm_status avm_solver_reset(avm_solver* solver) {
   if (solver == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
   solver->last_error.clear();
-  return guarded(solver, [&] {
+  return guard("avm_solver_reset", to_handle(solver), [&]() -> avm_status {
     solver->solver.reset();
     solver->filter.reset();
     solver->resampler.reset();
@@ -451,7 +477,7 @@ AVATARMAP_C_API avm_status avm_solver_push(avm_solver* solver, const avm_frame* 
   if (frame == nullptr)
     return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_push: frame is NULL");
   if (const char* bad = check_frame(*frame)) return fail(solver, AVM_ERROR_INVALID_ARGUMENT, bad);
-  return guarded(solver, [&] {
+  return guard("avm_solver_push", to_handle(solver), [&]() -> avm_status {
     convert_frame(*frame, solver->frame);
     solver->solver.solve(solver->frame, solver->raw);
     filter_pose(solver->filter, solver->channels, solver->raw, solver->latest);
@@ -478,7 +504,7 @@ AVATARMAP_C_API avm_status avm_solver_sample(avm_solver* solver, double t, avm_p
     return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_sample: out_pose is NULL");
   if (!std::isfinite(t))
     return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_sample: t must be finite");
-  return guarded(solver, [&] {
+  return guard("avm_solver_sample", to_handle(solver), [&]() -> avm_status {
     if (!solver->resampler.sample(t, solver->sampled)) {
       solver->sampled.set_rest();  // nothing pushed yet
       solver->sampled.t = t;
@@ -504,7 +530,7 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
   };
   if (in_landmarks == nullptr || out_pose == nullptr)
     return report(AVM_ERROR_INVALID_ARGUMENT, "avm_solve_file: a path is NULL");
-  try {
+  return guard("avm_solve_file", report, [&]() -> avm_status {
     core_options o;
     std::string msg;
     if (!read_options(options, o, msg)) {
@@ -513,7 +539,7 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
     }
     am::landmark_reader reader;
     am::status st = reader.open(in_landmarks);
-    if (!st) return report(AVM_ERROR_IO, st.message().c_str());
+    if (!st) return report(code_for(st, AVM_ERROR_IO), st.message().c_str());
     const am::landmark_file_header& lh = reader.header();
     if (o.solver.image_width == 0.f && o.solver.image_height == 0.f && lh.image_width > 0 &&
         lh.image_height > 0) {
@@ -525,7 +551,7 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
     ph.present = true;
     ph.fps = lh.fps;
     st = writer.open(out_pose, ph);
-    if (!st) return report(AVM_ERROR_IO, st.message().c_str());
+    if (!st) return report(code_for(st, AVM_ERROR_IO), st.message().c_str());
 
     // Large scratch objects live on the heap, not on a caller's possibly small stack.
     struct scratch {
@@ -543,18 +569,12 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
       filter_pose(*filter, o.channels, work->raw, work->filtered);
       work->filtered.t = work->frame.t;
       st = writer.write(work->filtered);
-      if (!st) return report(AVM_ERROR_IO, st.message().c_str());
+      if (!st) return report(code_for(st, AVM_ERROR_IO), st.message().c_str());
     }
     st = writer.commit();
-    if (!st) return report(AVM_ERROR_IO, st.message().c_str());
+    if (!st) return report(code_for(st, AVM_ERROR_IO), st.message().c_str());
     return AVM_OK;
-  } catch (const std::bad_alloc&) {
-    return report(AVM_ERROR_OUT_OF_MEMORY, "avm_solve_file: out of memory");
-  } catch (const std::exception& e) {
-    return report(AVM_ERROR_INTERNAL, e.what());
-  } catch (...) {
-    return report(AVM_ERROR_INTERNAL, "avm_solve_file: unknown internal error");
-  }
+  });
 }
 
 }  // extern "C"
@@ -637,16 +657,12 @@ avm_status load_bound_avatar(const char* avatar_path, const char* mapping, am::r
 }  // namespace
 
 AVATARMAP_C_API avm_status avm_set_mappings_folder(const char* folder) {
-  try {
+  return guard("avm_set_mappings_folder", silently, [&]() -> avm_status {
     std::string copy = folder != nullptr ? folder : "";
     std::lock_guard<std::mutex> lock(mappings_mutex());
     mappings_folder_slot().swap(copy);
     return AVM_OK;
-  } catch (const std::bad_alloc&) {
-    return AVM_ERROR_OUT_OF_MEMORY;
-  } catch (...) {
-    return AVM_ERROR_INTERNAL;
-  }
+  });
 }
 
 // ---- retargeting ------------------------------------------------------------------------
@@ -678,7 +694,7 @@ AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const 
     set_create_error("avm_retargeter_create: avatar_path and out must not be NULL");
     return AVM_ERROR_INVALID_ARGUMENT;
   }
-  try {
+  return guard("avm_retargeter_create", to_create_error, [&]() -> avm_status {
     std::unique_ptr<avm_retargeter> r(new avm_retargeter());
     std::string msg;
     const avm_status code = load_bound_avatar(avatar_path, mapping, r->rig, r->choice, msg);
@@ -696,16 +712,7 @@ AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const 
     set_create_error("");
     *out = r.release();
     return AVM_OK;
-  } catch (const std::bad_alloc&) {
-    set_create_error("avm_retargeter_create: out of memory");
-    return AVM_ERROR_OUT_OF_MEMORY;
-  } catch (const std::exception& e) {
-    set_create_error(e.what());
-    return AVM_ERROR_INTERNAL;
-  } catch (...) {
-    set_create_error("avm_retargeter_create: unknown internal error");
-    return AVM_ERROR_INTERNAL;
-  }
+  });
 }
 
 AVATARMAP_C_API void avm_retargeter_destroy(avm_retargeter* retargeter) { delete retargeter; }
@@ -740,7 +747,7 @@ AVATARMAP_C_API avm_status avm_retargeter_apply(avm_retargeter* retargeter, cons
     set_error(retargeter, "pose and out_rotations must not be NULL");
     return AVM_ERROR_INVALID_ARGUMENT;
   }
-  try {
+  return guard("avm_retargeter_apply", to_handle(retargeter), [&]() -> avm_status {
     am::proxy_pose& p = retargeter->proxy;
     p.t = pose->t;
     for (int i = 0; i < 3; ++i)
@@ -763,10 +770,7 @@ AVATARMAP_C_API avm_status avm_retargeter_apply(avm_retargeter* retargeter, cons
     }
     retargeter->last_error.clear();
     return AVM_OK;
-  } catch (...) {
-    set_error(retargeter, "internal error");
-    return AVM_ERROR_INTERNAL;
-  }
+  });
 }
 
 AVATARMAP_C_API const char* avm_retargeter_last_error(const avm_retargeter* retargeter) {
@@ -964,7 +968,7 @@ avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::stri
       if (fps > 0.0) {
         if (am::status rs = am::resample_clip(frames, fps, true, resampled, path); !rs.ok()) {
           msg = rs.message();
-          return AVM_ERROR_INVALID_ARGUMENT;
+          return code_for(rs, AVM_ERROR_INVALID_ARGUMENT);
         }
       }
       const std::vector<am::proxy_pose>& out = fps > 0.0 ? resampled : frames;
@@ -985,7 +989,7 @@ avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::stri
   }
   if (!st.ok()) {
     msg = naming(path, st.message());
-    return AVM_ERROR_IO;
+    return code_for(st, AVM_ERROR_IO);
   }
   return AVM_OK;
 }
@@ -999,16 +1003,10 @@ AVATARMAP_C_API avm_status avm_clip_create(avm_clip** out) {
     return AVM_ERROR_INVALID_ARGUMENT;
   }
   *out = nullptr;
-  try {
+  return guard("avm_clip_create", to_create_error, [&]() -> avm_status {
     *out = new avm_clip();
     return AVM_OK;
-  } catch (const std::bad_alloc&) {
-    set_create_error("avm_clip_create: out of memory");
-    return AVM_ERROR_OUT_OF_MEMORY;
-  } catch (...) {
-    set_create_error("avm_clip_create: unknown internal error");
-    return AVM_ERROR_INTERNAL;
-  }
+  });
 }
 
 AVATARMAP_C_API void avm_clip_destroy(avm_clip* clip) { delete clip; }
@@ -1024,7 +1022,7 @@ AVATARMAP_C_API avm_status avm_clip_add(avm_clip* clip, const avm_pose* pose) {
     set_error(clip, "avm_clip_add: pose->t must be finite");
     return AVM_ERROR_INVALID_ARGUMENT;
   }
-  try {
+  return guard("avm_clip_add", to_handle(clip), [&]() -> avm_status {
     const am::proxy_pose* prev = clip->frames.empty() ? nullptr : &clip->frames.back();
     if (prev != nullptr && !(pose->t > prev->t)) {
       const std::string msg = "avm_clip_add: pose->t (" + std::to_string(pose->t) +
@@ -1037,13 +1035,7 @@ AVATARMAP_C_API avm_status avm_clip_add(avm_clip* clip, const avm_pose* pose) {
     sanitized_pose(*pose, prev, p);
     clip->frames.push_back(p);  // may reallocate: `prev` is not used after this
     return AVM_OK;
-  } catch (const std::bad_alloc&) {
-    set_error(clip, "avm_clip_add: out of memory");
-    return AVM_ERROR_OUT_OF_MEMORY;
-  } catch (...) {
-    set_error(clip, "avm_clip_add: unknown internal error");
-    return AVM_ERROR_INTERNAL;
-  }
+  });
 }
 
 AVATARMAP_C_API int avm_clip_frame_count(const avm_clip* clip) {
@@ -1062,18 +1054,12 @@ AVATARMAP_C_API avm_status avm_clip_write(avm_clip* clip, const char* path, doub
   };
   if (clip == nullptr || path == nullptr)
     return report(AVM_ERROR_INVALID_ARGUMENT, "avm_clip_write: clip and path must not be NULL");
-  try {
+  return guard("avm_clip_write", report, [&]() -> avm_status {
     std::string msg;
     const avm_status code = write_clip(clip->frames, path, fps, avatar_path, mapping, msg);
     if (code != AVM_OK) return report(code, msg.c_str());
     return AVM_OK;
-  } catch (const std::bad_alloc&) {
-    return report(AVM_ERROR_OUT_OF_MEMORY, "avm_clip_write: out of memory");
-  } catch (const std::exception& e) {
-    return report(AVM_ERROR_INTERNAL, e.what());
-  } catch (...) {
-    return report(AVM_ERROR_INTERNAL, "avm_clip_write: unknown internal error");
-  }
+  });
 }
 
 AVATARMAP_C_API const char* avm_clip_last_error(const avm_clip* clip) {

@@ -1,7 +1,11 @@
-// The avatar itself with a motion as a glTF animation: reads the avatar file again (meshes,
-// skins, materials, extensions such as VRM are kept as they are), adds one animation that
-// drives the rig's joints (rotation channels for every joint whose rotation changes, the hips'
-// translation) and writes a binary glTF (.glb). The written file is replaced atomically.
+// The avatar itself with a motion as a glTF animation: reads the avatar file again through the
+// guarded glTF path (docs/security.md; meshes, skins, materials, extensions such as VRM are
+// kept as they are), gathers every buffer (the GLB's own chunk, data URIs, external files
+// confined to the avatar's folder) into the one BIN chunk with textures copied byte for byte
+// (never decoded: WebP, KTX2 or a 16k PNG pass through), adds one animation that drives the
+// rig's joints (rotation channels for every joint whose rotation changes, the hips'
+// translation) and writes a binary glTF (.glb). The written file is replaced atomically; a
+// failed write leaves the previous file as it was. Non-finite pose values are refused.
 #pragma once
 
 #include <string>

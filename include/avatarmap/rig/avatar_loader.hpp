@@ -30,9 +30,15 @@ namespace avatarmap {
 ///  - none of these: gltf, no humanoid bones, no expressions.
 /// When a file carries both VRMC_vrm and VRM, VRM 1.0 wins. `out.file` is `path`.
 ///
+/// The file is untrusted: before any parser that recurses sees it, it must keep the limits of
+/// docs/security.md (at most 1 GiB, JSON nested at most 128 levels, a well-formed GLB
+/// container, core indices within int, bufferViews inside their buffers, buffer and image URIs
+/// inside the file's folder, data URIs at most 256 MiB). Images are never decoded.
+///
 /// Fails, with a message that starts with `path`, when the file cannot be read or is empty,
-/// is neither binary glTF nor JSON, the JSON or GLB container is malformed or tinygltf rejects
-/// it (its message is included), a node's transform has the wrong number of components, a
+/// is neither binary glTF nor JSON, breaks one of those limits, is otherwise invalid glTF (the
+/// reason is included, in our words), a node's `matrix` is singular, a node's transform has the
+/// wrong number of components, a
 /// child index is out of range or names the node itself, a node is the child of two parents,
 /// a humanoid bone name is not a VRM bone (the name is quoted), a humanoid entry has no node
 /// or a node index out of range, one bone is declared twice, or one node is assigned to two

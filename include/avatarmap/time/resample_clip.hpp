@@ -123,8 +123,8 @@ inline status resample_clip(const std::vector<proxy_pose>& frames, double fps, b
     out.resize(count);
   } catch (const std::bad_alloc&) {
     std::vector<proxy_pose>().swap(out);
-    return status::error(what + ": not enough memory for " + std::to_string(count) +
-                         " resampled frames; lower the frame rate or split the clip");
+    return status::out_of_memory(what + ": not enough memory for " + std::to_string(count) +
+                                 " resampled frames; lower the frame rate or split the clip");
   }
   std::size_t seg = 0;
   for (std::size_t k = 0; k < count; ++k) {
