@@ -8,62 +8,7 @@
 # replaced, the secret in no output. A legitimate avatar with a buffer in a subfolder and an
 # external texture converts, and the texture's bytes are in the .glb.
 # Registered with CTest as cli.hostile_avatar_test by tests/cli/CMakeLists.txt.
-set -u
-
-exe=$1
-work=$2
-rm -rf "$work"
-mkdir -p "$work"
-cd "$work" || exit 1
-
-passed=0
-failed=0
-fail() {
-  echo "FAIL: $*" >&2
-  failed=$((failed + 1))
-}
-pass() { passed=$((passed + 1)); }
-
-# run WANT ARGS...: runs the tool (stdout out.txt, stderr err.txt). WANT is "ok" (status 0)
-# or "error" (status 1 or 2: never 0, never a signal).
-run() {
-  local want=$1
-  shift
-  "$exe" "$@" >out.txt 2>err.txt
-  local got=$?
-  local good=0
-  if [ "$want" = ok ]; then
-    [ "$got" -eq 0 ] && good=1
-  else
-    { [ "$got" -eq 1 ] || [ "$got" -eq 2 ]; } && good=1
-  fi
-  if [ "$good" -eq 1 ]; then
-    pass
-  else
-    fail "avatarmap $* exited $got, expected $want"
-    echo "--- stderr:" >&2
-    head -c 2000 err.txt >&2
-  fi
-}
-
-# expect_in FILE TEXT: FILE contains TEXT (fixed string).
-expect_in() {
-  if LC_ALL=C grep -qF -- "$2" "$1"; then
-    pass
-  else
-    fail "$1 does not contain '$2': $(head -c 1000 "$1")"
-  fi
-}
-
-# expect_not_in FILE TEXT
-expect_not_in() {
-  if LC_ALL=C grep -qF -- "$2" "$1"; then fail "$1 contains '$2'"; else pass; fi
-}
-
-# absent FILE
-absent() {
-  if [ -e "$1" ]; then fail "$1 was created"; else pass; fi
-}
+source "$(dirname "$0")/hostile_lib.sh" "$@"
 
 # repeat TEXT N: TEXT N times.
 repeat() { printf "%${2}s" '' | sed "s/ /$1/g"; }
@@ -214,5 +159,4 @@ convert_fails av/zero_scale.gltf "zero"
 expect_in err.txt "'hips'"
 expect_not_in err.txt "nan"
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

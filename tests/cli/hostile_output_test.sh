@@ -7,64 +7,7 @@
 # untouched and a symlink placed there is never followed; a replaced file keeps its mode; a
 # FIFO output stays a FIFO; SIGTERM, SIGINT and SIGHUP during a long write leave no temporary
 # file. Registered with CTest as cli.hostile_output_test by tests/cli/CMakeLists.txt.
-set -u
-
-exe=$1
-work=$2
-rm -rf "$work"
-mkdir -p "$work"
-cd "$work" || exit 1
-
-passed=0
-failed=0
-fail() {
-  echo "FAIL: $*" >&2
-  failed=$((failed + 1))
-}
-pass() { passed=$((passed + 1)); }
-
-# run WANT ARGS...: runs the tool (stdout out.txt, stderr err.txt). WANT is "ok" (status 0)
-# or "error" (status 1 or 2: never 0, never a signal).
-run() {
-  local want=$1
-  shift
-  "$exe" "$@" >out.txt 2>err.txt
-  local got=$?
-  local good=0
-  if [ "$want" = ok ]; then
-    [ "$got" -eq 0 ] && good=1
-  else
-    [ "$got" -eq 1 ] || [ "$got" -eq 2 ] && good=1
-  fi
-  if [ "$good" -eq 1 ]; then
-    pass
-  else
-    fail "avatarmap $* exited $got, expected $want"
-    echo "--- stderr:" >&2
-    head -c 2000 err.txt >&2
-  fi
-}
-
-# expect_in FILE TEXT: FILE contains TEXT (fixed string).
-expect_in() {
-  if grep -qF -- "$2" "$1"; then
-    pass
-  else
-    fail "$1 does not contain '$2': $(head -c 1000 "$1")"
-  fi
-}
-
-# same_file A B: identical content.
-same_file() {
-  if cmp -s "$1" "$2"; then pass; else fail "$1 differs from $2"; fi
-}
-
-# no_temp DIR: no temporary file of ours (.NAME.tmp.XXXXXX or NAME.tmp.*) in DIR.
-no_temp() {
-  local left
-  left=$(find "$1" -maxdepth 1 -name '*.tmp.*' ! -name '*.tmp.keep*' | head -5)
-  if [ -z "$left" ]; then pass; else fail "temporary files left in $1: $left"; fi
-}
+source "$(dirname "$0")/hostile_lib.sh" "$@"
 
 # mode_is FILE OCTAL
 mode_is() {
@@ -295,5 +238,4 @@ for sig in TERM INT HUP; do
 done
 set +m
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

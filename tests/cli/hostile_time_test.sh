@@ -6,63 +6,8 @@
 # with a warning), 1 or 2 and a short message naming the file and the limit; never a signal,
 # never a run that writes without bound, never an existing output replaced by a failed run.
 # Usage: hostile_time_test.sh AVATARMAP_EXE WORK_DIR. Prints "N passed, N failed".
-set -u
-
-exe=$1
-work=$2
 here=$(cd "$(dirname "$0")" && pwd)
-rm -rf "$work"
-mkdir -p "$work"
-cd "$work" || exit 1
-
-passed=0
-failed=0
-ok() { passed=$((passed + 1)); }
-fail() {
-  echo "FAIL: $*" >&2
-  failed=$((failed + 1))
-}
-
-# run EXPECTED_STATUS ARGS...: runs the tool (at most 60 s), stdout to out.txt, stderr to
-# err.txt. A status >= 124 (timeout, a signal) always fails.
-run() {
-  local want=$1
-  shift
-  timeout 60 "$exe" "$@" >out.txt 2>err.txt
-  local got=$?
-  if [ "$got" -eq "$want" ] && [ "$got" -lt 124 ]; then
-    ok
-  else
-    fail "avatarmap $* exited $got, expected $want"
-    head -c 2000 err.txt >&2
-  fi
-}
-
-# expect_in FILE TEXT: FILE contains TEXT (fixed string).
-expect_in() {
-  if grep -qF -- "$2" "$1"; then ok; else
-    fail "$1 does not contain '$2'"
-    head -c 2000 "$1" >&2
-  fi
-}
-
-# short_lines FILE: no line of FILE is longer than 600 characters (no 300-digit numbers).
-short_lines() {
-  local longest
-  longest=$(awk '{ if (length($0) > m) m = length($0) } END { print m + 0 }' "$1")
-  if [ "$longest" -le 600 ]; then ok; else fail "$1 has a line of $longest characters"; fi
-}
-
-# absent PATH / kept PATH TEXT
-absent() { if [ ! -e "$1" ]; then ok; else fail "$1 was written"; fi; }
-kept() { if [ "$(cat "$1")" = "$2" ]; then ok; else fail "$1 was replaced"; fi; }
-# no_temp: no temporary file was left beside the outputs.
-no_temp() {
-  # The writers' temporary files are hidden (.NAME.tmp.XXXXXX): look at dot files too.
-  local left
-  left=$(find . -maxdepth 1 -name '*.tmp.*' | head -3)
-  if [ -n "$left" ]; then fail "temporary files left: $left"; else ok; fi
-}
+source "$(dirname "$0")/hostile_lib.sh" "$@"
 
 # lines FILE: number of lines.
 lines() { wc -l <"$1" | tr -d ' '; }
@@ -217,5 +162,4 @@ else
   fail "convert under a 512 MiB cap exited $got, expected 1: $(head -c 300 err.txt)"
 fi
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

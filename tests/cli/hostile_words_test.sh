@@ -6,44 +6,14 @@
 # Exit status 1 or 2, never a signal, nothing written. The avatar cases need
 # $AVATARMAP_TEST_DATA (skipped with a message when unset).
 # Usage: hostile_words_test.sh AVATARMAP_EXE WORK_DIR. Prints "N passed, N failed".
-set -u
+source "$(dirname "$0")/hostile_lib.sh" "$@"
 
-exe=$1
-work=$2
-rm -rf "$work"
-mkdir -p "$work"
-cd "$work" || exit 1
-
-passed=0
-failed=0
-ok() { passed=$((passed + 1)); }
-fail() {
-  echo "FAIL: $*" >&2
-  failed=$((failed + 1))
-}
-run() {
-  local want=$1
-  shift
-  timeout 60 "$exe" "$@" >out.txt 2>err.txt
-  local got=$?
-  if [ "$got" -eq "$want" ] && [ "$got" -lt 124 ]; then ok; else
-    fail "avatarmap $* exited $got, expected $want"
-    head -c 2000 err.txt >&2
-  fi
-}
-expect_in() {
-  if grep -qF -- "$2" "$1"; then ok; else
-    fail "$1 does not contain '$2'"
-    head -c 2000 "$1" >&2
-  fi
-}
 # ours FILE: no library text in FILE.
 ours() {
   if grep -qE 'json\.exception|\[json|parse_error|out_of_range|basic_string|vector::' "$1"; then
     fail "$1 quotes a library: $(head -c 400 "$1")"
   else ok; fi
 }
-absent() { if [ ! -e "$1" ]; then ok; else fail "$1 was written"; fi; }
 
 # --- import-tfjs: broken JSON ------------------------------------------------------------
 printf '[[[1e400,0,0]]]' >big_number.json
@@ -97,5 +67,4 @@ else
   echo "AVATARMAP_TEST_DATA is not set: the mapping-table and rig cases are skipped"
 fi
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish
