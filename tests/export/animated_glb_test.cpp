@@ -26,16 +26,8 @@ namespace avatarmap {
 namespace {
 
 using nlohmann::json;
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
-std::uint32_t u32_at(const std::string& b, std::size_t at) {
-  std::uint32_t v = 0;
-  for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(b[at + k]);
-  return v;
-}
+using test::contains;
+using test::u32_at;
 
 // A GLB written by us, taken apart with the spec's rules (independently of the writer).
 struct parsed_glb {

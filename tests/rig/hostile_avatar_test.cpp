@@ -20,10 +20,8 @@ namespace avatarmap {
 namespace {
 
 using nlohmann::json;
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+using test::contains;
+using test::u32_at;
 
 // Words of the libraries we use, which must not reach a user.
 void expect_our_words(const std::string& message) {

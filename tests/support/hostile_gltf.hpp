@@ -84,4 +84,16 @@ inline std::string dump_with_raw(const nlohmann::json& j, const std::string& raw
   return text;
 }
 
+/// True when `text` contains `part`.
+inline bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// The little-endian uint32 at byte `at` of `b` (GLB header and chunk fields).
+inline std::uint32_t u32_at(const std::string& b, std::size_t at) {
+  std::uint32_t v = 0;
+  for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(b[at + k]);
+  return v;
+}
+
 }  // namespace avatarmap::test
