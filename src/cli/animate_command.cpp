@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "avatarmap/jobs/clip_output.hpp"
 #include "cli/capture_setup.hpp"
 #include "cli/commands.hpp"
 #include "io/atomic_file.hpp"
@@ -38,11 +39,6 @@ const char* k_animate_help =
     "  --quiet                  no progress and no summaries\n"
     "\n"
     "Capture options (--hands and --face are on unless turned off):\n";
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() &&
-         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 // Options of each stage: name -> takes a value.
 struct option_spec {
@@ -156,15 +152,15 @@ int run_animate(int argc, char** argv) {
                                : "give the output with -o OUT (.vrma, .glb, .bvh, .pose.jsonl)");
     return 2;
   }
-  if (!ends_with(out_path, ".vrma") && !ends_with(out_path, ".glb") &&
-      !ends_with(out_path, ".bvh") && !ends_with(out_path, ".pose.jsonl")) {
-    std::fprintf(stderr,
-                 "avatarmap animate: the output must end in .vrma, .glb, .bvh or .pose.jsonl\n");
+  // The output is checked before the capture, which can take minutes (convert checks it again).
+  const clip_format_info* format = nullptr;
+  if (status st = clip_format_for(out_path, format); !st.ok()) {
+    std::fprintf(stderr, "avatarmap animate: %s\n", st.message().c_str());
     return 2;
   }
   bool has_avatar = false;
   for (const std::string& c : conv) has_avatar |= c == "--avatar" || c.rfind("--avatar=", 0) == 0;
-  if (ends_with(out_path, ".glb") && !has_avatar) {
+  if (format->needs_avatar && !has_avatar) {
     std::fprintf(stderr, "avatarmap animate: .glb output needs --avatar AVATAR\n");
     return 2;
   }

@@ -8,14 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "avatarmap/export/animated_glb.hpp"
-#include "avatarmap/export/bvh.hpp"
 #include "avatarmap/export/vrma.hpp"
 #include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/jobs/clip_output.hpp"
+#include "avatarmap/jobs/solve_file.hpp"
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/synth/synth_skeleton.hpp"
-#include "avatarmap/time/pose_resampler.hpp"
 #include "avatarmap/time/resample_clip.hpp"
 #include "avatarmap/time/seconds_text.hpp"
 #include "cli/cli_args.hpp"
@@ -54,23 +53,29 @@ const char* k_convert_help =
     "                        as for `avatarmap solve` (landmark input only)\n"
     "  --quiet               no summary\n";
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() &&
-         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+// Whether `s` ends with the lower-case `suffix`, ignoring ASCII case (as output names are).
+bool ends_with_nocase(const std::string& s, const std::string& suffix) {
+  if (s.size() < suffix.size()) return false;
+  for (std::size_t i = 0; i < suffix.size(); ++i) {
+    char c = s[s.size() - suffix.size() + i];
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+    if (c != suffix[i]) return false;
+  }
+  return true;
 }
 
-status load_motion(const std::string& in, const solve_job& solve, std::vector<proxy_pose>& out,
+status load_motion(const std::string& in, const solve_file_job& solve, std::vector<proxy_pose>& out,
                    double& source_fps) {
   out.clear();
   source_fps = 0.0;
-  if (ends_with(in, ".vrma")) {
+  if (ends_with_nocase(in, ".vrma")) {
     vrma_clip clip;
     status st = read_vrma(in, clip);
     if (!st.ok()) return st;
     out = std::move(clip.frames);
     return {};
   }
-  if (ends_with(in, ".pose.jsonl")) {
+  if (ends_with_nocase(in, ".pose.jsonl")) {
     pose_reader reader;
     status st = reader.open(in);
     if (!st.ok()) return st;
@@ -84,42 +89,19 @@ status load_motion(const std::string& in, const solve_job& solve, std::vector<pr
     }
     return {};
   }
-  if (ends_with(in, ".jsonl") || in == "-") {
-    solve_job job = solve;
+  if (ends_with_nocase(in, ".jsonl") || in == "-") {
+    solve_file_job job = solve;
     job.input = in;
-    job.progress = progress_mode::automatic;  // a progress line on a terminal
     job.sink = [&](const proxy_pose& p) {
       out.push_back(p);
       return status{};
     };
-    solve_summary summary;
-    return run_solve_job(job, summary);
+    solve_file_summary summary;
+    // A progress line on a terminal.
+    return run_solve_job(job, progress_mode::automatic, summary);
   }
   return status::error(in +
                        ": unknown input type (give *.landmarks.jsonl, *.pose.jsonl or *.vrma)");
-}
-
-// Retargets `sampled` onto `r` as every avatar output does: the performer's standing hips
-// height is a high percentile of the clip's hips heights.
-status retarget_frames(const rig& r, const rig_selection& selection,
-                       const std::vector<proxy_pose>& sampled, bool ground, bool root_motion,
-                       retargeter& rt, std::vector<rig_pose>& out) {
-  if (sampled.empty()) return status::error("no frames to retarget");
-  std::vector<float> heights;
-  for (const proxy_pose& p : sampled) heights.push_back(p.hips_position.y);
-  std::sort(heights.begin(), heights.end());
-  retarget_options ro;
-  ro.performer_hips_height = heights[heights.size() * 9 / 10];
-  ro.keep_feet_on_ground = ground;
-  ro.root_motion = root_motion;
-  status st = rt.build(r, selection.binding, ro, selection.table);
-  if (!st.ok()) return st;
-  out.assign(sampled.size(), rig_pose{});
-  for (size_t i = 0; i < sampled.size(); ++i) {
-    rt.prepare(out[i]);
-    rt.apply(sampled[i], out[i]);
-  }
-  return {};
 }
 
 void append_position(std::string& s, const std::string& name, glm::dvec3 p, bool first) {
@@ -193,7 +175,7 @@ int run_convert(int argc, char** argv) {
   const bool ground = a.flag("--ground");
   const bool root_motion = !a.flag("--no-root-motion");
   const bool quiet = a.flag("--quiet");
-  solve_job solve;
+  solve_file_job solve = make_cli_solve_job();
   solve.options.mirror = a.flag("--mirror");
   if (a.value("--image-size", value)) {
     int w = 0, h = 0;
@@ -223,14 +205,13 @@ int run_convert(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap convert: --fps must be in (0, 1000]\n");
     return 2;
   }
-  const bool to_vrma = ends_with(out_path, ".vrma"), to_glb = ends_with(out_path, ".glb"),
-             to_bvh = ends_with(out_path, ".bvh"), to_pose = ends_with(out_path, ".pose.jsonl");
-  if (!to_vrma && !to_glb && !to_bvh && !to_pose) {
-    std::fprintf(stderr,
-                 "avatarmap convert: the output must end in .vrma, .glb, .bvh or .pose.jsonl\n");
+  const clip_format_info* format = nullptr;
+  if (status st = clip_format_for(out_path, format); !st.ok()) {
+    std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
     return 2;
   }
-  if (to_glb && avatar.empty()) {
+  const bool to_pose = format->format == clip_format::pose_jsonl;
+  if (format->needs_avatar && avatar.empty()) {
     std::fprintf(stderr,
                  "avatarmap convert: .glb output needs --avatar AVATAR (the model to animate)\n");
     return 2;
@@ -241,7 +222,6 @@ int run_convert(int argc, char** argv) {
   raw_rig raw;
   rig r;
   rig_selection selection;
-  retargeter rt;
   if (!avatar.empty()) {
     status st = load_avatar(avatar, raw);
     if (st.ok()) st = build_rig(raw, r);
@@ -298,57 +278,45 @@ int run_convert(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap convert: %s has no frames\n", a.rest()[0].c_str());
     return 1;
   }
-  const double out_fps = fps_given ? fps : 30.0;
+  const double out_fps = fps_given ? fps : k_default_rig_fps;
   // Resampling needs the frames in time order; landmark and pose files need not be (a capture
   // may end with a frame stamped before its first). Sorted here (stably, so at equal times the
-  // later line wins), with a warning; the span and the output size are bounded by
-  // resample_clip (k_max_clip_seconds, k_max_resampled_frames).
-  std::vector<proxy_pose> sampled;
-  if (to_pose && !fps_given) {
-    sampled = frames;
-  } else {
+  // later line wins), with a warning; .pose.jsonl without --fps passes them through as read.
+  const bool pass_through = to_pose && !fps_given;
+  if (!pass_through) {
     if (const std::size_t moved = sort_clip_by_time(frames); moved > 0)
       std::fprintf(stderr,
                    "avatarmap convert: warning: %zu frame(s) of %s were out of time order; "
                    "sorted by time before resampling\n",
                    moved, a.rest()[0].c_str());
-    st = resample_clip(frames, out_fps, true, sampled, a.rest()[0]);
-    if (!st.ok()) {
-      std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
-      return 1;
-    }
   }
-
-  // Avatar outputs (.glb, and .bvh with --avatar) write the retargeted rig poses.
-  const bool to_rig = to_glb || (to_bvh && !avatar.empty());
+  // The library writes every format (clip_output_job): resampling bounded by resample_clip,
+  // avatar outputs (.glb, and .bvh with --avatar) retargeted onto the rig.
+  clip_output_job out;
+  out.path = out_path;
+  out.frames = &frames;
+  out.fps = pass_through ? 0.0 : out_fps;
+  out.source_fps = source_fps;
+  out.what = a.rest()[0];
+  if (!avatar.empty()) {
+    out.avatar_path = avatar;
+    out.avatar_rig = &r;
+    out.avatar_binding = selection.binding;
+    out.avatar_table = selection.table;
+  }
+  out.keep_feet_on_ground = ground;
+  out.root_motion = root_motion;
+  const bool to_rig = format->uses_avatar && !avatar.empty();
+  const bool dump = !dump_path.empty() && format->uses_avatar;  // .glb and .bvh
+  std::vector<proxy_pose> sampled;
   std::vector<rig_pose> poses;
-  if (to_rig) st = retarget_frames(r, selection, sampled, ground, root_motion, rt, poses);
-  if (!st.ok()) {
-    // reported below
-  } else if (to_vrma) {
-    vrma_write_options o;
-    st = write_vrma(out_path, sampled, o);
-  } else if (to_bvh && to_rig) {
-    rig_bvh_options o;
-    o.fps = out_fps;
-    st = write_rig_bvh(out_path, r, poses, o);
-  } else if (to_bvh) {
-    bvh_write_options o;
-    o.fps = out_fps;
-    st = write_bvh(out_path, sampled, o);
-  } else if (to_pose) {
-    pose_writer w;
-    pose_file_header h;
-    h.fps = fps_given ? out_fps : source_fps;
-    st = w.open(out_path, h);
-    for (size_t i = 0; st.ok() && i < sampled.size(); ++i) st = w.write(sampled[i]);
-    if (st.ok()) st = w.commit();
-  } else {
-    animated_glb_options go;
-    go.fps = out_fps;
-    st = write_animated_glb(avatar, r, poses, go, out_path);
+  if (dump) {
+    out.out_frames = &sampled;
+    out.out_rig_poses = &poses;
   }
-  if (st.ok() && !dump_path.empty() && !to_vrma && !to_pose)
+  clip_output_summary written;
+  st = out.run(written);
+  if (st.ok() && dump)
     st = dump_positions(dump_path, out_fps, sampled, to_rig ? &r : nullptr, poses);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
@@ -361,7 +329,7 @@ int run_convert(int argc, char** argv) {
     std::snprintf(fps_text, sizeof fps_text, " at %g fps", out_fps);
     std::fprintf(stderr, "converted %zu input frames (%s s) into %zu frames%s in %.3f s\n",
                  frames.size(), seconds_text(frames.back().t - frames.front().t, 2).c_str(),
-                 sampled.size(), (to_pose && !fps_given) ? "" : fps_text, secs);
+                 written.frames_written, pass_through ? "" : fps_text, secs);
     if (!avatar.empty())
       std::fprintf(stderr, "avatar %s: %d joints; %s\n", avatar.c_str(), r.joint_count(),
                    selection.description.c_str());

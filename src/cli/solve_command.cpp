@@ -1,16 +1,8 @@
 // `avatarmap solve`: *.landmarks.jsonl -> *.pose.jsonl.
-#include <unistd.h>
-
-#include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <string>
 
-#include "avatarmap/io/landmark_file.hpp"
-#include "avatarmap/io/pose_file.hpp"
-#include "avatarmap/solve/frame_solver.hpp"
-#include "avatarmap/time/pose_filter.hpp"
-#include "avatarmap/time/pose_resampler.hpp"
+#include "avatarmap/jobs/solve_file.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/solve_job.hpp"
@@ -56,14 +48,15 @@ int run_solve(int argc, char** argv) {
     std::fputs(k_solve_help, stdout);
     return 0;
   }
-  solve_job job;
+  solve_file_job job = make_cli_solve_job();
+  progress_mode progress = progress_mode::automatic;
   std::string value;
   a.value("--output", job.output, "-o");
   job.options.mirror = a.flag("--mirror");
   job.skip_bad_lines = a.flag("--skip-bad-lines");
   job.write_confidence = a.flag("--confidence");
-  if (a.flag("--progress")) job.progress = progress_mode::on;
-  if (a.flag("--quiet")) job.progress = progress_mode::off;
+  if (a.flag("--progress")) progress = progress_mode::on;
+  if (a.flag("--quiet")) progress = progress_mode::off;
   if (a.value("--image-size", value)) {
     int w = 0, h = 0;
     if (parse_image_size(value, w, h)) {
@@ -149,8 +142,8 @@ int run_solve(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap solve: %s\n", st.message().c_str());
     return 2;
   }
-  solve_summary summary;
-  st = run_solve_job(job, summary);
+  solve_file_summary summary;
+  st = run_solve_job(job, progress, summary);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap solve: %s\n", st.message().c_str());
     return 1;

@@ -183,12 +183,11 @@ int run_demo(int argc, char** argv) {
       "synthesised %ld frames of a scripted motion (squats, waving, finger curls, "
       "blinks, talking): %s\n",
       frames, s.output.c_str());
-  solve_job job;
+  solve_file_job job = make_cli_solve_job();
   job.input = s.output;
   job.output = dir + "/demo.pose.jsonl";
-  job.progress = progress_mode::off;
-  solve_summary summary;
-  st = run_solve_job(job, summary);
+  solve_file_summary summary;
+  st = run_solve_job(job, progress_mode::off, summary);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap demo: %s\n", st.message().c_str());
     return 1;

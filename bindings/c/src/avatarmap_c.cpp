@@ -18,11 +18,8 @@
 
 #include "avatarmap/avatarmap.h"
 #include "avatarmap/core/rotation.hpp"
-#include "avatarmap/export/animated_glb.hpp"
-#include "avatarmap/export/bvh.hpp"
-#include "avatarmap/export/vrma.hpp"
-#include "avatarmap/io/landmark_file.hpp"
-#include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/jobs/clip_output.hpp"
+#include "avatarmap/jobs/solve_file.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "avatarmap/rig/retarget.hpp"
@@ -35,7 +32,6 @@
 #include "avatarmap/solve/solver_options.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
-#include "avatarmap/time/resample_clip.hpp"
 #include "avatarmap/version.hpp"
 
 namespace am = avatarmap;
@@ -62,22 +58,12 @@ static_assert(AVM_EXPRESSION_BROW_DOWN_RIGHT == am::idx(am::expression::brow_dow
 static_assert(sizeof(avm_solver_options) % 4 == 0 && alignof(avm_solver_options) == 4,
               "avm_solver_options must hold only 4-byte fields");
 
-namespace avm_detail {
-// Which parts of a pose are filtered (pose_filter itself filters all or nothing).
-struct filter_channels {
-  bool rotations = true;
-  bool position = true;
-  bool expressions = true;
-};
-}  // namespace avm_detail
-using avm_detail::filter_channels;
-
 // The handle. Everything a frame needs is preallocated here.
 struct avm_solver {
   am::frame_solver solver;
   am::pose_filter filter;
   am::pose_resampler resampler;
-  filter_channels channels;
+  am::pose_filter_channels channels;
   am::landmark_frame frame;  // scratch: the C frame converted
   am::proxy_pose raw;        // scratch: solved, before filtering
   am::proxy_pose latest;     // solved and filtered
@@ -129,6 +115,22 @@ void set_error(const avm_clip* c, const char* msg) noexcept;        // defined w
 // else `otherwise` (the entry point's code for that step: I/O, parse, invalid argument).
 avm_status code_for(const am::status& st, avm_status otherwise) {
   return st.is_out_of_memory() ? AVM_ERROR_OUT_OF_MEMORY : otherwise;
+}
+
+// The status code for why a library job (avatarmap/jobs/*) failed.
+avm_status job_code(am::job_failure why) {
+  switch (why) {
+    case am::job_failure::invalid_argument:
+      return AVM_ERROR_INVALID_ARGUMENT;
+    case am::job_failure::input_io:
+    case am::job_failure::output_io:
+      return AVM_ERROR_IO;
+    case am::job_failure::input_parse:
+      return AVM_ERROR_PARSE;
+    case am::job_failure::none:
+      break;
+  }
+  return AVM_ERROR_INTERNAL;
 }
 
 // Reporters for guard(): where an entry point's error message goes. None of them throws or
@@ -216,7 +218,7 @@ struct core_options {
   am::solver_options solver;
   am::pose_filter_options filter;
   am::pose_resampler_options resampler;
-  filter_channels channels;
+  am::pose_filter_channels channels;
 };
 
 // Larger than any plausible future avm_solver_options: a bigger struct_size is taken as an
@@ -337,15 +339,6 @@ void convert_frame(const avm_frame& f, am::landmark_frame& out) {
             out.right_hand_world.data());
   copy_part(out, fp::face, f.face, f.face != nullptr ? f.face_count : 0, out.face.data());
   out.face_count = f.face != nullptr ? f.face_count : 0;
-}
-
-// Filters `raw` into `out`; channels whose filtering is off are taken unfiltered.
-void filter_pose(am::pose_filter& filter, const filter_channels& c, const am::proxy_pose& raw,
-                 am::proxy_pose& out) {
-  filter.apply(raw, out);
-  if (!c.rotations) out.rotations = raw.rotations;
-  if (!c.position) out.hips_position = raw.hips_position;
-  if (!c.expressions) out.expressions = raw.expressions;
 }
 
 void to_c_pose(const am::proxy_pose& p, avm_pose& out) {
@@ -480,7 +473,7 @@ AVATARMAP_C_API avm_status avm_solver_push(avm_solver* solver, const avm_frame* 
   return guard("avm_solver_push", to_handle(solver), [&]() -> avm_status {
     convert_frame(*frame, solver->frame);
     solver->solver.solve(solver->frame, solver->raw);
-    filter_pose(solver->filter, solver->channels, solver->raw, solver->latest);
+    am::filter_pose_channels(solver->filter, solver->channels, solver->raw, solver->latest);
     solver->latest.t = frame->t;
     if (!solver->resampler.push(solver->latest))
       return fail(solver, AVM_ERROR_INTERNAL, "avm_solver_push: the resampler refused the pose");
@@ -537,42 +530,20 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
       set_create_error(msg.c_str());
       return report(AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
     }
-    am::landmark_reader reader;
-    am::status st = reader.open(in_landmarks);
-    if (!st) return report(code_for(st, AVM_ERROR_IO), st.message().c_str());
-    const am::landmark_file_header& lh = reader.header();
-    if (o.solver.image_width == 0.f && o.solver.image_height == 0.f && lh.image_width > 0 &&
-        lh.image_height > 0) {
-      o.solver.image_width = static_cast<float>(lh.image_width);
-      o.solver.image_height = static_cast<float>(lh.image_height);
-    }
-    am::pose_writer writer;
-    am::pose_file_header ph;
-    ph.present = true;
-    ph.fps = lh.fps;
-    st = writer.open(out_pose, ph);
-    if (!st) return report(code_for(st, AVM_ERROR_IO), st.message().c_str());
-
-    // Large scratch objects live on the heap, not on a caller's possibly small stack.
-    struct scratch {
-      am::landmark_frame frame;
-      am::proxy_pose raw, filtered;
-    };
-    auto work = std::make_unique<scratch>();
-    auto solver = std::make_unique<am::frame_solver>(o.solver);
-    auto filter = std::make_unique<am::pose_filter>(o.filter);
-    for (;;) {
-      am::read_result r = reader.next(work->frame);
-      if (r == am::read_result::end) break;
-      if (r == am::read_result::error) return report(AVM_ERROR_PARSE, reader.error().c_str());
-      solver->solve(work->frame, work->raw);
-      filter_pose(*filter, o.channels, work->raw, work->filtered);
-      work->filtered.t = work->frame.t;
-      st = writer.write(work->filtered);
-      if (!st) return report(code_for(st, AVM_ERROR_IO), st.message().c_str());
-    }
-    st = writer.commit();
-    if (!st) return report(code_for(st, AVM_ERROR_IO), st.message().c_str());
+    // The library's solve-file job (the CLI's `solve` runs it too), on this thread.
+    am::solve_file_job job;
+    job.input = in_landmarks;
+    job.output = out_pose;
+    job.options = o.solver;
+    // Non-zero options.image_width/height win over the file's header (0 = the header's).
+    job.image_width = o.solver.image_width;
+    job.image_height = o.solver.image_height;
+    job.filter = o.filter;
+    job.filter_channels = o.channels;
+    job.threads = 1;
+    am::solve_file_summary summary;
+    const am::status st = job.run(summary);
+    if (!st) return report(code_for(st, job_code(summary.failure)), st.message().c_str());
     return AVM_OK;
   });
 }
@@ -828,168 +799,39 @@ void sanitized_pose(const avm_pose& in, const am::proxy_pose* prev, am::proxy_po
   }
 }
 
-bool ends_with_nocase(const std::string& s, const char* suffix) {
-  const std::size_t n = std::strlen(suffix);
-  if (s.size() < n) return false;
-  for (std::size_t i = 0; i < n; ++i) {
-    char c = s[s.size() - n + i];
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-    if (c != suffix[i]) return false;
-  }
-  return true;
-}
-
-// "PATH: message" unless the message already names PATH.
-std::string naming(const std::string& path, const std::string& msg) {
-  return msg.find(path) != std::string::npos ? msg : path + ": " + msg;
-}
-
-constexpr double k_default_rig_fps = 30.0;
-constexpr double k_max_fps = 1000.0;
-
-// An avatar with a clip retargeted onto it (large: kept on the heap).
-struct avatar_motion {
-  am::rig rig;
-  am::rig_binding_choice choice;
-  am::retargeter retargeter;
-  std::vector<am::rig_pose> poses;
-};
-
-// Loads and binds the avatar, resamples `frames` at `fps` and retargets them into out.poses
-// (the performer's standing hips height: a high percentile of the clip's hips heights, as the
-// CLI's `convert` takes it). On failure returns the status and sets `msg`.
-avm_status retarget_clip(const std::vector<am::proxy_pose>& frames, double fps,
-                         const char* avatar_path, const char* mapping, avatar_motion& out,
-                         std::string& msg) {
-  const avm_status code = load_bound_avatar(avatar_path, mapping, out.rig, out.choice, msg);
-  if (code != AVM_OK) return code;
-  std::vector<am::proxy_pose> sampled;
-  if (am::status st = am::resample_clip(frames, fps, true, sampled, "avm_clip_write"); !st.ok()) {
+// Writes `frames` to `path` with the library's clip-output job (the CLI's `convert` runs it
+// too): the job's checks first, then the avatar (loaded and bound only when the format uses
+// it), then the write. On failure returns the status and sets `msg`.
+avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::string& path,
+                      double fps, const char* avatar_path, const char* mapping, std::string& msg) {
+  am::clip_output_job job;
+  job.path = path;
+  job.frames = &frames;
+  job.fps = fps;
+  job.avatar_path = avatar_path != nullptr ? avatar_path : "";
+  if (am::status st = job.validate(); !st.ok()) {
     msg = st.message();
     return AVM_ERROR_INVALID_ARGUMENT;
   }
-  if (sampled.empty()) {
-    msg = "avm_clip_write: resampling gave no frames";
-    return AVM_ERROR_INTERNAL;
+  // An avatar with its binding (large: kept on the heap).
+  struct bound_avatar {
+    am::rig rig;
+    am::rig_binding_choice choice;
+  };
+  std::unique_ptr<bound_avatar> avatar;
+  if (avatar_path != nullptr && am::find_clip_format(path)->uses_avatar) {
+    avatar = std::make_unique<bound_avatar>();
+    const avm_status code =
+        load_bound_avatar(avatar_path, mapping, avatar->rig, avatar->choice, msg);
+    if (code != AVM_OK) return code;
+    job.avatar_rig = &avatar->rig;
+    job.avatar_binding = avatar->choice.binding;
+    job.avatar_table = avatar->choice.table_or_null();
   }
-  std::vector<float> heights;
-  heights.reserve(sampled.size());
-  for (const am::proxy_pose& p : sampled) heights.push_back(p.hips_position.y);
-  std::sort(heights.begin(), heights.end());
-  am::retarget_options ro;
-  const float h = heights[heights.size() * 9 / 10];
-  if (std::isfinite(h) && h > 0.f) ro.performer_hips_height = h;
-  am::status st = out.retargeter.build(out.rig, out.choice.binding, ro, out.choice.table_or_null());
-  if (!st.ok()) {
-    msg = naming(avatar_path, st.message());
-    return AVM_ERROR_PARSE;
-  }
-  out.poses.resize(sampled.size());
-  for (std::size_t i = 0; i < sampled.size(); ++i) {
-    out.retargeter.prepare(out.poses[i]);
-    out.retargeter.apply(sampled[i], out.poses[i]);
-  }
-  return AVM_OK;
-}
-
-avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::string& path,
-                      double fps, const char* avatar_path, const char* mapping, std::string& msg) {
-  enum class format { vrma, bvh, pose, glb } fmt;
-  if (ends_with_nocase(path, ".pose.jsonl")) {
-    fmt = format::pose;
-  } else if (ends_with_nocase(path, ".vrma")) {
-    fmt = format::vrma;
-  } else if (ends_with_nocase(path, ".bvh")) {
-    fmt = format::bvh;
-  } else if (ends_with_nocase(path, ".glb")) {
-    fmt = format::glb;
-  } else {
-    msg = path + ": unknown output format (the name must end in .vrma, .bvh, .glb or .pose.jsonl)";
-    return AVM_ERROR_INVALID_ARGUMENT;
-  }
-  if (!(std::isfinite(fps) && fps >= 0.0 && fps <= k_max_fps)) {
-    msg = path + ": fps must be 0 (the frames' own times) or in (0, 1000], got " +
-          std::to_string(fps);
-    return AVM_ERROR_INVALID_ARGUMENT;
-  }
-  if (frames.empty()) {
-    msg = path + ": the clip has no frames (add some with avm_clip_add())";
-    return AVM_ERROR_INVALID_ARGUMENT;
-  }
-  if (fmt == format::glb && avatar_path == nullptr) {
-    msg = path + ": .glb output needs avatar_path (the avatar to animate)";
-    return AVM_ERROR_INVALID_ARGUMENT;
-  }
-  {
-    // The clip's span and resampled size are bounded (avatarmap/time/resample_clip.hpp) for
-    // every format, before any work: an avatar output at fps 0 is resampled at 30 fps, the
-    // others keep one frame per added frame (1 fps stands in for the span check alone).
-    const bool rig_output = fmt == format::glb || (fmt == format::bvh && avatar_path != nullptr);
-    const double checked_fps = fps > 0.0 ? fps : rig_output ? k_default_rig_fps : 1.0;
-    std::size_t count = 0;
-    const am::status st =
-        am::resampled_frame_count(frames.front().t, frames.back().t, checked_fps, path, count);
-    if (!st.ok()) {
-      msg = st.message();
-      return AVM_ERROR_INVALID_ARGUMENT;
-    }
-  }
-
-  am::status st;
-  switch (fmt) {
-    case format::vrma: {
-      am::vrma_write_options o;
-      // fps > 0: the writer resamples (bounded, see check_frames) from the frames' own times.
-      o.fps = fps;
-      st = am::write_vrma(path, frames, o);
-      break;
-    }
-    case format::bvh: {
-      if (avatar_path != nullptr) {
-        am::rig_bvh_options o;
-        o.fps = fps > 0.0 ? fps : k_default_rig_fps;
-        auto a = std::make_unique<avatar_motion>();
-        const avm_status code = retarget_clip(frames, o.fps, avatar_path, mapping, *a, msg);
-        if (code != AVM_OK) return code;
-        st = am::write_rig_bvh(path, a->rig, a->poses, o);
-        break;
-      }
-      am::bvh_write_options o;
-      o.fps = fps;
-      st = am::write_bvh(path, frames, o);  // resamples at o.fps > 0 (bounded)
-      break;
-    }
-    case format::pose: {
-      am::pose_writer w;
-      am::pose_file_header h;
-      h.present = true;
-      h.fps = fps;
-      std::vector<am::proxy_pose> resampled;
-      if (fps > 0.0) {
-        if (am::status rs = am::resample_clip(frames, fps, true, resampled, path); !rs.ok()) {
-          msg = rs.message();
-          return code_for(rs, AVM_ERROR_INVALID_ARGUMENT);
-        }
-      }
-      const std::vector<am::proxy_pose>& out = fps > 0.0 ? resampled : frames;
-      st = w.open(path, h);
-      for (std::size_t i = 0; st.ok() && i < out.size(); ++i) st = w.write(out[i]);
-      if (st.ok()) st = w.commit();
-      break;
-    }
-    case format::glb: {
-      am::animated_glb_options o;
-      o.fps = fps > 0.0 ? fps : k_default_rig_fps;
-      auto a = std::make_unique<avatar_motion>();
-      const avm_status code = retarget_clip(frames, o.fps, avatar_path, mapping, *a, msg);
-      if (code != AVM_OK) return code;
-      st = am::write_animated_glb(avatar_path, a->rig, a->poses, o, path);
-      break;
-    }
-  }
-  if (!st.ok()) {
-    msg = naming(path, st.message());
-    return code_for(st, AVM_ERROR_IO);
+  am::clip_output_summary summary;
+  if (am::status st = job.run(summary); !st.ok()) {
+    msg = st.message();
+    return code_for(st, job_code(summary.failure));
   }
   return AVM_OK;
 }

@@ -1,13 +1,14 @@
 // Reads and parses a landmark file on a second thread while the caller solves and writes:
-// the two halves of `avatarmap solve` then use both cores (prefetch_ring.hpp).
+// the two halves of solve_file_job (parse | solve and write) then use both cores
+// (prefetch_ring.hpp).
 #pragma once
 
 #include <string>
 
 #include "avatarmap/io/landmark_file.hpp"
-#include "cli/prefetch_ring.hpp"
+#include "jobs/prefetch_ring.hpp"
 
-namespace avatarmap::cli {
+namespace avatarmap::jobs_detail {
 
 class frame_prefetcher {
  public:
@@ -41,4 +42,4 @@ class frame_prefetcher {
   slot* current_ = nullptr;
 };
 
-}  // namespace avatarmap::cli
+}  // namespace avatarmap::jobs_detail

@@ -1,0 +1,352 @@
+// The landmarks-file -> poses job (include/avatarmap/jobs/solve_file.hpp): on a synthetic
+// recording it must give exactly what frame_solver + pose_filter give frame by frame, resample
+// on the bounded grid, and fail cleanly (naming the field, file or line) on bad input.
+#include "avatarmap/jobs/solve_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "avatarmap/io/landmark_file.hpp"
+#include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/solve/frame_solver.hpp"
+#include "avatarmap/synth/landmark_synth.hpp"
+#include "avatarmap/synth/random_pose.hpp"
+#include "support/temp_dir.hpp"
+
+namespace avatarmap {
+namespace {
+
+constexpr double k_fps = 30.0;
+
+// Writes `frames` frames of the scripted demo motion (with a little noise, so that the filters
+// have work to do) as a *.landmarks.jsonl with an image-size header.
+void write_synthetic(const std::string& path, int frames, bool header = true) {
+  synth_options o;
+  o.body_noise_sigma = o.hand_noise_sigma = o.face_noise_sigma = 0.002f;
+  o.seed = 7;
+  ASSERT_TRUE(o.validate().ok());
+  landmark_synth synth(o);
+  landmark_writer writer;
+  landmark_file_header h;
+  if (header) {
+    h.present = true;
+    h.image_width = o.image_width;
+    h.image_height = o.image_height;
+    h.fps = k_fps;
+  }
+  ASSERT_TRUE(writer.open(path, h).ok());
+  landmark_frame frame;
+  for (int i = 0; i < frames; ++i) {
+    const double t = 1.0 + i / k_fps;
+    synth.generate(demo_motion_pose(t, synth.skeleton()), frame);
+    frame.t = t;
+    ASSERT_TRUE(writer.write(frame).ok());
+  }
+  ASSERT_TRUE(writer.commit().ok());
+}
+
+// The reference: the file read back with landmark_reader, solved and filtered frame by frame.
+std::vector<proxy_pose> reference_poses(const std::string& path, const solver_options& options,
+                                        const pose_filter_options& filter_options,
+                                        const pose_filter_channels& channels = {}) {
+  std::vector<proxy_pose> out;
+  landmark_reader reader;
+  EXPECT_TRUE(reader.open(path).ok());
+  frame_solver solver(options);
+  pose_filter filter(filter_options);
+  landmark_frame frame;
+  proxy_pose raw, filtered;
+  while (reader.next(frame) == read_result::frame) {
+    solver.solve(frame, raw);
+    filter.apply(raw, filtered);
+    if (!channels.position) filtered.hips_position = raw.hips_position;
+    if (!channels.rotations) filtered.rotations = raw.rotations;
+    if (!channels.expressions) filtered.expressions = raw.expressions;
+    out.push_back(filtered);
+  }
+  return out;
+}
+
+solver_options synth_camera() {
+  solver_options o;
+  o.image_width = 1280.f;
+  o.image_height = 720.f;
+  return o;
+}
+
+void expect_same_poses(const std::vector<proxy_pose>& got, const std::vector<proxy_pose>& want,
+                       float tolerance) {
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t f = 0; f < got.size(); ++f) {
+    EXPECT_NEAR(got[f].t, want[f].t, 1e-9) << "frame " << f;
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(got[f].hips_position[c], want[f].hips_position[c], tolerance) << "frame " << f;
+    for (int b = 0; b < k_bone_count; ++b)
+      for (int c = 0; c < 4; ++c)
+        ASSERT_NEAR(got[f].rotations[b][c], want[f].rotations[b][c], tolerance)
+            << "frame " << f << " bone " << bone_name(static_cast<bone>(b));
+    for (int e = 0; e < k_expression_count; ++e)
+      EXPECT_NEAR(got[f].expressions[e], want[f].expressions[e], tolerance) << "frame " << f;
+  }
+}
+
+class solve_file : public ::testing::Test {
+ protected:
+  test::temp_dir dir{"solve_file"};
+  std::string input = dir.file("in.landmarks.jsonl");
+  void SetUp() override { write_synthetic(input, 60); }
+};
+
+TEST_F(solve_file, sink_gets_exactly_the_frame_by_frame_poses_with_either_thread_count) {
+  const std::vector<proxy_pose> want = reference_poses(input, synth_camera(), {});
+  ASSERT_EQ(want.size(), 60u);
+  for (int threads : {1, 2}) {
+    solve_file_job job;
+    job.input = input;
+    job.threads = threads;
+    std::vector<proxy_pose> got;
+    job.sink = [&got](const proxy_pose& p) {
+      got.push_back(p);
+      return status{};
+    };
+    solve_file_summary s;
+    const status st = job.run(s);
+    ASSERT_TRUE(st.ok()) << st.message();
+    EXPECT_EQ(s.frames, 60);
+    EXPECT_EQ(s.poses_written, 60);
+    EXPECT_EQ(s.failure, job_failure::none);
+    EXPECT_FALSE(s.image_size_assumed);  // the header's 1280x720
+    EXPECT_EQ(s.image_width, 1280.f);
+    EXPECT_DOUBLE_EQ(s.t_first, 1.0);
+    EXPECT_NEAR(s.t_last, 1.0 + 59 / k_fps, 1e-9);
+    EXPECT_EQ(s.part_frames[static_cast<int>(frame_part::face)], 60);
+    expect_same_poses(got, want, 0.f);  // the same code on the same frames: bit for bit
+  }
+}
+
+TEST_F(solve_file, written_file_reads_back_as_the_same_poses) {
+  const std::string out = dir.file("out.pose.jsonl");
+  solve_file_job job;
+  job.input = input;
+  job.output = out;
+  solve_file_summary s;
+  ASSERT_TRUE(job.run(s).ok());
+  pose_reader reader;
+  ASSERT_TRUE(reader.open(out).ok());
+  EXPECT_DOUBLE_EQ(reader.header().fps, k_fps);  // the input's header fps
+  std::vector<proxy_pose> got;
+  proxy_pose p;
+  while (reader.next(p) == read_result::frame) got.push_back(p);
+  // Text round trip: the writer prints ~7 significant digits.
+  expect_same_poses(got, reference_poses(input, synth_camera(), {}), 2e-6f);
+}
+
+TEST_F(solve_file, filter_options_and_channels_are_those_of_the_reference) {
+  pose_filter_options f;
+  f.rotation.min_cutoff = 0.5f;
+  pose_filter_channels c;
+  c.position = false;
+  solve_file_job job;
+  job.input = input;
+  job.filter = f;
+  job.filter_channels = c;
+  std::vector<proxy_pose> got;
+  job.sink = [&got](const proxy_pose& p) {
+    got.push_back(p);
+    return status{};
+  };
+  solve_file_summary s;
+  ASSERT_TRUE(job.run(s).ok());
+  const std::vector<proxy_pose> want = reference_poses(input, synth_camera(), f, c);
+  expect_same_poses(got, want, 0.f);
+  // And they differ from the unfiltered solve (the channels matter).
+  pose_filter_options off;
+  off.enabled = false;
+  const std::vector<proxy_pose> raw = reference_poses(input, synth_camera(), off);
+  float rotation_gap = 0.f;
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    EXPECT_EQ(got[i].hips_position, raw[i].hips_position);  // position filtering is off
+    for (int b = 0; b < k_bone_count; ++b)
+      rotation_gap = std::max(rotation_gap,
+                              glm::length(glm::vec4(got[i].rotations[b].x, got[i].rotations[b].y,
+                                                    got[i].rotations[b].z, got[i].rotations[b].w) -
+                                          glm::vec4(raw[i].rotations[b].x, raw[i].rotations[b].y,
+                                                    raw[i].rotations[b].z, raw[i].rotations[b].w)));
+  }
+  EXPECT_GT(rotation_gap, 1e-3f);
+}
+
+TEST_F(solve_file, output_fps_writes_the_bounded_grid) {
+  solve_file_job job;
+  job.input = input;
+  job.output_fps = 60.0;
+  std::vector<double> times;
+  job.sink = [&times](const proxy_pose& p) {
+    times.push_back(p.t);
+    return status{};
+  };
+  solve_file_summary s;
+  ASSERT_TRUE(job.run(s).ok());
+  // 59 / 30 s at 60 fps: t = 1 + j / 60 for j = 0..118.
+  ASSERT_EQ(times.size(), 119u);
+  EXPECT_EQ(s.poses_written, 119);
+  for (std::size_t j = 0; j < times.size(); ++j) EXPECT_NEAR(times[j], 1.0 + j / 60.0, 1e-9);
+}
+
+TEST(solve_file_times, a_frame_going_back_is_skipped_with_a_warning_when_resampling) {
+  test::temp_dir dir{"solve_file_back"};
+  const std::string in = dir.file("back.landmarks.jsonl");
+  test::write_text(in, "{\"t\":5}\n{\"t\":5.1}\n{\"t\":1}\n");
+  solve_file_job job;
+  job.input = in;
+  job.output_fps = 60.0;
+  job.output_fps_name = "--fps";
+  std::vector<std::string> warnings;
+  job.warning = [&warnings](const std::string& w) { warnings.push_back(w); };
+  long poses = 0;
+  job.sink = [&poses](const proxy_pose&) {
+    ++poses;
+    return status{};
+  };
+  solve_file_summary s;
+  ASSERT_TRUE(job.run(s).ok());
+  EXPECT_EQ(s.out_of_order, 1);
+  EXPECT_EQ(poses, 7);  // 5.0 .. 5.1 s at 60 fps
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("frame 2 (t = 1.000 s) is earlier than the frame before it"),
+            std::string::npos)
+      << warnings[0];
+  EXPECT_NE(warnings[0].find("--fps needs times in order"), std::string::npos) << warnings[0];
+  EXPECT_TRUE(s.image_size_assumed);  // no header, no size given
+}
+
+TEST(solve_file_times, a_span_beyond_a_day_fails_as_an_argument_and_leaves_the_output) {
+  test::temp_dir dir{"solve_file_gap"};
+  const std::string in = dir.file("gap.landmarks.jsonl");
+  const std::string out = dir.file("gap.pose.jsonl");
+  test::write_text(in, "{\"t\":0}\n{\"t\":1000000}\n");
+  test::write_text(out, "precious");
+  solve_file_job job;
+  job.input = in;
+  job.output = out;
+  job.output_fps = 60.0;
+  solve_file_summary s;
+  const status st = job.run(s);
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(s.failure, job_failure::invalid_argument);
+  EXPECT_NE(st.message().find("gap.landmarks.jsonl: frame 1"), std::string::npos) << st.message();
+  EXPECT_NE(st.message().find("output_fps resamples at most 86400 s"), std::string::npos)
+      << st.message();
+  EXPECT_EQ(test::read_text(out), "precious");
+}
+
+TEST(solve_file_lines, a_bad_line_fails_naming_it_or_is_skipped_and_counted) {
+  test::temp_dir dir{"solve_file_bad"};
+  const std::string in = dir.file("bad.landmarks.jsonl");
+  const std::string out = dir.file("bad.pose.jsonl");
+  test::write_text(in, "{\"t\":0}\n{\"t\": [oops\n{\"t\":0.1}\n");
+  for (int threads : {1, 2}) {
+    std::filesystem::remove(out);
+    solve_file_job job;
+    job.input = in;
+    job.output = out;
+    job.threads = threads;
+    solve_file_summary s;
+    status st = job.run(s);
+    ASSERT_FALSE(st.ok());
+    EXPECT_EQ(s.failure, job_failure::input_parse);
+    EXPECT_NE(st.message().find("bad.landmarks.jsonl:2"), std::string::npos) << st.message();
+    EXPECT_TRUE(test::read_text(out).empty());  // never created
+
+    job.skip_bad_lines = true;
+    std::vector<std::string> warnings;
+    job.warning = [&warnings](const std::string& w) { warnings.push_back(w); };
+    st = job.run(s);
+    ASSERT_TRUE(st.ok()) << st.message();
+    EXPECT_EQ(s.bad_lines, 1);
+    EXPECT_EQ(s.frames, 2);
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_EQ(warnings[0].rfind("skipped ", 0), 0u) << warnings[0];
+  }
+}
+
+TEST(solve_file_inputs, a_missing_input_is_an_input_error) {
+  test::temp_dir dir{"solve_file_missing"};
+  solve_file_job job;
+  job.input = dir.file("none.landmarks.jsonl");
+  job.output = dir.file("none.pose.jsonl");
+  solve_file_summary s;
+  const status st = job.run(s);
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(s.failure, job_failure::input_io);
+  EXPECT_NE(st.message().find("none.landmarks.jsonl"), std::string::npos) << st.message();
+}
+
+TEST(solve_file_inputs, a_sink_error_ends_the_run_as_an_output_error) {
+  test::temp_dir dir{"solve_file_sink"};
+  const std::string in = dir.file("in.landmarks.jsonl");
+  write_synthetic(in, 5);
+  solve_file_job job;
+  job.input = in;
+  int calls = 0;
+  job.sink = [&calls](const proxy_pose&) {
+    return ++calls == 3 ? status::error("sink full") : status{};
+  };
+  solve_file_summary s;
+  const status st = job.run(s);
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(st.message(), "sink full");
+  EXPECT_EQ(s.failure, job_failure::output_io);
+  EXPECT_EQ(calls, 3);
+}
+
+// validate() breaks one field at a time; each message names the field.
+TEST(solve_file_validate, names_each_broken_field) {
+  auto good = [] {
+    solve_file_job j;
+    j.input = "in.landmarks.jsonl";
+    j.output = "out.pose.jsonl";
+    return j;
+  };
+  ASSERT_TRUE(good().validate().ok());
+  struct breaking {
+    void (*change)(solve_file_job&);
+    const char* words;
+  };
+  const breaking cases[] = {
+      {[](solve_file_job& j) { j.input.clear(); }, "input"},
+      {[](solve_file_job& j) { j.output.clear(); }, "output"},
+      {[](solve_file_job& j) { j.threads = 3; }, "threads"},
+      {[](solve_file_job& j) { j.output_fps = -1.0; }, "output_fps"},
+      {[](solve_file_job& j) { j.output_fps = 1001.0; }, "output_fps"},
+      {[](solve_file_job& j) { j.output_fps = NAN; }, "output_fps"},
+      {[](solve_file_job& j) { j.image_width = 640.f; }, "image_width"},
+      {[](solve_file_job& j) { j.options.horizontal_fov_degrees = 500.f; },
+       "horizontal_fov_degrees"},
+      {[](solve_file_job& j) { j.filter.rotation.min_cutoff = 0.f; }, "rotation.min_cutoff"},
+      {[](solve_file_job& j) { j.filter.position.beta = INFINITY; }, "position.beta"},
+      {[](solve_file_job& j) { j.filter.expression.d_cutoff = -1.f; }, "expression.d_cutoff"},
+  };
+  for (const breaking& c : cases) {
+    solve_file_job j = good();
+    c.change(j);
+    const status st = j.validate();
+    ASSERT_FALSE(st.ok()) << c.words;
+    EXPECT_NE(st.message().find(c.words), std::string::npos) << st.message();
+    solve_file_summary s;
+    EXPECT_FALSE(j.run(s).ok());
+    EXPECT_EQ(s.failure, job_failure::invalid_argument) << c.words;
+  }
+  // A sink replaces the output.
+  solve_file_job j = good();
+  j.output.clear();
+  j.sink = [](const proxy_pose&) { return status{}; };
+  EXPECT_TRUE(j.validate().ok());
+}
+
+}  // namespace
+}  // namespace avatarmap
