@@ -30,8 +30,10 @@ const char* k_usage =
     "      Latest-frame live loop (camera, or a file paced as one) with latency figures.\n"
     "  avatarmap convert IN -o OUT [--avatar AVATAR] [--rig auto|NAME|FILE.json] [--fps N]\n"
     "      Landmarks, poses or .vrma in; .vrma, .glb (animated avatar), .bvh or poses out.\n"
-    "  avatarmap synth -o OUT.landmarks.jsonl [--seconds S] [--fps F] [--noise MM] [--seed N]\n"
-    "      Writes a synthetic recording of a scripted motion (ground truth known).\n"
+    "  avatarmap synth -o OUT.landmarks.jsonl [--truth OUT.pose.jsonl] [--scenario clean|noisy]\n"
+    "      Writes a synthetic recording (scripted or random motion) and its ground truth.\n"
+    "  avatarmap eval-pose TRUTH.pose.jsonl SOLVED.pose.jsonl [--json]\n"
+    "      Bone-direction and head-orientation errors of solved poses against the truth.\n"
     "  avatarmap demo [--keep DIR]\n"
     "      Synthesises a recording, solves it and prints the summary (no input needed).\n"
     "  avatarmap import-tfjs IMAGE.json WORLD.json --size WxH --fps F -o OUT.landmarks.jsonl\n"
@@ -54,6 +56,7 @@ int dispatch(const std::string& cmd, int argc, char** argv) {
   if (cmd == "import-tfjs") return avatarmap::cli::run_import_tfjs(argc, argv);
   if (cmd == "backends") return avatarmap::cli::run_backends(argc, argv);
   if (cmd == "inspect") return avatarmap::cli::run_inspect(argc, argv);
+  if (cmd == "eval-pose") return avatarmap::cli::run_eval_pose(argc, argv);
   return -1;
 }
 

@@ -12,6 +12,7 @@
 #include "avatarmap/io/tfjs_import.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
+#include "avatarmap/synth/synth_recording.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/solve_job.hpp"
@@ -20,40 +21,57 @@ namespace avatarmap::cli {
 namespace {
 
 const char* k_synth_help =
-    "Usage: avatarmap synth -o OUT.landmarks.jsonl [options]\n"
+    "Usage: avatarmap synth -o OUT.landmarks.jsonl [--truth OUT.pose.jsonl] [options]\n"
     "\n"
-    "Writes the landmarks an ideal estimator would report for a scripted 10-second motion\n"
-    "(squats, waving, finger curls, blinking, talking) of a 1.70 m person seen by a 1280x720\n"
-    "camera with a 60 degree field of view: pose (image + world), both hands, 478-point face.\n"
+    "Writes the landmarks an estimator would report for a known motion, and with --truth the\n"
+    "true poses at the same times (docs/accuracy.md, docs/file-formats.md). Without --scenario:\n"
+    "a scripted 10-second motion (squats, waving, finger curls, blinking, talking) of a 1.70 m\n"
+    "person seen by a 1280x720 camera with a 60 degree field of view, exact landmarks: pose\n"
+    "(image + world), both hands, 478-point face.\n"
     "\n"
     "Options:\n"
-    "  -o, --output PATH   output file (required; written atomically)\n"
-    "  --seconds S         length (default 10; the motion loops every 10 s)\n"
-    "  --fps F             frames per second (default 30)\n"
-    "  --noise MM          Gaussian noise on every 3-D point, millimetres (default 0)\n"
-    "  --seed N            noise seed (default 1)\n"
+    "  -o, --output PATH     output file (required; written atomically)\n"
+    "  --truth PATH          also write the true poses (*.pose.jsonl; confidence 0 marks the\n"
+    "                        bones of a limb in a low-visibility burst, 1 the others)\n"
+    "  --scenario demo|clean|noisy\n"
+    "                        preset (default demo): clean = fast random motion, random camera\n"
+    "                        (field of view 50-90 degrees, 1.5-4 m, off centre), person\n"
+    "                        1.55-1.90 m; noisy = clean + 10/5/1 mm noise on body/hands/face\n"
+    "                        + low-visibility bursts of ~1 s on 12 % of each limb's time.\n"
+    "                        The options below change the preset.\n"
+    "  --seconds S           length (default 10; the demo motion loops every 10 s)\n"
+    "  --fps F               frames per second (default 30)\n"
+    "  --size WxH            image size in pixels (default 1280x720)\n"
+    "  --seed N              seed of the motion, camera, noise and bursts (default 1)\n"
+    "  --motion demo|random  the motion played\n"
+    "  --max-wrist-speed R   top speed of arms and fingers in the random motion, rad/s (6)\n"
+    "  --finger-bend DEG     sideways bend range of finger joints in the random motion (10)\n"
+    "  --fov DEG             horizontal field of view (fixes the random camera's draw)\n"
+    "  --distance M          camera distance in metres (fixes the random camera's draw)\n"
+    "  --height M            person height in metres\n"
+    "  --noise MM            Gaussian noise on every 3-D point, millimetres (default 0)\n"
+    "  --body-noise MM, --hand-noise MM, --face-noise MM   the same per part\n"
+    "  --low-vis F           fraction of each limb's time in low-visibility bursts, [0, 0.9]\n"
+    "  --low-vis-seconds S   mean burst length (default 1)\n"
     "  --no-hands, --no-face  leave those parts out\n";
 
 struct synth_settings {
   std::string output;
+  std::string truth;
   double seconds = 10.0;
   double fps = 30.0;
-  double noise_mm = 0.0;
-  unsigned seed = 1;
   bool hands = true;
   bool face = true;
+  synth_options options;
 };
 
 status write_synth(const synth_settings& s, long& frames) {
-  synth_options o;
+  synth_options o = s.options;
   o.hands_image = o.hands_world = s.hands;
   o.face = s.face ? synth_face::mesh_478 : synth_face::none;
-  o.body_noise_sigma = o.hand_noise_sigma = o.face_noise_sigma =
-      static_cast<float>(s.noise_mm * 0.001);
-  o.seed = s.seed;
   status st = o.validate();
   if (!st.ok()) return st;
-  landmark_synth synth(o);
+  synth_recording recording(o);
   landmark_writer writer;
   landmark_file_header h;
   h.present = true;
@@ -62,31 +80,142 @@ status write_synth(const synth_settings& s, long& frames) {
   h.fps = s.fps;
   st = writer.open(s.output, h);
   if (!st.ok()) return st;
+  pose_writer truth;
+  if (!s.truth.empty()) {
+    pose_file_header th;
+    th.present = true;
+    th.fps = s.fps;
+    pose_write_options wo;
+    wo.write_confidence = true;  // the low-visibility marker
+    st = truth.open(s.truth, th, wo);
+    if (!st.ok()) return st;
+  }
   landmark_frame frame;
+  proxy_pose pose;
   frames = static_cast<long>(s.seconds * s.fps + 0.5);
   for (long i = 0; i < frames; ++i) {
     const double t = double(i) / s.fps;
-    synth.generate(demo_motion_pose(t, synth.skeleton()), frame);
-    frame.t = t;
+    recording.generate(t, pose, frame);
     st = writer.write(frame);
+    if (st.ok() && !s.truth.empty()) st = truth.write(pose);
+    if (!st.ok()) return st;
+  }
+  // The truth first: a landmarks file without its truth would be measured against nothing.
+  if (!s.truth.empty()) {
+    st = truth.commit();
     if (!st.ok()) return st;
   }
   return writer.commit();
 }
 
+// Millimetres option -> metres field; false (err set) when out of [0, 1000] mm.
+bool noise_option(args& a, const char* name, float& out_metres, std::string& err) {
+  double v = 0;
+  if (!a.number(name, v)) return true;
+  if (!(v >= 0 && v <= 1000)) {
+    err = std::string(name) + " must be in [0, 1000] mm";
+    return false;
+  }
+  out_metres = static_cast<float>(v * 0.001);
+  return true;
+}
+
 bool parse_synth(args& a, synth_settings& s, std::string& err) {
   double v = 0;
+  std::string text;
   a.value("--output", s.output, "-o");
-  if (a.number("--seconds", v)) s.seconds = v;
-  if (a.number("--fps", v)) s.fps = v;
-  if (a.number("--noise", v)) s.noise_mm = v;
+  a.value("--truth", s.truth);
+  unsigned seed = 1;
   if (a.number("--seed", v)) {
     // Checked before the cast: a negative or huge double cast to unsigned is undefined.
     if (!(v >= 0 && v <= 4294967295.0 && v == static_cast<double>(static_cast<long long>(v)))) {
       err = "--seed must be an integer in [0, 4294967295]";
       return false;
     }
-    s.seed = static_cast<unsigned>(v);
+    seed = static_cast<unsigned>(v);
+  }
+  synth_scenario scenario = synth_scenario::demo;
+  if (a.value("--scenario", text)) {
+    const auto sc = synth_scenario_from_name(text);
+    if (!sc) {
+      err = "--scenario is demo, clean or noisy, got '" + text + "'";
+      return false;
+    }
+    scenario = *sc;
+  }
+  synth_options& o = s.options;
+  o = synth_scenario_options(scenario, seed);
+  if (a.number("--seconds", v)) s.seconds = v;
+  if (a.number("--fps", v)) s.fps = v;
+  if (a.value("--size", text) && !parse_image_size(text, o.image_width, o.image_height)) {
+    err = "--size wants WxH in pixels, e.g. 1280x720";
+    return false;
+  }
+  if (a.value("--motion", text)) {
+    if (text == "demo") {
+      o.motion = synth_motion::demo;
+    } else if (text == "random") {
+      o.motion = synth_motion::random;
+    } else {
+      err = "--motion is demo or random, got '" + text + "'";
+      return false;
+    }
+  }
+  if (a.number("--max-wrist-speed", v)) {
+    if (!(v > 0 && v <= 100)) {
+      err = "--max-wrist-speed must be in (0, 100] rad/s";
+      return false;
+    }
+    o.max_wrist_speed = static_cast<float>(v);
+  }
+  if (a.number("--finger-bend", v)) {
+    if (!(v >= 0 && v <= 45)) {
+      err = "--finger-bend must be in [0, 45] degrees";
+      return false;
+    }
+    o.finger_side_bend_degrees = static_cast<float>(v);
+  }
+  if (a.number("--fov", v)) {
+    if (!(v > 1 && v < 179)) {
+      err = "--fov must be in (1, 179) degrees";
+      return false;
+    }
+    o.horizontal_fov_degrees = o.fov_min_degrees = o.fov_max_degrees = static_cast<float>(v);
+  }
+  if (a.number("--distance", v)) {
+    if (!(v >= 0.1 && v <= 100)) {
+      err = "--distance must be in [0.1, 100] metres";
+      return false;
+    }
+    o.camera_position.z = o.distance_min = o.distance_max = static_cast<float>(v);
+  }
+  if (a.number("--height", v)) {
+    if (!(v >= 0.5 && v <= 3)) {
+      err = "--height must be in [0.5, 3] metres";
+      return false;
+    }
+    o.person_height = static_cast<float>(v);
+  }
+  float all_noise = -1.f;
+  if (!noise_option(a, "--noise", all_noise, err)) return false;
+  if (all_noise >= 0.f) o.body_noise_sigma = o.hand_noise_sigma = o.face_noise_sigma = all_noise;
+  if (!noise_option(a, "--body-noise", o.body_noise_sigma, err) ||
+      !noise_option(a, "--hand-noise", o.hand_noise_sigma, err) ||
+      !noise_option(a, "--face-noise", o.face_noise_sigma, err))
+    return false;
+  if (a.number("--low-vis", v)) {
+    if (!(v >= 0 && v <= 0.9)) {
+      err = "--low-vis must be in [0, 0.9] (a fraction of each limb's time)";
+      return false;
+    }
+    o.low_visibility_fraction = static_cast<float>(v);
+  }
+  if (a.number("--low-vis-seconds", v)) {
+    if (!(v > 0 && v <= 3600)) {
+      err = "--low-vis-seconds must be in (0, 3600]";
+      return false;
+    }
+    o.low_visibility_seconds = static_cast<float>(v);
   }
   if (a.flag("--no-hands")) s.hands = false;
   if (a.flag("--no-face")) s.face = false;
@@ -96,7 +225,8 @@ bool parse_synth(args& a, synth_settings& s, std::string& err) {
   }
   if (!(s.seconds > 0 && s.seconds <= 36000)) err = "--seconds must be in (0, 36000]";
   if (!(s.fps > 0 && s.fps <= 1000)) err = "--fps must be in (0, 1000]";
-  if (!(s.noise_mm >= 0 && s.noise_mm <= 1000)) err = "--noise must be in [0, 1000] mm";
+  if (err.empty() && !s.truth.empty() && s.truth == s.output)
+    err = "--truth and -o name the same file; give the truth its own file (e.g. X.pose.jsonl)";
   return err.empty();
 }
 
@@ -172,7 +302,7 @@ int run_demo(int argc, char** argv) {
   }
   synth_settings s;
   s.output = dir + "/demo.landmarks.jsonl";
-  s.noise_mm = 2.0;
+  s.options.body_noise_sigma = s.options.hand_noise_sigma = s.options.face_noise_sigma = 0.002f;
   long frames = 0;
   status st = write_synth(s, frames);
   if (!st.ok()) {

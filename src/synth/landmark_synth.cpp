@@ -205,7 +205,66 @@ status synth_options::validate() const {
   auto bad_sigma = [](float v) { return !(v >= 0.f) || !std::isfinite(v); };
   if (bad_sigma(body_noise_sigma) || bad_sigma(hand_noise_sigma) || bad_sigma(face_noise_sigma))
     return status::error("synth_options.*_noise_sigma must be finite and >= 0 metres");
+  if (random_camera) {
+    if (!(fov_min_degrees > 1.f && fov_max_degrees < 179.f && fov_min_degrees <= fov_max_degrees))
+      return status::error(
+          "synth_options.fov_min_degrees/fov_max_degrees must satisfy 1 < min <= max < 179");
+    if (!(distance_min > 0.f && distance_min <= distance_max && std::isfinite(distance_max)))
+      return status::error(
+          "synth_options.distance_min/distance_max must satisfy 0 < min <= max (metres, finite)");
+    if (!(camera_height_min <= camera_height_max) || !std::isfinite(camera_height_min) ||
+        !std::isfinite(camera_height_max))
+      return status::error(
+          "synth_options.camera_height_min/camera_height_max must be finite with min <= max");
+    if (!(off_centre_max >= 0.f && off_centre_max <= 1.f))
+      return status::error("synth_options.off_centre_max must be in [0, 1]");
+  }
+  if (!(low_visibility_fraction >= 0.f && low_visibility_fraction <= 0.9f))
+    return status::error("synth_options.low_visibility_fraction must be in [0, 0.9]");
+  if (!(low_visibility_seconds > 0.f && low_visibility_seconds <= 3600.f))
+    return status::error("synth_options.low_visibility_seconds must be in (0, 3600]");
+  if (!(low_visibility_min >= 0.f && low_visibility_min <= low_visibility_max &&
+        low_visibility_max <= 1.f))
+    return status::error(
+        "synth_options.low_visibility_min/low_visibility_max must satisfy 0 <= min <= max <= 1");
+  if (bad_sigma(low_visibility_noise_sigma))
+    return status::error("synth_options.low_visibility_noise_sigma must be finite and >= 0 metres");
+  if (!(max_wrist_speed > 0.f && max_wrist_speed <= 100.f))
+    return status::error("synth_options.max_wrist_speed must be in (0, 100] rad/s");
+  if (!(finger_side_bend_degrees >= 0.f && finger_side_bend_degrees <= 45.f))
+    return status::error("synth_options.finger_side_bend_degrees must be in [0, 45]");
   return {};
+}
+
+int synth_limb_of(bone b) {
+  switch (b) {
+    case bone::left_upper_leg:
+    case bone::left_lower_leg:
+    case bone::left_foot:
+    case bone::left_toes:
+      return static_cast<int>(synth_limb::left_leg);
+    case bone::right_upper_leg:
+    case bone::right_lower_leg:
+    case bone::right_foot:
+    case bone::right_toes:
+      return static_cast<int>(synth_limb::right_leg);
+    case bone::left_upper_arm:
+    case bone::left_lower_arm:
+    case bone::left_hand:
+      return static_cast<int>(synth_limb::left_arm);
+    case bone::right_upper_arm:
+    case bone::right_lower_arm:
+    case bone::right_hand:
+      return static_cast<int>(synth_limb::right_arm);
+    default:
+      break;
+  }
+  const int i = idx(b);
+  if (i >= idx(bone::left_thumb_metacarpal) && i <= idx(bone::left_little_distal))
+    return static_cast<int>(synth_limb::left_arm);
+  if (i >= idx(bone::right_thumb_metacarpal) && i <= idx(bone::right_little_distal))
+    return static_cast<int>(synth_limb::right_arm);
+  return -1;
 }
 
 landmark_synth::landmark_synth(const synth_options& options)
@@ -228,8 +287,24 @@ void landmark_synth::init() {
     options_ = defaults;
   }
   camera_ = options_.camera_position;
+  fov_degrees_ = options_.horizontal_fov_degrees;
+  if (options_.random_camera) {
+    // A generator of its own (seed mixed with a constant), so the noise sequence of a seed is
+    // the same with and without the random camera.
+    std::mt19937 g(options_.seed ^ 0x5eed0cafu);
+    auto draw = [&g](float lo, float hi) {
+      return lo + (hi - lo) * std::uniform_real_distribution<float>(0.f, 1.f)(g);
+    };
+    fov_degrees_ = draw(options_.fov_min_degrees, options_.fov_max_degrees);
+    const float distance = draw(options_.distance_min, options_.distance_max);
+    const float height = draw(options_.camera_height_min, options_.camera_height_max);
+    const float half_width = distance * std::tan(0.5f * fov_degrees_ * k_pi / 180.f);
+    // The camera moves sideways so that the origin appears off the image centre.
+    const float offset = draw(-options_.off_centre_max, options_.off_centre_max) * half_width;
+    camera_ = glm::vec3(offset, height, distance);
+  }
   if (options_.camera_y_scales_with_height) camera_.y *= skeleton_.scale;
-  const float half_fov = 0.5f * options_.horizontal_fov_degrees * k_pi / 180.f;
+  const float half_fov = 0.5f * fov_degrees_ * k_pi / 180.f;
   focal_ = 0.5f * static_cast<float>(options_.image_width) / std::tan(half_fov);
   build_template(face_template_, skeleton_.scale);
   reseed(options_.seed);
@@ -238,6 +313,55 @@ void landmark_synth::init() {
 void landmark_synth::reseed(std::uint32_t seed) {
   rng_.seed(seed);
   normal_.reset();
+  burst_rng_.seed(seed ^ 0xb0a57u);
+  bursts_started_ = false;
+  in_burst_.fill(false);
+}
+
+void landmark_synth::update_bursts(double t) {
+  in_burst_.fill(false);
+  const double f = options_.low_visibility_fraction;
+  if (!(f > 0.0) || !std::isfinite(t)) return;
+  const double mean_burst = options_.low_visibility_seconds;
+  // Gaps uniform in [0.2 G, 1.8 G] with G = mean_burst (1 - f) / f: bursts take f of the time
+  // on average (renewal process: E[burst] / (E[burst] + E[gap])) and never run into each other.
+  const double mean_gap = mean_burst * (1.0 - f) / f;
+  auto uniform = [this](double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(burst_rng_);
+  };
+  auto schedule_from = [&](int l, double from) {
+    burst_start_[l] = from + uniform(0.2 * mean_gap, 1.8 * mean_gap);
+    burst_end_[l] = burst_start_[l] + mean_burst * uniform(0.6, 1.4);
+  };
+  if (!bursts_started_ || t < last_t_) {
+    for (int l = 0; l < k_synth_limb_count; ++l) schedule_from(l, t);
+    bursts_started_ = true;
+  }
+  last_t_ = t;
+  for (int l = 0; l < k_synth_limb_count; ++l) {
+    // Bounded: a jump far ahead skips the missed bursts rather than drawing all of them.
+    for (int guard = 0; t >= burst_end_[l] && guard < 1000; ++guard)
+      schedule_from(l, burst_end_[l]);
+    if (t >= burst_end_[l]) schedule_from(l, t);
+    in_burst_[l] = t >= burst_start_[l] && t < burst_end_[l];
+  }
+}
+
+float landmark_synth::draw_visibility() {
+  return std::uniform_real_distribution<float>(options_.low_visibility_min,
+                                               options_.low_visibility_max)(burst_rng_);
+}
+
+void landmark_synth::add_noise_at(glm::vec3* points, const int* indices, int count, float sigma) {
+  if (!(sigma > 0.f)) return;
+  // The burst generator, so the regular noise sequence does not shift with the bursts.
+  std::normal_distribution<float> n(0.f, sigma);
+  for (int i = 0; i < count; ++i) {
+    glm::vec3& p = points[indices[i]];
+    p.x += n(burst_rng_);
+    p.y += n(burst_rng_);
+    p.z += n(burst_rng_);
+  }
 }
 
 namespace {
@@ -343,6 +467,12 @@ void landmark_synth::generate(const proxy_pose& pose, landmark_frame& out) {
     camera.x = -camera.x;
   }
   compute_synth_fk(skeleton_, *p, fk_);
+  update_bursts(pose.t);
+  // Bursts are the person's limbs; mirrored output swaps the labels of the points they hit.
+  auto burst_on_output_side = [&](bool arm, int output_side) {
+    const int person_side = options_.mirror ? 1 - output_side : output_side;
+    return in_burst_[(arm ? 0 : 2) + person_side];
+  };
 
   out.clear();
   out.t = pose.t;
@@ -408,6 +538,15 @@ void landmark_synth::generate(const proxy_pose& pose, landmark_frame& out) {
     P[31] = fk_.tips[idx(bone::left_toes)];
     P[32] = fk_.tips[idx(bone::right_toes)];
     add_noise(P.data(), k_pose_landmark_count, options_.body_noise_sigma);
+    // Limb points of each output side: [arm: left, right][leg: left, right].
+    static constexpr int k_arm_points[2][5] = {{13, 15, 17, 19, 21}, {14, 16, 18, 20, 22}};
+    static constexpr int k_leg_points[2][4] = {{25, 27, 29, 31}, {26, 28, 30, 32}};
+    const float lv_sigma = options_.low_visibility_noise_sigma;
+    for (int side = 0; side < 2; ++side) {
+      if (burst_on_output_side(true, side)) add_noise_at(P.data(), k_arm_points[side], 5, lv_sigma);
+      if (burst_on_output_side(false, side))
+        add_noise_at(P.data(), k_leg_points[side], 4, lv_sigma);
+    }
 
     const glm::vec3 hip_mid = 0.5f * (P[23] + P[24]);
     if (options_.pose_image) {
@@ -420,6 +559,19 @@ void landmark_synth::generate(const proxy_pose& pose, landmark_frame& out) {
       for (int i = 0; i < k_pose_landmark_count; ++i)
         put(out.pose_world[i], to_mediapipe(P[i]) - origin);
       out.set(frame_part::pose_world, true);
+    }
+    // One visibility per point and frame, the same in the image and world lists (as
+    // MediaPipe reports them).
+    auto dim = [&](const int* indices, int count) {
+      for (int i = 0; i < count; ++i) {
+        const float v = draw_visibility();
+        out.pose[indices[i]].visibility = v;
+        out.pose_world[indices[i]].visibility = v;
+      }
+    };
+    for (int side = 0; side < 2; ++side) {
+      if (burst_on_output_side(true, side)) dim(k_arm_points[side], 5);
+      if (burst_on_output_side(false, side)) dim(k_leg_points[side], 4);
     }
   }
 
@@ -439,6 +591,12 @@ void landmark_synth::generate(const proxy_pose& pose, landmark_frame& out) {
         H[l + 3] = fk_.tips[b + 2];
       }
       add_noise(H.data(), k_hand_landmark_count, options_.hand_noise_sigma);
+      static constexpr int k_all_hand_points[k_hand_landmark_count] = {
+          0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20};
+      const bool burst = burst_on_output_side(true, side);
+      if (burst)
+        add_noise_at(H.data(), k_all_hand_points, k_hand_landmark_count,
+                     options_.low_visibility_noise_sigma);
       std::array<landmark, k_hand_landmark_count>& img = side == 0 ? out.left_hand : out.right_hand;
       std::array<landmark, k_hand_landmark_count>& wld =
           side == 0 ? out.left_hand_world : out.right_hand_world;
@@ -451,6 +609,13 @@ void landmark_synth::generate(const proxy_pose& pose, landmark_frame& out) {
         const glm::vec3 centre = to_mediapipe((H[0] + H[5] + H[9] + H[13] + H[17]) * 0.2f);
         for (int i = 0; i < k_hand_landmark_count; ++i) put(wld[i], to_mediapipe(H[i]) - centre);
         out.set(side == 0 ? frame_part::left_hand_world : frame_part::right_hand_world, true);
+      }
+      if (burst) {
+        for (int i = 0; i < k_hand_landmark_count; ++i) {
+          const float v = draw_visibility();
+          img[i].visibility = v;
+          wld[i].visibility = v;
+        }
       }
     }
   }

@@ -59,9 +59,18 @@ proxy_pose random_pose(std::mt19937& rng, const random_pose_limits& L) {
                               uniform(rng, -L.hips_xz_range, L.hips_xz_range));
   p[bone::hips] = axis_angle(k_y, sym(rng, L.hips_yaw)) * axis_angle(k_x, sym(rng, L.hips_lean)) *
                   axis_angle(k_z, sym(rng, L.hips_lean));
-  for (bone b : {bone::spine, bone::chest, bone::upper_chest}) p[b] = xyz_rotation(rng, L.spine);
-  p[bone::neck] = xyz_rotation(rng, L.neck);
-  p[bone::head] = xyz_rotation(rng, L.head);
+  if (L.coupled_deviation >= 0.f) {
+    const glm::quat bend = xyz_rotation(rng, L.spine);
+    for (bone b : {bone::spine, bone::chest, bone::upper_chest})
+      p[b] = bend * xyz_rotation(rng, L.coupled_deviation);
+    const glm::quat half_turn = quat_fraction(xyz_rotation(rng, L.head), 0.5f);
+    for (bone b : {bone::neck, bone::head})
+      p[b] = half_turn * xyz_rotation(rng, L.coupled_deviation);
+  } else {
+    for (bone b : {bone::spine, bone::chest, bone::upper_chest}) p[b] = xyz_rotation(rng, L.spine);
+    p[bone::neck] = xyz_rotation(rng, L.neck);
+    p[bone::head] = xyz_rotation(rng, L.head);
+  }
 
   for (int side = 0; side < 2; ++side) {
     const bool right = side == 1;
@@ -101,9 +110,11 @@ proxy_pose random_pose(std::mt19937& rng, const random_pose_limits& L) {
         glm::quat prox = finger_flex(uniform(rng, 0.f, L.finger_flex_max) * k_deg) *
                          axis_angle(k_y, sym(rng, L.finger_spread));
         set_side(p, static_cast<bone>(b), prox, right);
-        for (int j = 1; j < 3; ++j)
-          set_side(p, static_cast<bone>(b + j),
-                   finger_flex(uniform(rng, 0.f, L.finger_flex_max) * k_deg), right);
+        for (int j = 1; j < 3; ++j) {
+          glm::quat q = finger_flex(uniform(rng, 0.f, L.finger_flex_max) * k_deg);
+          if (L.finger_side_bend > 0.f) q = q * axis_angle(k_y, sym(rng, L.finger_side_bend));
+          set_side(p, static_cast<bone>(b + j), q, right);
+        }
       }
       const glm::vec3 h = thumb_hinge();
       const glm::vec3 d = bone_rest_direction(bone::left_thumb_metacarpal);
@@ -111,10 +122,14 @@ proxy_pose random_pose(std::mt19937& rng, const random_pose_limits& L) {
                        axis_angle(k_y, sym(rng, L.thumb_metacarpal)) *
                        axis_angle(d, sym(rng, L.thumb_metacarpal));
       set_side(p, bone::left_thumb_metacarpal, meta, right);
-      set_side(p, bone::left_thumb_proximal,
-               axis_angle(h, uniform(rng, 0.f, L.thumb_flex_max) * k_deg), right);
-      set_side(p, bone::left_thumb_distal,
-               axis_angle(h, uniform(rng, 0.f, L.thumb_flex_max) * k_deg), right);
+      for (bone tb : {bone::left_thumb_proximal, bone::left_thumb_distal}) {
+        glm::quat q = axis_angle(h, uniform(rng, 0.f, L.thumb_flex_max) * k_deg);
+        if (L.finger_side_bend > 0.f) {
+          const glm::vec3 side = glm::normalize(glm::cross(h, bone_rest_direction(tb)));
+          q = q * axis_angle(side, sym(rng, L.finger_side_bend));
+        }
+        set_side(p, tb, q, right);
+      }
     }
   }
   // Conjugate gaze: both eyes turn together.

@@ -16,13 +16,25 @@
 //   rules. The forehead, chin, cheeks, temples and jaw points never move with expressions,
 //   so they carry the head's orientation only.
 //
-// Output spaces (REFERENCE §2): pose_world = MediaPipe world (x = X, y = -Y, z = -Z, origin at
-// the midpoint of points 23/24); hand world likewise with the origin at the mean of hand
-// points 0, 5, 9, 13, 17; image points through a pinhole camera at camera_position looking
+// Output spaces (docs/conventions.md, "Spaces"): pose_world = MediaPipe world (x = X, y = -Y, z =
+// -Z, origin at the midpoint of points 23/24); hand world likewise with the origin at the mean of
+// hand points 0, 5, 9, 13, 17; image points through a pinhole camera at camera_position looking
 // along -Z: x_c = X - cx, y_c = -(Y - cy), z_c = cz - Z, u = W/2 + f x_c / z_c,
 // v = H/2 + f y_c / z_c, f = (W/2) / tan(fov/2); landmark (u/W, v/H, (z_c - z_ref) f /
 // (z_ref W)) with z_ref the depth of the hip midpoint (pose), the wrist (hands) or the head
-// joint (face). visibility = presence = 1 everywhere.
+// joint (face). visibility = presence = 1 everywhere, except in low-visibility bursts.
+//
+// Variation of real recordings (all off by default, so the defaults reproduce the fixed camera
+// above; synth_recording.hpp's scenario presets turn them on):
+// - random_camera: horizontal field of view, distance, height and sideways offset drawn once
+//   per seed (the camera still looks along -Z; the person is off the optical axis).
+// - low-visibility bursts (low_visibility_fraction > 0): per limb (each arm with its hand,
+//   each leg) an alternating schedule along pose.t of gaps and bursts of about
+//   low_visibility_seconds; inside a burst the limb's points (pose 13/15/17/19/21 or
+//   14/16/18/20/22 and that hand's 21 points for an arm; pose 25/27/29/31 or 26/28/30/32 for
+//   a leg) get a visibility drawn uniformly in [low_visibility_min, low_visibility_max] per
+//   point and frame, and extra Gaussian noise of low_visibility_noise_sigma on their 3-D
+//   points. The pose passed in keeps moving: the generator only degrades what is reported.
 #pragma once
 
 #include <array>
@@ -39,6 +51,20 @@ namespace avatarmap {
 
 /// Which face mesh the generator outputs.
 enum class synth_face : std::uint8_t { none, mesh_468, mesh_478 };
+
+/// Which motion a synthetic recording plays (synth_recording.hpp; landmark_synth itself takes
+/// any pose): demo = demo_motion_pose()'s scripted 10 s loop; random = random_motion
+/// (random_motion.hpp), fast, seeded by synth_options::seed.
+enum class synth_motion : std::uint8_t { demo, random };
+
+/// The limbs that low-visibility bursts affect (the person's sides, also when mirrored).
+enum class synth_limb : std::uint8_t { left_arm, right_arm, left_leg, right_leg };
+inline constexpr int k_synth_limb_count = 4;
+
+/// The limb whose burst marks bone `b` as low-visibility: an arm's upper arm, lower arm, hand
+/// and all its fingers; a leg's upper leg, lower leg, foot and toes. -1 for every other bone
+/// (torso, head, eyes, jaw, shoulders: their child joints stay visible).
+int synth_limb_of(bone b);
 
 struct synth_options {
   // Parts to output.
@@ -68,8 +94,44 @@ struct synth_options {
   float body_noise_sigma = 0.f;
   float hand_noise_sigma = 0.f;
   float face_noise_sigma = 0.f;
-  /// Seed of the generator's std::mt19937 (reseeded by landmark_synth::reseed()).
+  /// Seed of the generator's std::mt19937 (reseeded by landmark_synth::reseed()). The camera
+  /// draws and the burst schedule use their own generators derived from it, so turning them
+  /// on leaves the noise sequence as it was.
   std::uint32_t seed = 1;
+
+  /// Random camera: when true, camera_position and horizontal_fov_degrees are ignored and
+  /// drawn once from the seed: field of view uniform in [fov_min_degrees, fov_max_degrees]
+  /// (each in (1, 179), min <= max), distance from the origin (where the person starts)
+  /// uniform in [distance_min, distance_max] metres (> 0), height uniform in
+  /// [camera_height_min, camera_height_max] metres (scaled like camera_position.y), and a
+  /// sideways offset that puts the origin anywhere up to off_centre_max (in [0, 1]) of the
+  /// half image width from the image centre.
+  bool random_camera = false;
+  float fov_min_degrees = 50.f;
+  float fov_max_degrees = 90.f;
+  float distance_min = 1.5f;
+  float distance_max = 4.f;
+  float camera_height_min = 0.8f;
+  float camera_height_max = 1.5f;
+  float off_centre_max = 0.5f;
+
+  /// Low-visibility bursts (see above): fraction of each limb's time in bursts, in [0, 0.9]
+  /// (0 = none); mean burst length in seconds (> 0; each burst lasts 0.6..1.4 times it);
+  /// visibility range inside a burst (0 <= min <= max <= 1); extra noise on the limb's 3-D
+  /// points (metres, >= 0). Bursts are scheduled along pose.t: call generate() with
+  /// non-decreasing times (a time going back restarts the schedule from that time).
+  float low_visibility_fraction = 0.f;
+  float low_visibility_seconds = 1.f;
+  float low_visibility_min = 0.02f;
+  float low_visibility_max = 0.3f;
+  float low_visibility_noise_sigma = 0.03f;
+
+  /// Motion of a synth_recording (landmark_synth ignores these): the motion, the random
+  /// motion's top wrist speed (rad/s, > 0) and the random sideways bend of finger
+  /// intermediate/distal and thumb joints (degrees, in [0, 45]).
+  synth_motion motion = synth_motion::demo;
+  float max_wrist_speed = 6.f;
+  float finger_side_bend_degrees = 10.f;
 
   /// Names the first field out of range.
   status validate() const;
@@ -109,8 +171,19 @@ class landmark_synth {
   /// Camera centre actually used (VRM, metres, non-mirrored).
   const glm::vec3& camera_position() const { return camera_; }
 
-  /// Restarts the noise sequence.
+  /// Horizontal field of view actually used (degrees): drawn when options.random_camera.
+  float horizontal_fov_degrees() const { return fov_degrees_; }
+
+  /// Restarts the noise sequence and the burst schedule (the camera stays as drawn).
   void reseed(std::uint32_t seed);
+
+  /// Whether limb `l` was in a low-visibility burst in the last generate() call.
+  bool limb_low_visibility(synth_limb l) const { return in_burst_[static_cast<int>(l)]; }
+  /// Whether bone `b` was marked low-visibility in the last generate() call (synth_limb_of).
+  bool bone_low_visibility(bone b) const {
+    const int l = synth_limb_of(b);
+    return l >= 0 && in_burst_[l];
+  }
 
   const synth_skeleton& skeleton() const { return skeleton_; }
   const synth_options& options() const { return options_; }
@@ -123,14 +196,25 @@ class landmark_synth {
   void init();
   void build_face(const proxy_pose& pose);
   void add_noise(glm::vec3* points, int count, float sigma);
+  void add_noise_at(glm::vec3* points, const int* indices, int count, float sigma);
+  void update_bursts(double t);
+  float draw_visibility();
 
   synth_skeleton skeleton_;
   synth_options options_;
   glm::vec3 camera_{0.f};
   float focal_ = 1.f;
   std::array<glm::vec3, k_face_mesh_iris_count> face_template_{};
+  float fov_degrees_ = 60.f;
   std::mt19937 rng_;
   std::normal_distribution<float> normal_{0.f, 1.f};
+  // Burst schedule: its own generator so that the noise sequence does not depend on it.
+  std::mt19937 burst_rng_;
+  bool bursts_started_ = false;
+  double last_t_ = 0.0;
+  std::array<double, k_synth_limb_count> burst_start_{};
+  std::array<double, k_synth_limb_count> burst_end_{};
+  std::array<bool, k_synth_limb_count> in_burst_{};
   proxy_pose mirrored_;
   synth_fk fk_;
   synth_points points_;

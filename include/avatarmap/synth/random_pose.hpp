@@ -2,7 +2,8 @@
 // Conventions of the sampled local rotations (VRM normalised space, left side; the right side
 // is always mirror_x of the same construction):
 // - finger flexion theta at a joint: axis_angle((0, 0, -1), theta) (bends toward the palm,
-//   -Y); proximal joints add spread about local Y first: q = flex * axis_angle((0,1,0), s).
+//   -Y); proximal joints add spread about local Y first: q = flex * axis_angle((0,1,0), s);
+//   with random_pose_limits::finger_side_bend the intermediate and distal joints too.
 // - thumb hinge axis h = normalize(cross(rest_dir, (0, -1, 0))) = (1, 0, -1)/sqrt(2);
 //   proximal/distal flexion = axis_angle(h, theta); metacarpal = flex(h) * spread(Y) *
 //   twist(rest_dir).
@@ -45,6 +46,18 @@ struct random_pose_limits {
   float finger_spread = 15.f;
   float thumb_metacarpal = 30.f;
   float thumb_flex_max = 80.f;
+  /// Non-hinge fingers: a sideways bend drawn in +-finger_side_bend at every finger
+  /// intermediate and distal joint (q = flex * axis_angle((0, 1, 0), b)) and at the thumb's
+  /// proximal and distal joints (about cross(h, rest_dir), after the hinge). 0 (the default)
+  /// draws nothing, so the random sequence of older seeds is unchanged.
+  float finger_side_bend = 0.f;
+  /// Coupled spine and neck, as a person bends: when >= 0, one rotation drawn with `spine` per
+  /// axis is shared by spine, chest and upperChest, and one drawn with `head` per axis is
+  /// split in halves between neck and head (quat_fraction 1/2 each); every one of these five
+  /// bones then gets its own deviation drawn in +-coupled_deviation degrees per axis (the
+  /// part no landmark can tell apart). Negative (the default): the five are drawn
+  /// independently, as before.
+  float coupled_deviation = -1.f;
   float eye_yaw = 25.f;
   float eye_pitch = 15.f;
   bool fingers = true;      // else finger bones stay at rest

@@ -5,7 +5,7 @@
 //
 // Space: VRM (metres, Y up, the avatar faces +Z, avatar's left = +X); rest = VRM T-pose.
 // For every bone, offsets[primary child] == lengths[bone] * bone_rest_direction(bone), so a
-// bone's rest direction (REFERENCE §3) is exactly the direction from its joint to its
+// bone's rest direction (docs/conventions.md) is exactly the direction from its joint to its
 // primary child's joint (leaves: to their tip). Everything here is allocation-free.
 #pragma once
 

@@ -1,0 +1,86 @@
+// Accuracy of solved poses against the synthetic ground truth (synth_recording.hpp): the
+// measuring stick of docs/accuracy.md and `avatarmap eval-pose`.
+//
+// Bone-direction error: for each measured bone b, the angle (degrees, [0, 180]) between
+// world_true[b] * bone_rest_direction(b) and world_solved[b] * bone_rest_direction(b), where
+// world = compute_world_rotations() (the proxy skeleton's FK: a bone's direction is the way
+// from its joint to its primary child's joint, independent of bone lengths). The hips position
+// is not measured. Measured bones are those of the torso, arms, legs and fingers groups.
+// Head orientation error: the angle of world_solved[head]^-1 * world_true[head] (degrees).
+// Eyes and jaw are in the head group but not measured (gaze and mouth opening are expressions
+// in the output). Every mean is over (frame, bone) samples.
+//
+// Low visibility: a truth frame is a low-visibility frame when any bone's truth confidence is
+// below 0.5 (the marker synth_recording writes for the bones of a limb in a burst). Over those
+// frames the same figures are kept again, and separately over the marked bones only.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "avatarmap/core/status.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+
+namespace avatarmap {
+
+/// Groups of the proxy skeleton's bones; every bone is in exactly one.
+/// torso: hips, spine, chest, upperChest, neck. arms: shoulders, upper/lower arms, hands.
+/// legs: upper/lower legs, feet, toes. fingers: thumbs and fingers (30 bones).
+/// head: head, eyes, jaw.
+enum class accuracy_group : std::uint8_t { torso, arms, legs, fingers, head };
+inline constexpr int k_accuracy_group_count = 5;
+/// Groups whose bones enter the direction error (all but head).
+inline constexpr int k_direction_group_count = 4;
+
+accuracy_group bone_accuracy_group(bone b);
+const char* accuracy_group_name(accuracy_group g);
+
+/// Mean and maximum of angles in degrees.
+struct angle_stats {
+  double sum = 0.0;
+  double max = 0.0;
+  long count = 0;
+  void add(double degrees) {
+    sum += degrees;
+    if (degrees > max) max = degrees;
+    ++count;
+  }
+  /// 0 when empty.
+  double mean() const { return count > 0 ? sum / static_cast<double>(count) : 0.0; }
+};
+
+/// Figures over one set of samples.
+struct accuracy_figures {
+  angle_stats direction;                                    // every measured bone
+  std::array<angle_stats, k_direction_group_count> groups;  // torso, arms, legs, fingers
+  angle_stats head;                                         // head orientation
+};
+
+struct pose_accuracy {
+  long frames = 0;                  // truth frames compared
+  long low_visibility_frames = 0;   // of those, frames with a marked bone
+  accuracy_figures all;             // every frame
+  accuracy_figures low_visibility;  // low-visibility frames only
+  angle_stats marked;               // marked bones only (bone directions)
+};
+
+/// Adds one frame (truth and solved at the same time) to `acc`. Non-finite or zero
+/// quaternions in `solved` count as 180 degrees (a solver must never output them).
+void accumulate_pose_accuracy(const proxy_pose& truth, const proxy_pose& solved,
+                              pose_accuracy& acc);
+
+/// Compares two *.pose.jsonl files: every frame of `truth_path` is matched with the frame of
+/// `solved_path` at the same time (within time_tolerance seconds). Both files must have
+/// strictly increasing times. Fails (naming the file and line) on a read error or on times
+/// that do not increase; fails after reading both files when a truth frame has no solved frame
+/// at its time (`out` then holds the figures of the matched frames; the message counts the
+/// unmatched frames and gives the first one's time). Solved frames between truth frames are
+/// ignored (e.g. a resampled output). An empty truth file is an error.
+struct pose_accuracy_options {
+  double time_tolerance = 0.5e-3;  // seconds, >= 0
+};
+status evaluate_pose_files(const std::string& truth_path, const std::string& solved_path,
+                           pose_accuracy& out, const pose_accuracy_options& options = {});
+
+}  // namespace avatarmap

@@ -1,0 +1,100 @@
+// `avatarmap eval-pose`: accuracy of solved poses against the synthetic truth
+// (include/avatarmap/synth/pose_accuracy.hpp, docs/accuracy.md).
+#include <cstdio>
+#include <string>
+
+#include "avatarmap/synth/pose_accuracy.hpp"
+#include "cli/cli_args.hpp"
+#include "cli/commands.hpp"
+
+namespace avatarmap::cli {
+namespace {
+
+const char* k_eval_help =
+    "Usage: avatarmap eval-pose TRUTH.pose.jsonl SOLVED.pose.jsonl [--json]\n"
+    "\n"
+    "Compares solved poses with the true ones written by `avatarmap synth --truth`, frame by\n"
+    "frame at the same times: the mean angle between true and solved bone directions (world\n"
+    "space, proxy skeleton), overall and per group (torso, arms, legs, fingers), the head's\n"
+    "orientation error, and the same over the low-visibility frames (truth confidence 0 marks\n"
+    "a bone in a burst; 'marked' is over those bones only). Angles in degrees.\n"
+    "\n"
+    "Options:\n"
+    "  --json   one JSON object on standard output instead of the table\n"
+    "  --tolerance MS   time difference allowed between matched frames (default 0.5)\n";
+
+void print_stats_json(const char* name, const angle_stats& s, bool comma) {
+  std::printf("\"%s\":{\"mean\":%.4f,\"max\":%.4f,\"count\":%ld}%s", name, s.mean(), s.max, s.count,
+              comma ? "," : "");
+}
+
+void print_figures_json(const char* name, const accuracy_figures& f) {
+  std::printf("\"%s\":{", name);
+  print_stats_json("overall", f.direction, true);
+  for (int g = 0; g < k_direction_group_count; ++g)
+    print_stats_json(accuracy_group_name(static_cast<accuracy_group>(g)), f.groups[g], true);
+  print_stats_json("head", f.head, false);
+  std::printf("}");
+}
+
+void print_figures_row(const char* name, const accuracy_figures& f) {
+  std::printf("%-22s %8.2f", name, f.direction.mean());
+  for (int g = 0; g < k_direction_group_count; ++g) std::printf(" %8.2f", f.groups[g].mean());
+  std::printf(" %8.2f\n", f.head.mean());
+}
+
+}  // namespace
+
+int run_eval_pose(int argc, char** argv) {
+  args a(argc, argv, 2);
+  if (a.flag("--help") || a.flag("-h")) {
+    std::fputs(k_eval_help, stdout);
+    return 0;
+  }
+  const bool json = a.flag("--json");
+  pose_accuracy_options options;
+  double ms = 0;
+  if (a.number("--tolerance", ms)) {
+    if (!(ms >= 0 && ms <= 1000)) {
+      std::fprintf(stderr, "avatarmap eval-pose: --tolerance must be in [0, 1000] ms\n");
+      return 2;
+    }
+    options.time_tolerance = ms * 1e-3;
+  }
+  if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 2) {
+    std::fprintf(stderr, "avatarmap eval-pose: %s\n",
+                 !a.error().empty() ? a.error().c_str()
+                                    : "give TRUTH.pose.jsonl and SOLVED.pose.jsonl (see --help)");
+    return 2;
+  }
+  pose_accuracy acc;
+  const status st = evaluate_pose_files(a.rest()[0], a.rest()[1], acc, options);
+  if (!st.ok()) {
+    std::fprintf(stderr, "avatarmap eval-pose: %s\n", st.message().c_str());
+    return 1;
+  }
+  if (json) {
+    std::printf("{\"frames\":%ld,\"low_visibility_frames\":%ld,", acc.frames,
+                acc.low_visibility_frames);
+    print_figures_json("all", acc.all);
+    std::printf(",");
+    print_figures_json("low_visibility", acc.low_visibility);
+    std::printf(",");
+    print_stats_json("marked", acc.marked, false);
+    std::printf("}\n");
+    return 0;
+  }
+  std::printf("%ld frames, %ld with low-visibility bones; mean angles in degrees\n", acc.frames,
+              acc.low_visibility_frames);
+  std::printf("%-22s %8s %8s %8s %8s %8s %8s\n", "", "overall", "torso", "arms", "legs", "fingers",
+              "head");
+  print_figures_row("all frames", acc.all);
+  if (acc.low_visibility_frames > 0) {
+    print_figures_row("low-visibility frames", acc.low_visibility);
+    std::printf("%-22s %8.2f  (bones in a burst only; max %.1f)\n", "marked bones",
+                acc.marked.mean(), acc.marked.max);
+  }
+  return 0;
+}
+
+}  // namespace avatarmap::cli

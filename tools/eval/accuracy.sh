@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# Accuracy of `avatarmap solve` on the synthetic generator's recordings (docs/accuracy.md).
+#
+# Usage: tools/eval/accuracy.sh [SEEDS...]      (default: the held-out seeds 101-105)
+#   Seeds 1-5 are for tuning, 101-105 for the report: never tune on the report seeds.
+# Environment: AVATARMAP (the tool; default build/avatarmap beside this checkout),
+#   SECONDS_PER_RUN (default 20), FPS (default 30), SIZE (default 1280x720),
+#   FILTERS (default "default none": solve's defaults, and --filter none for comparison),
+#   KEEP (a folder to keep the files in; default: a temporary folder, removed).
+# For each seed and scenario (clean, noisy) it synthesises a recording with its truth, solves
+# it with each filter setting and prints one row of mean errors in degrees: bone directions
+# overall and per group, head orientation, and over the bones in low-visibility bursts
+# ("low-vis"; "-" when the recording has none). A last row per scenario and filter gives the
+# mean over the seeds. Needs python3 (to read eval-pose --json).
+set -euo pipefail
+
+here=$(cd "$(dirname "$0")/../.." && pwd)
+exe=${AVATARMAP:-$here/build/avatarmap}
+seconds=${SECONDS_PER_RUN:-20}
+fps=${FPS:-30}
+size=${SIZE:-1280x720}
+filters=${FILTERS:-default none}
+if [ ! -x "$exe" ]; then
+  echo "accuracy.sh: no avatarmap at $exe; build it or set AVATARMAP=path/to/avatarmap" >&2
+  exit 2
+fi
+command -v python3 >/dev/null || { echo "accuracy.sh: needs python3" >&2; exit 2; }
+seeds=("$@")
+[ ${#seeds[@]} -gt 0 ] || seeds=(101 102 103 104 105)
+for s in "${seeds[@]}"; do
+  [[ $s =~ ^[0-9]+$ ]] || { echo "accuracy.sh: seeds are integers, got '$s'" >&2; exit 2; }
+done
+
+if [ -n "${KEEP:-}" ]; then
+  work=$KEEP
+  mkdir -p "$work"
+else
+  work=$(mktemp -d "${TMPDIR:-/tmp}/avatarmap-accuracy-XXXXXX")
+  trap 'rm -rf "$work"' EXIT
+fi
+
+printf '%-6s %-6s %-8s %8s %8s %8s %8s %8s %8s %8s\n' seed scene filter overall torso arms \
+  legs fingers head low-vis
+declare -A sums counts
+for scene in clean noisy; do
+  for seed in "${seeds[@]}"; do
+    base=$work/$scene-$seed
+    "$exe" synth --scenario "$scene" --seed "$seed" --seconds "$seconds" --fps "$fps" \
+      --size "$size" -o "$base.landmarks.jsonl" --truth "$base.truth.pose.jsonl" 2>/dev/null
+    for filter in $filters; do
+      args=()
+      [ "$filter" = default ] || args=(--filter "$filter")
+      "$exe" solve "$base.landmarks.jsonl" -o "$base.$filter.pose.jsonl" --quiet \
+        ${args[@]+"${args[@]}"} 2>/dev/null
+      json=$("$exe" eval-pose "$base.truth.pose.jsonl" "$base.$filter.pose.jsonl" --json)
+      row=$(python3 -c '
+import json, sys
+d = json.loads(sys.stdin.read()); a = d["all"]; m = d["marked"]
+v = [a[k]["mean"] for k in ("overall", "torso", "arms", "legs", "fingers", "head")]
+print(" ".join("%.4f" % x for x in v), "%.4f" % m["mean"] if m["count"] > 0 else "-")
+' <<<"$json")
+      read -r o t a l f h m <<<"$row"
+      lv=$m
+      [ "$m" = - ] || lv=$(printf '%.2f' "$m")
+      printf '%-6s %-6s %-8s %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8s\n' "$seed" "$scene" \
+        "$filter" "$o" "$t" "$a" "$l" "$f" "$h" "$lv"
+      key="$scene $filter"
+      vals=("$o" "$t" "$a" "$l" "$f" "$h" "$m")
+      for i in "${!vals[@]}"; do
+        [ "${vals[$i]}" = - ] && continue
+        sums[$key.$i]=$(awk -v x="${sums[$key.$i]:-0}" -v y="${vals[$i]}" 'BEGIN{print x + y}')
+        counts[$key.$i]=$((${counts[$key.$i]:-0} + 1))
+      done
+    done
+  done
+  for filter in $filters; do
+    key="$scene $filter"
+    means=()
+    for i in 0 1 2 3 4 5 6; do
+      if [ -n "${counts[$key.$i]:-}" ]; then
+        means+=("$(awk -v x="${sums[$key.$i]}" -v n="${counts[$key.$i]}" \
+          'BEGIN{printf "%.2f", x / n}')")
+      else
+        means+=(-)
+      fi
+    done
+    printf '%-6s %-6s %-8s %8s %8s %8s %8s %8s %8s %8s\n' mean "$scene" "$filter" \
+      "${means[0]}" "${means[1]}" "${means[2]}" "${means[3]}" "${means[4]}" "${means[5]}" \
+      "${means[6]}"
+  done
+done
