@@ -56,7 +56,8 @@ const char* format_key(rig_source s) {
   return "unknown";
 }
 
-// REFERENCE §5: the bones a VRM file must declare; VRM 0.x also requires chest and neck.
+// The bones a VRM 1.0 file must declare (docs/conventions.md, "Real rigs"); VRM 0.x also
+// requires chest and neck.
 std::vector<bone> required_bones(rig_source s) {
   std::vector<bone> r = {bone::hips,
                          bone::spine,

@@ -18,7 +18,7 @@ namespace {
 
 using json = nlohmann::json;
 
-// VRM 1.0 preset expressions (REFERENCE §5); the project's custom brow expressions come from
+// VRM 1.0 preset expressions (docs/conventions.md); the project's custom brow expressions come from
 // expression.hpp.
 constexpr std::array<std::string_view, 18> k_vrm1_expressions = {
     "happy",      "angry",  "sad",      "relaxed",  "surprised", "aa",

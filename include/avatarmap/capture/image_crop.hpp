@@ -2,7 +2,7 @@
 // an image resampled into a float RGB tensor, plus the transform that maps landmarks found in
 // that tensor back onto the image.
 //
-// Conventions (shared with MediaPipe, see docs in REFERENCE.md §4):
+// Conventions (shared with MediaPipe; docs/capture.md):
 // - Image pixel coordinates: x right, y down, pixel (i, j) sampled at the integer point (i, j)
 //   (OpenCV's convention). Normalised image coordinates are pixel coordinates divided by the
 //   image width and height: (0.5, 0.5) is the point (width / 2, height / 2).

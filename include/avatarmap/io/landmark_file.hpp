@@ -1,4 +1,4 @@
-// Streaming reader and writer of *.landmarks.jsonl (REFERENCE §3, docs/file-formats.md).
+// Streaming reader and writer of *.landmarks.jsonl (docs/file-formats.md).
 // Constant memory on any file size: one line is held at a time. Errors name the file and
 // line. Writes are atomic: a temporary file beside the target is renamed over it by
 // commit(); a writer destroyed without commit() leaves any existing target untouched.

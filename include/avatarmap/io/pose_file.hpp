@@ -1,4 +1,4 @@
-// Streaming reader and writer of *.pose.jsonl (REFERENCE §3, docs/file-formats.md).
+// Streaming reader and writer of *.pose.jsonl (docs/file-formats.md).
 // Quaternions are written [x, y, z, w]; bones are VRM 1.0 names; bones at identity may be
 // omitted when reading (missing bones mean identity). Same error and atomicity rules as
 // landmark_file.hpp.

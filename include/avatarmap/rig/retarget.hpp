@@ -1,4 +1,4 @@
-// Proxy pose -> a real rig's joint rotations, rest-pose aware (REFERENCE §5): the proxy's
+// Proxy pose -> a real rig's joint rotations, rest-pose aware (docs/conventions.md): the proxy's
 // normalised rotations become world orientations of the rig's bones, whatever the rig's bone
 // axes and rest rotations, so a humanoid rig works from its bone names alone.
 //

@@ -1,6 +1,6 @@
 // The proxy skeleton's bones: all 55 VRM 1.0 humanoid bones, in an order where every parent
-// comes before its children. Names are VRM 1.0's. Rest geometry: docs/conventions.md and
-// REFERENCE §3 (VRM T-pose, Y up, facing +Z, avatar's left +X).
+// comes before its children. Names are VRM 1.0's. Rest geometry: docs/conventions.md, "The
+// proxy skeleton" (VRM T-pose, Y up, facing +Z, avatar's left +X).
 #pragma once
 
 #include <array>
@@ -214,7 +214,7 @@ constexpr bone mirror_bone(bone b) {
 }
 
 /// Unit direction, in VRM space at rest (T-pose), from the bone's joint toward its child's
-/// joint (REFERENCE §3). Eyes and jaw point forward (+Z).
+/// joint (docs/conventions.md, "The proxy skeleton"). Eyes and jaw point forward (+Z).
 inline glm::vec3 bone_rest_direction(bone b) {
   constexpr float k_r2 = 0.70710678f;
   constexpr float k_r5a = 0.44721360f, k_r5b = 0.89442719f;  // (0, -1, 2) / sqrt(5)

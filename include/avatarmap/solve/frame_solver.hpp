@@ -1,6 +1,8 @@
 // Landmarks -> proxy pose: body, hands, face, confidence gating, hips translation.
-// The solver keeps per-bone state between frames (hysteresis, last good rotation, the
-// translation origin); frames must be fed in capture order. solve() allocates nothing.
+// Stages: prepare -> measure body / hands / face -> confidence gate (docs/solver.md, "Stages";
+// the gate's rules: solve/confidence_gate.hpp). The solver keeps per-bone state between
+// frames (the gate's, the translation origin, the last upper-arm twist); frames must be fed in
+// capture order. solve() allocates nothing.
 // Thread-safety: one solver per performer and thread; no member (not even the const
 // measure()) may run concurrently with another on the same object. See docs/solver.md.
 #pragma once
@@ -11,6 +13,7 @@
 
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
+#include "avatarmap/solve/confidence_gate.hpp"
 #include "avatarmap/solve/solver_options.hpp"
 
 namespace avatarmap {
@@ -57,37 +60,24 @@ class frame_solver {
   const solver_options& options() const { return options_; }
 
  private:
-  struct bone_state {
-    bool tracked = false;
-    bool ever_tracked = false;
-    bool blending = false;  // blending back in after being found again
-    double lost_at = 0.0;
-    double found_at = -1e9;
-    glm::quat last_good{1.f, 0.f, 0.f, 0.f};
-    glm::quat output{1.f, 0.f, 0.f, 0.f};
-    glm::quat regain_from{1.f, 0.f, 0.f, 0.f};
-  };
-  struct scalar_state {
-    bool tracked = false;
-    bool ever_tracked = false;
-    double lost_at = 0.0;
-    double found_at = -1e9;
-  };
-
-  float gate(scalar_state& s, float confidence, double t) const;
+  // The gate stage (src/solve/solve_gate.cpp): this frame's measurement -> what is shown.
+  void gate_bones(const frame_measurement& m, double t, proxy_pose& out);
+  glm::vec3 gate_hips_position(const frame_measurement& m, double t);
+  void gate_expressions(const frame_measurement& m, double t,
+                        std::array<float, k_expression_count>& out);
   const glm::quat& previous_world(int b) const;
 
   solver_options options_;
   float focal_per_width_ = 1.f;  // focal length / image width, from the field of view
-  std::array<bone_state, k_bone_count> bones_{};
+  std::array<rotation_gate, k_bone_count> bones_{};           // output = the local rotation shown
   mutable std::array<glm::quat, k_bone_count> prev_world_{};  // memo of previous_world()
   mutable std::array<unsigned, k_bone_count> world_stamp_{};
   unsigned world_generation_ = 1;
   glm::quat arm_reference_[2]{};  // last measured upper-arm world rotations (left, right)
   bool have_arm_reference_[2] = {false, false};
-  scalar_state hips_height_state_{};
-  scalar_state ground_state_{};
-  scalar_state face_state_{};
+  gate_state hips_height_state_{};
+  gate_state ground_state_{};
+  gate_state face_state_{};
   float hips_height_ = 0.f;
   float hips_height_held_ = 0.f;
   glm::vec2 ground_{0.f};
@@ -96,7 +86,6 @@ class frame_solver {
   std::array<float, k_expression_count> expressions_held_{};
   double last_t_ = 0.0;
   bool started_ = false;
-  bool have_prev_world_ = false;
   mutable frame_measurement scratch_{};
 };
 

@@ -1,0 +1,70 @@
+// Stage 1 of the solver (internal): landmark frame -> prepared points. Checks every point
+// (non-finite = not seen), applies the mirror option and the image's aspect ratio, and puts
+// each part in the space its measuring stage works in (VRM space; see docs/conventions.md).
+// Nothing here allocates; a prepared_frame is plain storage that is overwritten each frame.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <glm/glm.hpp>
+
+#include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/solve/solver_options.hpp"
+
+namespace avatarmap::solve_detail {
+
+/// A landmark's confidence in [0, 1]: min(visibility, presence), 0 when a coordinate or the
+/// confidence itself is not finite.
+inline float landmark_confidence(const landmark& l) {
+  // x * 0 is NaN for NaN and +-inf: one comparison tests all three coordinates.
+  const float probe = l.x * 0.f + l.y * 0.f + l.z * 0.f;
+  if (probe != 0.f) return 0.f;
+  const float c = std::min(l.visibility, l.presence);  // NaN compares false below
+  return c >= 0.f ? (c <= 1.f ? c : 1.f) : 0.f;
+}
+
+/// Pose points in VRM space after mirroring: metres when from pose_world, else VRM pixels
+/// (x W, -y H, -z W). Points the frame does not need (the face's without a face mesh, the
+/// hands' without hand landmarks) have confidence 0 and unset positions.
+struct body_points {
+  std::array<glm::vec3, k_pose_landmark_count> p;
+  std::array<float, k_pose_landmark_count> c;
+  bool valid = false;
+  bool metric = false;  // from pose_world (metres)
+};
+
+/// A hand's 21 points in canonical left-hand space (the avatar's right hand mirrored through
+/// X), metres or VRM pixels.
+struct hand_points {
+  std::array<glm::vec3, k_hand_landmark_count> p;
+  float c = 0.f;  // 1 when every point is finite, else 0
+};
+
+/// The face mesh points the solver reads, in VRM pixels with the perspective shear of the
+/// face's viewing ray removed, sides after mirroring (index 0 = avatar's left).
+struct eye_points {
+  glm::vec3 outer, inner, upper[3], lower[3], iris, brow;
+  bool has_iris = false;
+};
+struct face_points {
+  bool valid = false;
+  glm::vec3 forehead, chin, cheek[2], mouth[2], lip_upper, lip_lower;
+  eye_points eye[2];
+};
+
+/// Everything the measuring stages read.
+struct prepared_frame {
+  body_points body;
+  hand_points hand[2];  // 0 = avatar's left
+  face_points face;
+  float width = 1.f, height = 1.f;  // image size in pixels (1 x 1 when unknown: square pixels)
+  float focal = 1.f;                // pixels, from the horizontal field of view
+};
+
+/// Fills `out` from `in`. `focal_per_width` is the focal length over the image width (from
+/// the horizontal field of view). Hands and face are prepared before the body, which skips
+/// the pose points they replace.
+void prepare_frame(const landmark_frame& in, const solver_options& o, float focal_per_width,
+                   prepared_frame& out);
+
+}  // namespace avatarmap::solve_detail
