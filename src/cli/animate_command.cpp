@@ -33,7 +33,7 @@ const char* k_animate_help =
     "  --avatar FILE            the avatar to drive (.vrm, .glb, .gltf; required for .glb)\n"
     "  --keep-landmarks PATH    keep the captured landmarks (*.landmarks.jsonl) there\n"
     "  --overlay PATH           as for `capture`\n"
-    "  --rig, --bind, --fps, --ground, --no-root-motion, --filter, --mirror\n"
+    "  --rig, --bind, --fps, --ground, --no-root-motion, --filter, --smoothing, --mirror\n"
     "                           as for `convert`\n"
     "  --body-only              neither hands nor face (same as --no-hands --no-face)\n"
     "  --quiet                  no progress and no summaries\n"
@@ -51,9 +51,9 @@ constexpr option_spec k_capture_options[] = {
     {"--face", false},   {"--no-face", false},   {"--mirrored", false}, {"--progress", false},
 };
 constexpr option_spec k_convert_options[] = {
-    {"--avatar", true},  {"--rig", true},        {"--bind", true},    {"--fps", true},
-    {"--filter", true},  {"--image-size", true}, {"--ground", false}, {"--no-root-motion", false},
-    {"--mirror", false},
+    {"--avatar", true},          {"--rig", true},       {"--bind", true},       {"--fps", true},
+    {"--filter", true},          {"--smoothing", true}, {"--image-size", true}, {"--ground", false},
+    {"--no-root-motion", false}, {"--mirror", false},
 };
 
 // Whether `arg` is option `o` ("--name" or "--name=value").

@@ -19,6 +19,7 @@
 #include "avatarmap/time/seconds_text.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
+#include "cli/filter_option.hpp"
 #include "cli/rig_select.hpp"
 #include "cli/solve_job.hpp"
 #include "io/atomic_file.hpp"
@@ -49,7 +50,7 @@ const char* k_convert_help =
     "                        table fits\n"
     "  --ground              keep the avatar's lowest foot on the floor every frame\n"
     "  --no-root-motion      keep the hips where they are at rest\n"
-    "  --mirror, --image-size WxH, --filter euro|landmarks|both|none\n"
+    "  --mirror, --image-size WxH, --filter offline|live|none, --smoothing S\n"
     "                        as for `avatarmap solve` (landmark input only)\n"
     "  --quiet               no summary\n";
 
@@ -186,13 +187,15 @@ int run_convert(int argc, char** argv) {
     solve.image_width = float(w);
     solve.image_height = float(h);
   }
-  if (a.value("--filter", value)) {
-    if (value == "none" || value == "landmarks") solve.filter.enabled = false;
-    if (value == "landmarks" || value == "both") solve.landmark_filter.enabled = true;
-    if (value != "none" && value != "euro" && value != "landmarks" && value != "both") {
-      std::fprintf(stderr, "avatarmap convert: --filter is euro, landmarks, both or none\n");
-      return 2;
-    }
+  if (a.value("--filter", value) && !apply_filter_option(value, solve)) {
+    std::fprintf(stderr, "avatarmap convert: --filter is %s, got '%s'\n", k_filter_names,
+                 value.c_str());
+    return 2;
+  }
+  double smoothing = 1.0;
+  if (a.number("--smoothing", smoothing) && !apply_smoothing_option(smoothing, solve)) {
+    std::fprintf(stderr, "avatarmap convert: --smoothing is a scale in [0, 10] (1 = default)\n");
+    return 2;
   }
   if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 1 || out_path.empty()) {
     std::fprintf(stderr, "avatarmap convert: %s\n",

@@ -5,6 +5,7 @@
 #include "avatarmap/jobs/solve_file.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
+#include "cli/filter_option.hpp"
 #include "cli/solve_job.hpp"
 
 namespace avatarmap::cli {
@@ -22,12 +23,16 @@ const char* k_solve_help =
     "  --mirror               mirror the performer (for mirrored webcam recordings)\n"
     "  --image-size WxH       image size in pixels (default: the file's header; without one,\n"
     "                         square pixels are assumed and a warning is printed)\n"
-    "  --filter euro|landmarks|both|none\n"
-    "                         One Euro filtering: euro = on the solved rotations, position\n"
-    "                         and expressions (default); landmarks = on every landmark before\n"
-    "                         solving; both; none\n"
-    "  --min-cutoff HZ        One Euro cutoff at rest for rotations (default 1.5)\n"
-    "  --beta B               One Euro speed coefficient for rotations (default 0.5)\n"
+    "  --filter offline|live|none\n"
+    "                         offline (default): zero-lag smoothing of the solved poses that\n"
+    "                         sees 1.5 s ahead, and bones not seen for up to 1.5 s filled\n"
+    "                         from both sides; live: the causal One Euro filter of a live\n"
+    "                         stream; none. Older names: euro = live, landmarks = One Euro\n"
+    "                         on the landmarks only, both = landmarks and live\n"
+    "  --smoothing S          scale on the offline filter's time constants (default 1; 0 =\n"
+    "                         fill gaps only, 2 = twice as smooth)\n"
+    "  --min-cutoff HZ        live: One Euro cutoff at rest for rotations (default 1.5)\n"
+    "  --beta B               live: One Euro speed coefficient for rotations (default 0.5)\n"
     "  --fps N                resample the output at N frames per second (slerp between\n"
     "                         capture frames); default: one pose per input frame. Frames\n"
     "                         earlier than the one before are skipped (a warning); at most\n"
@@ -67,16 +72,16 @@ int run_solve(int argc, char** argv) {
       return 2;
     }
   }
-  if (a.value("--filter", value)) {
-    if (value == "none" || value == "landmarks") job.filter.enabled = false;
-    if (value == "landmarks" || value == "both") job.landmark_filter.enabled = true;
-    if (value != "none" && value != "euro" && value != "landmarks" && value != "both") {
-      std::fprintf(stderr, "avatarmap solve: --filter is euro, landmarks, both or none, got '%s'\n",
-                   value.c_str());
-      return 2;
-    }
+  if (a.value("--filter", value) && !apply_filter_option(value, job)) {
+    std::fprintf(stderr, "avatarmap solve: --filter is %s, got '%s'\n", k_filter_names,
+                 value.c_str());
+    return 2;
   }
   double num = 0.0;
+  if (a.number("--smoothing", num) && !apply_smoothing_option(num, job)) {
+    std::fprintf(stderr, "avatarmap solve: --smoothing is a scale in [0, 10] (1 = default)\n");
+    return 2;
+  }
   if (a.number("--min-cutoff", num)) job.filter.rotation.min_cutoff = static_cast<float>(num);
   if (a.number("--beta", num)) job.filter.rotation.beta = static_cast<float>(num);
   // Remembered separately: output_fps == 0 means "not resampled", but "--fps 0" is an error.

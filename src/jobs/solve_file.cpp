@@ -40,9 +40,13 @@ status check_one_euro(const char* name, const one_euro_params& p) {
 // on the heap, so that a caller on a small stack (a C API user's thread) is safe.
 struct solve_state {
   explicit solve_state(const solve_file_job& job, const solver_options& options)
-      : solver(options), filter(job.filter), points_filter(job.landmark_filter) {}
+      : solver(options),
+        filter(job.filter),
+        smoother(job.offline),
+        points_filter(job.landmark_filter) {}
   frame_solver solver;
   pose_filter filter;
+  offline_smoother smoother;
   landmark_filter points_filter;
   landmark_frame smoothed;
   landmark_frame frame;  // the direct source's storage (threads == 1)
@@ -84,6 +88,10 @@ status solve_file_job::validate() const {
   if (st.ok()) st = check_one_euro("position", filter.position);
   if (st.ok()) st = check_one_euro("expression", filter.expression);
   if (!st.ok()) return status::error("solve_file_job." + st.message());
+  if (filter_mode != pose_filter_mode::offline && filter_mode != pose_filter_mode::live &&
+      filter_mode != pose_filter_mode::none)
+    return status::error("solve_file_job.filter_mode must be offline, live or none");
+  if (status o = offline.validate(); !o.ok()) return status::error("solve_file_job." + o.message());
   return {};
 }
 
@@ -110,6 +118,11 @@ status solve_file_job::run(solve_file_summary& s) const {
   } else if (!(options.image_width > 0.f)) {
     s.image_size_assumed = true;
   }
+  if (filter_mode == pose_filter_mode::offline) {
+    // The smoother sees the future, so it, not the causal gate, decides what was observed.
+    solve_options.confidence.lost_below = 0.f;
+    solve_options.confidence.found_above = 0.f;
+  }
   s.image_width = solve_options.image_width;
   s.image_height = solve_options.image_height;
   st = solve_options.validate();
@@ -135,13 +148,68 @@ status solve_file_job::run(solve_file_summary& s) const {
   // 1 / fps) keeps the number of poses per frame exact and bounded whatever the times' magnitude.
   const double fps = output_fps;
   const std::string& fps_name = output_fps_name;
-  double t_render0 = 0.0, t_newest = 0.0;
+  double t_render0 = 0.0;
+  // The first and newest frame read (resampling needs times in order; checked as frames are
+  // read, before the filter's delay).
+  double t_read_first = 0.0, t_read_newest = 0.0;
+  bool have_read = false;
   long j_next = 0;
   bool have_render = false;
   s.hips_height_min = 1e9f;
   s.hips_height_max = -1e9f;
   job_failure why = job_failure::none;  // set with each error below
 
+  // Everything after the filter, for one filtered pose: hips range, resampling, writing.
+  long delivered = 0;  // filtered poses so far (their frame index, for messages)
+  auto deliver = [&](const proxy_pose& filtered) -> status {
+    const long index = delivered++;
+    s.hips_height_min = std::min(s.hips_height_min, filtered.hips_position.y);
+    s.hips_height_max = std::max(s.hips_height_max, filtered.hips_position.y);
+    if (fps > 0.0) {
+      if (!state->resampler.push(filtered)) return {};
+      if (!have_render) {
+        t_render0 = filtered.t;
+        have_render = true;
+      }
+      // The last render time at or before this frame (1e-9 s of tolerance): an estimate,
+      // then at most a step or two to settle rounding (times are within
+      // k_max_clip_seconds of t_render0, so j stays far below LONG_MAX).
+      auto at_or_before = [&](long j) {
+        return t_render0 + static_cast<double>(j) / fps <= filtered.t + 1e-9;
+      };
+      // Checked as a double before any cast: an absurd rate must not overflow the count.
+      const double estimate = std::floor((filtered.t - t_render0) * fps) + 2.0;
+      if (!(estimate - static_cast<double>(j_next) + static_cast<double>(s.poses_written) <=
+            static_cast<double>(k_max_resampled_frames))) {
+        why = job_failure::invalid_argument;
+        return status::error(input + ": " + fps_name + " " + seconds_text(fps, 2) +
+                             " up to frame " + std::to_string(index) +
+                             " (t = " + seconds_text(filtered.t) + " s) would write more than " +
+                             std::to_string(k_max_resampled_frames) + " poses; lower " + fps_name +
+                             " or split the input");
+      }
+      long j_last = static_cast<long>(estimate) - 2;
+      for (int step = 0; step < 2 && at_or_before(j_last + 1); ++step) ++j_last;
+      for (int step = 0; step < 2 && j_last >= j_next && !at_or_before(j_last); ++step) --j_last;
+      for (; j_next <= j_last; ++j_next) {
+        const double rt = t_render0 + static_cast<double>(j_next) / fps;
+        if (!state->resampler.sample(rt, state->sampled)) break;
+        state->sampled.t = rt;
+        if (status w = emit(state->sampled); !w.ok()) {
+          why = job_failure::output_io;
+          return w;
+        }
+        ++s.poses_written;
+      }
+    } else {
+      if (status w = emit(filtered); !w.ok()) {
+        why = job_failure::output_io;
+        return w;
+      }
+      ++s.poses_written;
+    }
+    return {};
+  };
   // One pass over the frames of `src` (the reader itself, or a prefetcher parsing on a second
   // thread): solve, filter, resample, write.
   auto process = [&](auto& src) -> status {
@@ -160,29 +228,32 @@ status solve_file_job::run(solve_file_summary& s) const {
       }
       const landmark_frame& frame = src.frame();
       const long index = s.frames + s.out_of_order;  // 0-based among the good frames
-      if (fps > 0.0 && have_render) {
-        if (frame.t < t_newest) {
+      if (fps > 0.0 && have_read) {
+        if (frame.t < t_read_newest) {
           // Resampling cannot go back in time. The frame is left out entirely (solving it would
           // also restart the pose filter), with a warning.
           ++s.out_of_order;
           if (s.out_of_order <= k_warnings_per_kind && warning)
             warning("frame " + std::to_string(index) + " (t = " + seconds_text(frame.t) +
-                    " s) is earlier than the frame before it (t = " + seconds_text(t_newest) +
+                    " s) is earlier than the frame before it (t = " + seconds_text(t_read_newest) +
                     " s); skipped (" + fps_name + " needs times in order)");
           src.release();
           continue;
         }
-        if (frame.t - t_render0 > k_max_clip_seconds) {
+        if (frame.t - t_read_first > k_max_clip_seconds) {
           // The times are readable but too far apart for the asked rate: an argument error,
           // as for resample_clip (not a malformed line).
           why = job_failure::invalid_argument;
           return status::error(
               input + ": frame " + std::to_string(index) + " (t = " + seconds_text(frame.t) +
-              " s) is " + seconds_text(frame.t - t_render0, 2) + " s after the first frame; " +
+              " s) is " + seconds_text(frame.t - t_read_first, 2) + " s after the first frame; " +
               fps_name + " resamples at most " + seconds_text(k_max_clip_seconds, 0) +
               " s (24 h): check the times or solve without " + fps_name);
         }
       }
+      if (!have_read) t_read_first = frame.t;
+      have_read = true;
+      t_read_newest = frame.t;
       if (s.frames == 0) s.t_first = frame.t;
       s.t_last = frame.t;
       ++s.frames;
@@ -198,53 +269,16 @@ status solve_file_job::run(solve_file_summary& s) const {
         solver.solve(frame, state->solved);
       }
       src.release();
-      proxy_pose& filtered = state->filtered;
-      filter_pose_channels(state->filter, filter_channels, state->solved, filtered);
-      s.hips_height_min = std::min(s.hips_height_min, filtered.hips_position.y);
-      s.hips_height_max = std::max(s.hips_height_max, filtered.hips_position.y);
-      if (fps > 0.0) {
-        if (!state->resampler.push(filtered)) continue;
-        if (!have_render) {
-          t_render0 = filtered.t;
-          have_render = true;
-        }
-        t_newest = filtered.t;
-        // The last render time at or before this frame (1e-9 s of tolerance): an estimate,
-        // then at most a step or two to settle rounding (times are within
-        // k_max_clip_seconds of t_render0, so j stays far below LONG_MAX).
-        auto at_or_before = [&](long j) {
-          return t_render0 + static_cast<double>(j) / fps <= filtered.t + 1e-9;
-        };
-        // Checked as a double before any cast: an absurd rate must not overflow the count.
-        const double estimate = std::floor((filtered.t - t_render0) * fps) + 2.0;
-        if (!(estimate - static_cast<double>(j_next) + static_cast<double>(s.poses_written) <=
-              static_cast<double>(k_max_resampled_frames))) {
-          why = job_failure::invalid_argument;
-          return status::error(input + ": " + fps_name + " " + seconds_text(fps, 2) +
-                               " up to frame " + std::to_string(index) +
-                               " (t = " + seconds_text(filtered.t) + " s) would write more than " +
-                               std::to_string(k_max_resampled_frames) + " poses; lower " +
-                               fps_name + " or split the input");
-        }
-        long j_last = static_cast<long>(estimate) - 2;
-        for (int step = 0; step < 2 && at_or_before(j_last + 1); ++step) ++j_last;
-        for (int step = 0; step < 2 && j_last >= j_next && !at_or_before(j_last); ++step) --j_last;
-        for (; j_next <= j_last; ++j_next) {
-          const double rt = t_render0 + static_cast<double>(j_next) / fps;
-          if (!state->resampler.sample(rt, state->sampled)) break;
-          state->sampled.t = rt;
-          if (status w = emit(state->sampled); !w.ok()) {
-            why = job_failure::output_io;
-            return w;
-          }
-          ++s.poses_written;
-        }
+      if (filter_mode == pose_filter_mode::offline) {
+        state->smoother.push(state->solved);
+        while (state->smoother.pop(state->filtered))
+          if (status w = deliver(state->filtered); !w.ok()) return w;
       } else {
-        if (status w = emit(filtered); !w.ok()) {
-          why = job_failure::output_io;
-          return w;
-        }
-        ++s.poses_written;
+        if (filter_mode == pose_filter_mode::live)
+          filter_pose_channels(state->filter, filter_channels, state->solved, state->filtered);
+        else
+          state->filtered = state->solved;
+        if (status w = deliver(state->filtered); !w.ok()) return w;
       }
       if (progress && (s.frames & 255) == 0) {
         const auto now = clock_type::now();
@@ -261,6 +295,10 @@ status solve_file_job::run(solve_file_summary& s) const {
   } else {
     direct_source direct{reader, state->frame};
     st = process(direct);
+  }
+  if (st.ok() && filter_mode == pose_filter_mode::offline) {
+    state->smoother.finish();
+    while (st.ok() && state->smoother.pop(state->filtered)) st = deliver(state->filtered);
   }
   if (!st.ok()) return fail(why, st);
   if (!sink) st = writer.commit();

@@ -551,6 +551,25 @@ static void test_solve_file(void) {
   CHECK_STATUS(avm_solve_file(in, out, &o, err, sizeof err), AVM_ERROR_INVALID_ARGUMENT);
   CHECK(strstr(err, "horizontal_fov_degrees") != NULL);
 
+  /* Files are smoothed offline (zero lag) by default; the mode and strength are checked. */
+  avm_solver_options_init(&o);
+  CHECK(o.file_filter == AVM_FILE_FILTER_OFFLINE);
+  CHECK(o.file_smoothing == 1.f);
+  o.file_filter = 7;
+  CHECK_STATUS(avm_solve_file(in, out, &o, err, sizeof err), AVM_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(err, "file_filter") != NULL);
+  avm_solver_options_init(&o);
+  o.file_smoothing = -1.f;
+  CHECK_STATUS(avm_solve_file(in, out, &o, err, sizeof err), AVM_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(err, "file_smoothing") != NULL);
+  avm_solver_options_init(&o);
+  o.file_filter = AVM_FILE_FILTER_LIVE;
+  CHECK_STATUS(avm_solve_file(in, out, &o, err, sizeof err), AVM_OK);
+  CHECK(count_lines(out, &has_hips) == lines);
+  o.file_filter = AVM_FILE_FILTER_NONE;
+  CHECK_STATUS(avm_solve_file(in, out, &o, err, sizeof err), AVM_OK);
+  CHECK(count_lines(out, &has_hips) == lines);
+
   /* A missing input: an I/O error with a message; the output is untouched. */
   CHECK_STATUS(avm_solve_file("does/not/exist.landmarks.jsonl", out, NULL, err, sizeof err),
                AVM_ERROR_IO);

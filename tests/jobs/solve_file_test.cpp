@@ -15,6 +15,7 @@
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
+#include "avatarmap/time/offline_smoother.hpp"
 #include "support/temp_dir.hpp"
 
 namespace avatarmap {
@@ -78,6 +79,30 @@ solver_options synth_camera() {
   return o;
 }
 
+// The reference of the default (offline) filter: solved frame by frame with the confidence
+// gate opened (thresholds 0, as the job does for the offline filter), then streamed through
+// offline_smoother.
+std::vector<proxy_pose> reference_offline_poses(const std::string& path, solver_options options,
+                                                const offline_smoother_options& smooth = {}) {
+  options.confidence.lost_below = 0.f;
+  options.confidence.found_above = 0.f;
+  landmark_reader reader;
+  EXPECT_TRUE(reader.open(path).ok());
+  frame_solver solver(options);
+  offline_smoother smoother(smooth);
+  landmark_frame frame;
+  proxy_pose raw, smoothed;
+  std::vector<proxy_pose> out;
+  while (reader.next(frame) == read_result::frame) {
+    solver.solve(frame, raw);
+    smoother.push(raw);
+    while (smoother.pop(smoothed)) out.push_back(smoothed);
+  }
+  smoother.finish();
+  while (smoother.pop(smoothed)) out.push_back(smoothed);
+  return out;
+}
+
 void expect_same_poses(const std::vector<proxy_pose>& got, const std::vector<proxy_pose>& want,
                        float tolerance) {
   ASSERT_EQ(got.size(), want.size());
@@ -102,7 +127,8 @@ class solve_file : public ::testing::Test {
 };
 
 TEST_F(solve_file, sink_gets_exactly_the_frame_by_frame_poses_with_either_thread_count) {
-  const std::vector<proxy_pose> want = reference_poses(input, synth_camera(), {});
+  // The default filter is the offline one.
+  const std::vector<proxy_pose> want = reference_offline_poses(input, synth_camera());
   ASSERT_EQ(want.size(), 60u);
   for (int threads : {1, 2}) {
     solve_file_job job;
@@ -142,7 +168,7 @@ TEST_F(solve_file, written_file_reads_back_as_the_same_poses) {
   proxy_pose p;
   while (reader.next(p) == read_result::frame) got.push_back(p);
   // Text round trip: the writer prints ~7 significant digits.
-  expect_same_poses(got, reference_poses(input, synth_camera(), {}), 2e-6f);
+  expect_same_poses(got, reference_offline_poses(input, synth_camera()), 2e-6f);
 }
 
 TEST_F(solve_file, filter_options_and_channels_are_those_of_the_reference) {
@@ -152,6 +178,7 @@ TEST_F(solve_file, filter_options_and_channels_are_those_of_the_reference) {
   c.position = false;
   solve_file_job job;
   job.input = input;
+  job.filter_mode = pose_filter_mode::live;  // the live path is exactly pose_filter's
   job.filter = f;
   job.filter_channels = c;
   std::vector<proxy_pose> got;
@@ -330,6 +357,9 @@ TEST(solve_file_validate, names_each_broken_field) {
       {[](solve_file_job& j) { j.filter.rotation.min_cutoff = 0.f; }, "rotation.min_cutoff"},
       {[](solve_file_job& j) { j.filter.position.beta = INFINITY; }, "position.beta"},
       {[](solve_file_job& j) { j.filter.expression.d_cutoff = -1.f; }, "expression.d_cutoff"},
+      {[](solve_file_job& j) { j.offline.finger_sigma_seconds = 0.f; },
+       "offline_smoother_options.finger_sigma_seconds"},
+      {[](solve_file_job& j) { j.filter_mode = static_cast<pose_filter_mode>(7); }, "filter_mode"},
   };
   for (const breaking& c : cases) {
     solve_file_job j = good();
@@ -346,6 +376,51 @@ TEST(solve_file_validate, names_each_broken_field) {
   j.output.clear();
   j.sink = [](const proxy_pose&) { return status{}; };
   EXPECT_TRUE(j.validate().ok());
+}
+
+TEST_F(solve_file, offline_strength_and_none_are_honoured) {
+  auto solve_with = [&](pose_filter_mode mode, float strength) {
+    solve_file_job job;
+    job.input = input;
+    job.filter_mode = mode;
+    job.offline.strength = strength;
+    std::vector<proxy_pose> got;
+    job.sink = [&got](const proxy_pose& p) {
+      got.push_back(p);
+      return status{};
+    };
+    solve_file_summary s;
+    EXPECT_TRUE(job.run(s).ok());
+    return got;
+  };
+  offline_smoother_options twice;
+  twice.strength = 2.f;
+  expect_same_poses(solve_with(pose_filter_mode::offline, 2.f),
+                    reference_offline_poses(input, synth_camera(), twice), 0.f);
+  pose_filter_options off;
+  off.enabled = false;
+  expect_same_poses(solve_with(pose_filter_mode::none, 1.f),
+                    reference_poses(input, synth_camera(), off), 0.f);
+}
+
+TEST_F(solve_file, resampling_runs_after_the_offline_filter) {
+  // --fps resamples the smoothed poses: at 60 fps every second pose falls on a frame time
+  // (1 + k / 30 s), where it is that frame's smoothed pose.
+  solve_file_job job;
+  job.input = input;
+  job.output_fps = 60.0;
+  std::vector<proxy_pose> got;
+  job.sink = [&got](const proxy_pose& p) {
+    got.push_back(p);
+    return status{};
+  };
+  solve_file_summary s;
+  ASSERT_TRUE(job.run(s).ok());
+  const std::vector<proxy_pose> smoothed = reference_offline_poses(input, synth_camera());
+  ASSERT_EQ(got.size(), 2 * smoothed.size() - 1);
+  std::vector<proxy_pose> on_frames;
+  for (std::size_t j = 0; j < got.size(); j += 2) on_frames.push_back(got[j]);
+  expect_same_poses(on_frames, smoothed, 1e-5f);
 }
 
 }  // namespace

@@ -30,6 +30,7 @@
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/solve/solver_options.hpp"
+#include "avatarmap/time/offline_smoother.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
 #include "avatarmap/version.hpp"
@@ -210,6 +211,8 @@ avm_solver_options default_options() {
   o.expression_d_cutoff = f.expression.d_cutoff;
   const am::pose_resampler_options r{};
   o.max_extrapolation_seconds = static_cast<float>(r.max_extrapolation_seconds);
+  o.file_filter = AVM_FILE_FILTER_OFFLINE;
+  o.file_smoothing = am::offline_smoother_options{}.strength;
   return o;
 }
 
@@ -219,6 +222,8 @@ struct core_options {
   am::pose_filter_options filter;
   am::pose_resampler_options resampler;
   am::pose_filter_channels channels;
+  am::pose_filter_mode file_filter = am::pose_filter_mode::offline;  // avm_solve_file only
+  float file_smoothing = 1.f;
 };
 
 // Larger than any plausible future avm_solver_options: a bigger struct_size is taken as an
@@ -300,6 +305,27 @@ bool read_options(const avm_solver_options* in, core_options& out, std::string& 
   out.channels.expressions = o.filter_expressions != 0;
   out.filter.enabled = out.channels.rotations || out.channels.position || out.channels.expressions;
   out.resampler.max_extrapolation_seconds = o.max_extrapolation_seconds;
+  switch (o.file_filter) {
+    case AVM_FILE_FILTER_OFFLINE:
+      out.file_filter = am::pose_filter_mode::offline;
+      break;
+    case AVM_FILE_FILTER_LIVE:
+      out.file_filter = am::pose_filter_mode::live;
+      break;
+    case AVM_FILE_FILTER_NONE:
+      out.file_filter = am::pose_filter_mode::none;
+      break;
+    default:
+      msg =
+          "avm_solver_options.file_filter is " + std::to_string(o.file_filter) +
+          ": use AVM_FILE_FILTER_OFFLINE (0), AVM_FILE_FILTER_LIVE (1) or AVM_FILE_FILTER_NONE (2)";
+      return false;
+  }
+  if (!(std::isfinite(o.file_smoothing) && o.file_smoothing >= 0.f && o.file_smoothing <= 10.f)) {
+    msg = "avm_solver_options.file_smoothing must be finite and in [0, 10] (1 = default)";
+    return false;
+  }
+  out.file_smoothing = o.file_smoothing;
   return true;
 }
 
@@ -538,6 +564,8 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
     // Non-zero options.image_width/height win over the file's header (0 = the header's).
     job.image_width = o.solver.image_width;
     job.image_height = o.solver.image_height;
+    job.filter_mode = o.file_filter;
+    job.offline.strength = o.file_smoothing;
     job.filter = o.filter;
     job.filter_channels = o.channels;
     job.threads = 1;

@@ -1,11 +1,13 @@
 // The landmarks-file -> proxy-poses workflow, written once for the CLI (`solve`, `demo`,
 // `convert` of a landmark file) and the C API (avm_solve_file): read a *.landmarks.jsonl,
-// solve every frame (frame_solver), filter (landmark_filter before, pose_filter after),
-// optionally resample at a fixed rate, and write a *.pose.jsonl or hand each pose to a sink.
+// solve every frame (frame_solver), filter (landmark_filter before; offline_smoother or
+// pose_filter after), optionally resample at a fixed rate (after the filter), and write a
+// *.pose.jsonl or hand each pose to a sink.
 //
-// Memory: one frame in flight (or a ring of 64 parsed frames with threads = 2); the poses are
-// streamed, never held. Per-frame state lives in the solver, the filters and the resampler
-// the job creates for one run.
+// Memory: one frame in flight (or a ring of 64 parsed frames with threads = 2) and, with the
+// offline filter, its window of poses (offline_smoother_options::capacity_frames, ~300 kB by
+// default); the poses are streamed, never held all. Per-frame state lives in the solver, the
+// filters and the resampler the job creates for one run.
 #pragma once
 
 #include <functional>
@@ -16,6 +18,7 @@
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "avatarmap/solve/solver_options.hpp"
+#include "avatarmap/time/offline_smoother.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 
 namespace avatarmap {
@@ -37,6 +40,20 @@ inline void filter_pose_channels(pose_filter& filter, const pose_filter_channels
   if (!channels.position) out.hips_position = raw.hips_position;
   if (!channels.expressions) out.expressions = raw.expressions;
 }
+
+/// How solved poses are smoothed over time (docs/smoothing.md).
+enum class pose_filter_mode : unsigned char {
+  /// Zero-phase smoothing and gap filling with a bounded lookahead (offline_smoother): the
+  /// default for files. The solver's confidence gate is opened (thresholds 0) so that every
+  /// measured bone reaches the smoother, which decides what is observed with the future in
+  /// view (offline_smoother_options::observed_above) and fills or eases the rest.
+  offline,
+  /// The causal One Euro filter (pose_filter, `filter`): what a live stream gets; the solver's
+  /// gate as configured in `options`.
+  live,
+  /// No temporal filter after solving (the solver's gate as configured).
+  none,
+};
 
 /// What a solve_file_job reports to its progress callback.
 struct solve_file_progress {
@@ -82,7 +99,13 @@ struct solve_file_job {
   /// those are 0 too, square pixels are assumed and the summary says so).
   float image_width = 0.f;
   float image_height = 0.f;
+  /// Which filter runs after solving; `offline` and `live` use the options below.
+  pose_filter_mode filter_mode = pose_filter_mode::offline;
+  /// Options of the offline filter (filter_mode offline).
+  offline_smoother_options offline{};
+  /// Options of the live filter (filter_mode live; filter.enabled = false is the same as none).
   pose_filter_options filter{};
+  /// Channels that take the live filter's output (filter_mode live only).
   pose_filter_channels filter_channels{};
   /// Point filtering before solving: off unless asked for.
   landmark_filter_options landmark_filter = [] {
@@ -112,7 +135,8 @@ struct solve_file_job {
 
   /// Checks the fields that do not need the file: input set, output or sink set, options
   /// valid, image size finite and >= 0 (both or neither), output_fps finite in [0, 1000],
-  /// threads 1 or 2, filter parameters positive. The message names the field.
+  /// threads 1 or 2, filter_mode known, filter parameters positive, offline options valid
+  /// (offline_smoother_options::validate). The message names the field.
   status validate() const;
   /// validate(), then the whole run into `out` (replaced). Fails with a message naming the
   /// file (and line or frame) and out.failure set. Never throws but for std::bad_alloc.

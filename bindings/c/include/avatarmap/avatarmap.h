@@ -277,7 +277,27 @@ typedef struct avm_solver_options {
   /* -- resampler (avm_solver_sample) -- */
   float max_extrapolation_seconds; /* finite, >= 0: how far past the newest frame sample()
                                       extrapolates before holding still; 0.1 */
+
+  /* -- how avm_solve_file smooths a whole file (docs/smoothing.md); the per-frame path
+   *    (avm_solver_push) always uses the One Euro filter above. Added in 0.1.0 after the
+   *    fields above: a caller whose struct_size ends before them gets the defaults. -- */
+  int32_t file_filter;  /* avm_file_filter; AVM_FILE_FILTER_OFFLINE */
+  float file_smoothing; /* offline: scale on the smoothing time constants, finite, [0, 10]
+                           (0 = fill gaps only); 1 */
 } avm_solver_options;
+
+/* What avm_solve_file does after solving each frame. */
+typedef enum avm_file_filter {
+  /* Zero-lag smoothing that sees 1.5 s ahead, and bones not observed for up to 1.5 s filled
+   * from both sides (longer gaps ease to rest); the confidence_* thresholds above are not
+   * used (the smoother decides what was observed); hold and ease times are its own. */
+  AVM_FILE_FILTER_OFFLINE = 0,
+  /* The causal One Euro filter above, as avm_solver_push() applies it (the behaviour of
+   * avm_solve_file before file_filter existed). */
+  AVM_FILE_FILTER_LIVE = 1,
+  /* No smoothing after solving (the confidence gate above still applies). */
+  AVM_FILE_FILTER_NONE = 2
+} avm_file_filter;
 
 /* Fills `options` with the defaults and sets options->struct_size. Returns
  * AVM_ERROR_INVALID_ARGUMENT when `options` is NULL. Thread-safe. */
@@ -349,8 +369,11 @@ AVATARMAP_C_API const char* avm_solver_last_error(const avm_solver* solver);
 
 /* ---- files --------------------------------------------------------------------------- */
 
-/* Solves a whole *.landmarks.jsonl file into a *.pose.jsonl file (REFERENCE §3): every frame
- * is solved and filtered as by avm_solver_push(); no resampling. The image size of the
+/* Solves a whole *.landmarks.jsonl file into a *.pose.jsonl file (docs/file-formats.md): every frame
+ * is solved as by avm_solver_push() and smoothed as options->file_filter says (by default
+ * offline: zero-lag smoothing and gap filling with a 1.5 s lookahead, memory bounded by
+ * its window; AVM_FILE_FILTER_LIVE gives exactly avm_solver_push()'s filtering); no
+ * resampling. The image size of the
  * landmark file's header is used when options give none. The output is written atomically:
  * a temporary file beside `out_pose` is renamed over it only when everything succeeded, so
  * on failure an existing `out_pose` is untouched. `options` NULL means the defaults.
@@ -389,7 +412,7 @@ AVATARMAP_C_API avm_status avm_set_mappings_folder(const char* folder);
 /* ---- retargeting onto an avatar ------------------------------------------------------ */
 
 /* A rig loaded from an avatar file (glTF/GLB, VRM 0.x, VRM 1.0) with its proxy-bone binding,
- * turning proxy poses into the rig's local joint rotations (REFERENCE §5, rest-pose aware).
+ * turning proxy poses into the rig's local joint rotations (rest-pose aware; docs/conventions.md).
  * Typed opaque handle; one thread at a time per handle; different handles are independent. */
 typedef struct avm_retargeter avm_retargeter;
 
@@ -480,7 +503,7 @@ AVATARMAP_C_API int avm_clip_frame_count(const avm_clip* clip);
  *   .bvh         BVH, centimetres, ZXY: with avatar_path NULL, of the proxy skeleton (55 VRM
  *                bones); else of the avatar's own rig (its joints, names and proportions;
  *                the hips' subtree), the clip retargeted onto it as for .glb;
- *   .pose.jsonl  avatarmap proxy poses (REFERENCE §3); avatar_path is ignored;
+ *   .pose.jsonl  avatarmap proxy poses (docs/file-formats.md); avatar_path is ignored;
  *   .glb         the avatar at avatar_path (required; .vrm, .glb or .gltf) with the clip as a
  *                glTF animation of its joints, bound as `mapping` says (see "mapping tables";
  *                NULL = "auto"); meshes, materials and extensions are kept.

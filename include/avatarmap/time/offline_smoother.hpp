@@ -1,0 +1,166 @@
+// Zero-phase smoothing and gap filling of a stream of proxy poses for files (the default of
+// `solve`, `convert`, `animate` and avm_solve_file; docs/smoothing.md). It sees the future
+// through a bounded window: poses are pushed in capture order and come out, smoothed, once
+// `lookahead_seconds()` of later capture time has been pushed (or at finish()). Latency is
+// that window; memory is `capacity_frames` poses, allocated once at construction; push() and
+// pop() allocate nothing.
+//
+// Per bone, at the pose being emitted (the centre). "Confidence" below is the input's, except
+// that a hand and its fingers are capped by their lower arm's (hands_follow_arms).
+// - observed (confidence >= observed_above): a Gaussian-weighted local quadratic regression in
+//   time (degree 2; degree 0 = weighted mean) over the observed poses within 3 sigma, each
+//   weighted by kernel x confidence. Quaternions are hemisphere-aligned to the centre's first
+//   (each neighbour flipped to its side, so nothing is averaged through the double cover), fitted
+//   per component and normalised: for the spreads of a few degrees inside a kernel this is
+//   the chordal estimate, within O(spread^3) of a fit in the tangent space, without
+//   trigonometry. Sigma by group: body (torso, head, limbs) and fingers, whose noise is large
+//   relative to their length. The quadratic follows the peaks of fast motion that a mean of the
+//   same width would flatten, so the kernels can be wider for the same lag error.
+// - seen with a low confidence of its own (0 < confidence < observed_above, e.g. an occluded
+//   limb the estimator still places): smoothed over low_confidence_sigma_seconds with every
+//   frame weighted by its confidence; the measurement still says where the bone went.
+// - not observed (a gap: confidence 0, or a hand capped by its arm): filled from both sides.
+//   When the last observed pose before and the next one after are at most max_gap_seconds
+//   apart, the bone is the slerp between their smoothed rotations at the centre's time
+//   fraction. Longer gaps (or a side that does not exist) hold the side's rotation for
+//   hold_seconds and then ease it to rest (identity) over ease_seconds (confidence_gate.hpp's
+//   hold_and_ease), from each side symmetrically; with both sides, the two are slerped by time
+//   fraction so nothing snaps. A bone observed nowhere within reach keeps the input's rotations
+//   (e.g. unobservable bones the solver sets from priors), smoothed.
+// - confidence is copied unchanged (a filled bone stays marked as not observed); `t` is the
+//   centre's.
+// The hips position and the expression weights are Gaussian-smoothed (unweighted by
+// confidence: the solver already holds and eases them).
+//
+// Time: frames are expected in increasing `t` (duplicates are fine). A frame whose `t` is
+// earlier than the one before, or non-finite, starts a new segment: no smoothing or filling
+// crosses a segment boundary (the segment before is emitted as it stands). When more than
+// capacity_frames poses are waiting (a very high frame rate), the oldest is emitted with less
+// lookahead than asked. Non-finite rotations, positions or weights in the input count as not
+// observed (rotations) or are ignored (position, weights); the output is always finite.
+// Thread-safety: one instance per stream.
+#pragma once
+
+#include <array>
+#include <memory>
+
+#include "avatarmap/core/status.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+
+namespace avatarmap {
+
+/// Options of offline_smoother. Every time is in seconds of capture time.
+struct offline_smoother_options {
+  /// Scale on every sigma below (the CLI's --smoothing). 0 = no smoothing (gap filling only).
+  float strength = 1.f;
+  /// Gaussian sigma for torso, head, eyes, jaw, arms, legs.
+  float body_sigma_seconds = 0.10f;
+  /// Gaussian sigma for the 30 finger bones (5 mm of landmark noise on 2-4 cm bones).
+  float finger_sigma_seconds = 0.20f;
+  /// Gaussian sigma for the hips position.
+  float position_sigma_seconds = 0.05f;
+  /// Gaussian sigma for the expression weights.
+  float expression_sigma_seconds = 0.03f;
+  /// Rotations: 0 = Gaussian-weighted mean; 2 = local quadratic regression with the same
+  /// weights (keeps the peaks of fast motion; see docs/smoothing.md).
+  int degree = 2;
+  /// A bone is observed in a frame when its confidence is at least this (else it is a gap).
+  float observed_above = 0.5f;
+  /// A hand and its fingers count as observed only as far as their lower arm is: hand
+  /// landmarks are found in a crop placed by the body's wrist, so when the body model marks the
+  /// arm as barely visible the hand's points are unreliable even when the hand model is sure.
+  bool hands_follow_arms = true;
+  /// Bones seen with a low confidence of their own (0 < confidence < observed_above):
+  /// smoothed with this sigma, every frame weighted by its confidence, instead of filled.
+  /// 0 = fill them as gaps.
+  float low_confidence_sigma_seconds = 0.3f;
+  /// Gaps up to this long (from the last observed frame to the next) are interpolated.
+  float max_gap_seconds = 1.5f;
+  /// Longer gaps: hold, then ease to rest (as the solver's confidence gate does).
+  float hold_seconds = 0.5f;
+  float ease_seconds = 1.0f;
+  /// Poses held at most (the memory bound; ~1.2 kB each). 256 frames covers the default
+  /// lookahead (1.5 s) up to ~160 fps.
+  int capacity_frames = 256;
+
+  /// Checks every field: strength and sigmas finite and >= 0 (sigmas > 0), observed_above in
+  /// [0, 1], times finite and >= 0 (max_gap, hold, ease at most 60 s), capacity_frames in
+  /// [8, 65536]. The message names the field and its range.
+  status validate() const;
+};
+
+/// The smoother. Construct, push() poses in capture order, pop() while it returns true, call
+/// finish() after the last push and pop() the rest.
+class offline_smoother {
+ public:
+  /// `options` must pass validate() (checked by assertion; invalid values are clamped).
+  explicit offline_smoother(const offline_smoother_options& options = {});
+  ~offline_smoother();
+  offline_smoother(const offline_smoother&) = delete;
+  offline_smoother& operator=(const offline_smoother&) = delete;
+
+  /// Capture time a pose waits for (the latency of the window): the longest of max_gap_seconds,
+  /// hold + ease seconds, and 3 x the largest scaled sigma.
+  double lookahead_seconds() const noexcept { return lookahead_; }
+  int capacity() const noexcept { return capacity_; }
+  /// Poses pushed and not yet popped, plus the past ones kept for smoothing.
+  int buffered() const noexcept { return count_; }
+
+  /// Adds the next pose. Never fails: when the window is full, call pop() first (push() on a
+  /// full window drops the oldest pose that was already popped, or, when none has been, emits
+  /// nothing and returns false).
+  bool push(const proxy_pose& in) noexcept;
+  /// Writes the next smoothed pose into `out` and returns true when one is ready; false
+  /// otherwise (more input is needed, or everything has been popped after finish()).
+  bool pop(proxy_pose& out) noexcept;
+  /// No more input: every remaining pose becomes ready.
+  void finish() noexcept { finished_ = true; }
+  /// Forgets everything (as newly constructed).
+  void reset() noexcept;
+
+ private:
+  struct slot;
+  slot& at(int i) const noexcept;  // i-th oldest kept pose
+  bool ready() const noexcept;
+  // Which frames a kernel takes and how: all alike, observed ones by confidence, all by
+  // confidence.
+  enum class weighting { uniform, observed, confidence };
+  // Kernel weights and u = dt / sigma of the poses [lo, hi] around `centre` (indices from the
+  // oldest), for one sigma; valid while `version` is the smoother's.
+  struct kernel_table {
+    int centre = -1, lo = 0, hi = -1;
+    float sigma = 0.f;
+    unsigned version = 0;
+    float* w = nullptr;
+    float* u = nullptr;
+    const slot** slots = nullptr;  // the poses lo..hi
+  };
+  static constexpr int k_body_table = 0, k_finger_table = 1, k_low_confidence_table = 2,
+                       k_next_table = 3, k_table_count = 4;
+  const kernel_table& kernel_for(int table, int centre, float sigma) noexcept;
+  void smooth_rotation(const kernel_table& k, int b, weighting how, glm::quat& out) const noexcept;
+  void emit(proxy_pose& out) noexcept;
+
+  offline_smoother_options options_;
+  double lookahead_ = 0.0;
+  double past_seconds_ = 0.0;  // history kept behind the centre (3 sigma)
+  int capacity_ = 0;
+  std::unique_ptr<slot[]> slots_;
+  std::unique_ptr<float[]> kernel_storage_;      // the tables' w and u, capacity_ each
+  std::unique_ptr<const slot*[]> slot_storage_;  // the tables' slots, capacity_ each
+  std::array<kernel_table, k_table_count> tables_{};
+  unsigned version_ = 0;  // bumped whenever the ring's indices may have moved
+  int head_ = 0;          // ring index of the oldest kept pose
+  int count_ = 0;         // poses kept
+  int centre_ = 0;        // index (from the oldest) of the next pose to emit
+  int segment_ = 0;       // current segment id
+  bool finished_ = false;
+  bool has_last_t_ = false;
+  double last_t_ = 0.0;
+  // Per bone: the last emitted observed rotation (the left side of a gap) and its time.
+  std::array<glm::quat, k_bone_count> last_good_{};
+  std::array<double, k_bone_count> last_good_t_{};
+  std::array<int, k_bone_count> last_good_segment_{};
+};
+
+}  // namespace avatarmap

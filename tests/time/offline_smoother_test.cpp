@@ -1,0 +1,422 @@
+// offline_smoother: zero phase, exactness on constants, no flips through the double cover,
+// gap filling by slerp (known answers), long gaps easing to rest, low-confidence bones
+// following their measurement, segments, the window bound and no allocation per frame.
+#include "avatarmap/time/offline_smoother.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+#include "avatarmap/core/rotation.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}
+
+// Counts every allocation of this test executable (see tests/solve/allocation_test.cpp).
+void* operator new(std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace avatarmap {
+namespace {
+
+constexpr double k_fps = 30.0;
+const int k_arm = idx(bone::left_upper_arm);
+
+glm::quat about(const glm::vec3& axis, float radians) {
+  return glm::angleAxis(radians, glm::normalize(axis));
+}
+
+float degrees_between(const glm::quat& a, const glm::quat& b) {
+  return angle_between(a, b) * 180.f / k_pi;
+}
+
+// A pose at frame i: every bone observed, identity.
+proxy_pose frame_at(int i) {
+  proxy_pose p;
+  p.t = i / k_fps;
+  p.confidence.fill(1.f);
+  return p;
+}
+
+// Runs every pose through a smoother and returns what came out, in order.
+std::vector<proxy_pose> run(const std::vector<proxy_pose>& in,
+                            const offline_smoother_options& o = {}) {
+  offline_smoother s(o);
+  std::vector<proxy_pose> out;
+  proxy_pose p;
+  for (const proxy_pose& q : in) {
+    EXPECT_TRUE(s.push(q));
+    while (s.pop(p)) out.push_back(p);
+  }
+  s.finish();
+  while (s.pop(p)) out.push_back(p);
+  return out;
+}
+
+TEST(OfflineSmoother, DefaultsAreValidAndBadOptionsNameTheField) {
+  EXPECT_TRUE(offline_smoother_options{}.validate().ok());
+  offline_smoother_options o;
+  o.finger_sigma_seconds = -1.f;
+  EXPECT_NE(o.validate().message().find("finger_sigma_seconds"), std::string::npos);
+  o = {};
+  o.strength = std::nanf("");
+  EXPECT_NE(o.validate().message().find("strength"), std::string::npos);
+  o = {};
+  o.max_gap_seconds = 1e9f;
+  EXPECT_NE(o.validate().message().find("max_gap_seconds"), std::string::npos);
+  o = {};
+  o.capacity_frames = 2;
+  EXPECT_NE(o.validate().message().find("capacity_frames"), std::string::npos);
+  o = {};
+  o.degree = 1;
+  EXPECT_NE(o.validate().message().find("degree"), std::string::npos);
+}
+
+TEST(OfflineSmoother, EveryPoseComesOutOnceInOrderAfterTheLookahead) {
+  offline_smoother s;
+  EXPECT_DOUBLE_EQ(s.lookahead_seconds(), 1.5);  // max_gap 1.5 s = hold 0.5 + ease 1.0
+  proxy_pose p;
+  int popped = 0;
+  for (int i = 0; i < 300; ++i) {
+    s.push(frame_at(i));
+    while (s.pop(p)) {
+      EXPECT_DOUBLE_EQ(p.t, popped / k_fps);
+      // Out only once 1.5 s of later frames are in (45 frames at 30 fps).
+      EXPECT_GE(i - popped, 45);
+      ++popped;
+    }
+  }
+  s.finish();
+  while (s.pop(p)) {
+    EXPECT_DOUBLE_EQ(p.t, popped / k_fps);
+    ++popped;
+  }
+  EXPECT_EQ(popped, 300);
+  EXPECT_FALSE(s.pop(p));
+}
+
+TEST(OfflineSmoother, ConstantStaysExact) {
+  std::vector<proxy_pose> in;
+  for (int i = 0; i < 120; ++i) {
+    proxy_pose p = frame_at(i);
+    for (int b = 0; b < k_bone_count; ++b)
+      p.rotations[b] = about(glm::vec3(1.f, 0.3f * b, -0.5f), 0.05f * b - 1.f);
+    p.hips_position = glm::vec3(0.1f, 0.9f, -0.2f);
+    for (int e = 0; e < k_expression_count; ++e) p.expressions[e] = 0.05f * e;
+    in.push_back(p);
+  }
+  const auto out = run(in);
+  ASSERT_EQ(out.size(), in.size());
+  for (size_t i = 0; i < out.size(); ++i) {
+    for (int b = 0; b < k_bone_count; ++b)
+      ASSERT_LT(degrees_between(out[i].rotations[b], in[i].rotations[b]), 0.01f) << i << " " << b;
+    EXPECT_NEAR(out[i].hips_position.x, 0.1f, 1e-6f);
+    EXPECT_NEAR(out[i].hips_position.y, 0.9f, 1e-6f);
+    EXPECT_NEAR(out[i].hips_position.z, -0.2f, 1e-6f);
+    for (int e = 0; e < k_expression_count; ++e)
+      EXPECT_NEAR(out[i].expressions[e], 0.05f * e, 1e-6f);
+    EXPECT_EQ(out[i].confidence, in[i].confidence);
+  }
+}
+
+// Angle (radians) of the upper arm about X in pose p.
+float arm_angle(const proxy_pose& p) {
+  glm::quat q = p.rotations[k_arm];
+  if (q.w < 0.f) q = -q;
+  return 2.f * std::atan2(q.x, q.w);
+}
+
+TEST(OfflineSmoother, ZeroPhaseASineComesOutWithoutDelay) {
+  // 1 Hz, 60 degrees of amplitude plus a little high-frequency wobble (noise to remove).
+  std::vector<proxy_pose> in;
+  for (int i = 0; i < 300; ++i) {
+    proxy_pose p = frame_at(i);
+    const double t = p.t;
+    const float a =
+        float(60.0 * k_pi / 180.0 * std::sin(2.0 * k_pi * t) + 0.1 * ((i % 2) ? 1.0 : -1.0));
+    p.rotations[k_arm] = about(glm::vec3(1.f, 0.f, 0.f), a);
+    in.push_back(p);
+  }
+  const auto out = run(in);
+  ASSERT_EQ(out.size(), in.size());
+  // Each peak of the output is at the input's peak frame (within one frame): 0.25 s + k s.
+  for (int k = 1; k < 9; ++k) {
+    const int peak = int(std::lround((0.25 + k) * k_fps));
+    int best = peak - 8;
+    for (int i = peak - 8; i <= peak + 8; ++i)
+      if (arm_angle(out[i]) > arm_angle(out[best])) best = i;
+    EXPECT_LE(std::abs(best - peak), 1) << "peak " << k;
+    // The quadratic fit keeps the amplitude of a 1 Hz motion (a mean would flatten it).
+    EXPECT_NEAR(arm_angle(out[peak]) * 180.f / k_pi, 60.f, 1.5f);
+  }
+  // And the wobble (0.1 rad) is smoothed away; what is left is the fit's bias on a 1 Hz sine
+  // of 60 degrees (about 1 degree at the peaks with the default sigma of 0.1 s).
+  for (int i = 30; i < 270; ++i)
+    EXPECT_NEAR(arm_angle(out[i]), float(60.0 * k_pi / 180.0 * std::sin(2.0 * k_pi * i / k_fps)),
+                0.025f)
+        << i;
+}
+
+TEST(OfflineSmoother, PathThroughTheHemisphereBoundaryHasNoFlip) {
+  // A rotation about Y from 150 to 210 degrees and back; the input keeps w >= 0, so its sign
+  // flips where the angle passes 180 degrees. Averaging through the double cover would give a
+  // near-zero quaternion (a wild rotation) there.
+  std::vector<proxy_pose> in;
+  std::vector<glm::quat> truth;
+  for (int i = 0; i < 240; ++i) {
+    proxy_pose p = frame_at(i);
+    const float deg = 180.f + 30.f * float(std::sin(2.0 * k_pi * p.t / 4.0));
+    glm::quat q = about(glm::vec3(0.f, 1.f, 0.f), deg * k_pi / 180.f);
+    truth.push_back(q);
+    if (q.w < 0.f) q = -q;
+    p.rotations[k_arm] = q;
+    in.push_back(p);
+  }
+  const auto out = run(in);
+  ASSERT_EQ(out.size(), in.size());
+  for (size_t i = 0; i < out.size(); ++i) {
+    EXPECT_LT(degrees_between(out[i].rotations[k_arm], truth[i]), 0.2f) << i;
+    if (i > 0)
+      EXPECT_LT(degrees_between(out[i].rotations[k_arm], out[i - 1].rotations[k_arm]), 2.f) << i;
+  }
+}
+
+// Poses with the upper arm at `a` (observed) for t < t0, not observed in [t0, t1) with a
+// garbage rotation, and at `b` (observed) from t1 on.
+std::vector<proxy_pose> gap_recording(const glm::quat& a, const glm::quat& b, int f0, int f1,
+                                      int frames, float gap_confidence = 0.f) {
+  std::vector<proxy_pose> in;
+  for (int i = 0; i < frames; ++i) {
+    proxy_pose p = frame_at(i);
+    if (i < f0) {
+      p.rotations[k_arm] = a;
+    } else if (i < f1) {
+      p.rotations[k_arm] = about(glm::vec3(0.f, 0.f, 1.f), 2.5f);  // what a lost bone held
+      p.confidence[k_arm] = gap_confidence;
+    } else {
+      p.rotations[k_arm] = b;
+    }
+    in.push_back(p);
+  }
+  return in;
+}
+
+TEST(OfflineSmoother, ShortGapIsTheSlerpBetweenBothSides) {
+  const glm::quat a = about(glm::vec3(1.f, 0.f, 0.f), 0.4f);
+  const glm::quat b = about(glm::vec3(0.f, 1.f, 1.f), -0.9f);
+  const int f0 = 60, f1 = 90;  // last observed frame 59, next observed 90: 31 frames apart
+  const auto out = run(gap_recording(a, b, f0, f1, 180));
+  ASSERT_EQ(out.size(), 180u);
+  for (int i = f0; i < f1; ++i) {
+    const float u = float(i - (f0 - 1)) / float(f1 - (f0 - 1));
+    EXPECT_LT(degrees_between(out[i].rotations[k_arm], slerp_shortest(a, b, u)), 0.01f) << i;
+    EXPECT_EQ(out[i].confidence[k_arm], 0.f);  // still marked as not observed
+  }
+  // The observed spans stay where they were (a quadratic fit of a constant is the constant,
+  // also one-sided at the gap's edges).
+  EXPECT_LT(degrees_between(out[f0 - 1].rotations[k_arm], a), 0.01f);
+  EXPECT_LT(degrees_between(out[f1].rotations[k_arm], b), 0.01f);
+}
+
+TEST(OfflineSmoother, GapLongerThanTheLimitHoldsThenEasesToRest) {
+  const glm::quat a = about(glm::vec3(1.f, 0.f, 0.f), 0.8f);
+  const glm::quat b = about(glm::vec3(0.f, 1.f, 0.f), -0.7f);
+  const int f0 = 30, f1 = 30 + 150;  // a 5 s gap
+  const auto out = run(gap_recording(a, b, f0, f1, 300));
+  ASSERT_EQ(out.size(), 300u);
+  const glm::quat rest = identity_quat();
+  // Held for hold_seconds (0.5 s = 15 frames) after the last observed frame (29)...
+  EXPECT_LT(degrees_between(out[29 + 15].rotations[k_arm], a), 0.01f);
+  // ... eased to rest by hold + ease (1.5 s = 45 frames), at rest through the middle ...
+  for (int i = 29 + 45; i <= f1 - 45; ++i)
+    EXPECT_LT(degrees_between(out[i].rotations[k_arm], rest), 0.01f) << i;
+  // ... halfway along the ease (smoothstep 0.5) a quarter of the way through the fill.
+  const glm::quat half = slerp_shortest(a, rest, 0.5f);
+  EXPECT_LT(degrees_between(out[29 + 15 + 15].rotations[k_arm], half), 0.01f);
+  // and symmetrically towards the next observed frame (held for the last 0.5 s before it).
+  EXPECT_LT(degrees_between(out[f1 - 15].rotations[k_arm], b), 0.01f);
+  EXPECT_LT(degrees_between(out[f1 - 30].rotations[k_arm], slerp_shortest(b, rest, 0.5f)), 0.01f);
+  // Nothing snaps: neighbouring outputs never differ by more than a smooth ease allows.
+  for (int i = 1; i < 300; ++i)
+    EXPECT_LT(degrees_between(out[i].rotations[k_arm], out[i - 1].rotations[k_arm]), 3.f) << i;
+}
+
+TEST(OfflineSmoother, GapAtTheStartIsTheInputUntilTheFirstObservationIsInSight) {
+  const glm::quat a = about(glm::vec3(1.f, 0.f, 0.f), 0.8f);
+  // Not observed for the first 3 s, observed afterwards at a.
+  const auto in = gap_recording(a, a, 0, 90, 150);
+  const auto out = run(in);
+  // Neither side within reach (the lookahead is 1.5 s = 45 frames): what the input says (the
+  // solver's own hold and ease).
+  for (int i = 0; i < 90 - 46; ++i)
+    EXPECT_LT(degrees_between(out[i].rotations[k_arm], in[i].rotations[k_arm]), 0.01f) << i;
+  // Within the hold time before it, the first observation is held backwards.
+  for (int i = 90 - 15; i < 90; ++i)
+    EXPECT_LT(degrees_between(out[i].rotations[k_arm], a), 0.01f) << i;
+}
+
+TEST(OfflineSmoother, BoneObservedNowhereKeepsTheInput) {
+  // A bone the solver sets from priors (confidence always 0): its rotation is the input's.
+  std::vector<proxy_pose> in;
+  const glm::quat prior = about(glm::vec3(0.f, 0.f, 1.f), 0.3f);
+  for (int i = 0; i < 150; ++i) {
+    proxy_pose p = frame_at(i);
+    p.rotations[idx(bone::jaw)] = prior;
+    p.confidence[idx(bone::jaw)] = 0.f;
+    in.push_back(p);
+  }
+  for (const proxy_pose& p : run(in))
+    EXPECT_LT(degrees_between(p.rotations[idx(bone::jaw)], prior), 0.01f);
+}
+
+TEST(OfflineSmoother, LowConfidenceBoneFollowsItsMeasurement) {
+  // An occluded arm the estimator still places (confidence 0.2) keeps moving through a 1 s
+  // burst: it is smoothed, not replaced by the slerp between the burst's edges.
+  std::vector<proxy_pose> in;
+  auto truth = [](double t) { return about(glm::vec3(1.f, 0.f, 0.f), float(std::sin(3.0 * t))); };
+  for (int i = 0; i < 180; ++i) {
+    proxy_pose p = frame_at(i);
+    p.rotations[k_arm] = truth(p.t);
+    if (i >= 60 && i < 90) p.confidence[k_arm] = 0.2f;
+    in.push_back(p);
+  }
+  const auto out = run(in);
+  float worst = 0.f, worst_fill = 0.f;
+  for (int i = 60; i < 90; ++i) {
+    worst = std::max(worst, degrees_between(out[i].rotations[k_arm], truth(i / k_fps)));
+    const glm::quat fill = slerp_shortest(truth(59 / k_fps), truth(90 / k_fps), (i - 59) / 31.f);
+    worst_fill = std::max(worst_fill, degrees_between(fill, truth(i / k_fps)));
+  }
+  // The arm swings ~70 degrees through the burst at up to 3 rad/s: a fill between the edges
+  // would be ~50 degrees off; the wide smoothing of the measurement stays within ~9 (the bias
+  // of a 0.3 s kernel on a swing this fast).
+  EXPECT_GT(worst_fill, 40.f);
+  EXPECT_LT(worst, 10.f);
+}
+
+TEST(OfflineSmoother, HandFollowsItsArm) {
+  // The arm in a burst (confidence 0.1) and the hand model sure of itself (1): the fingers are
+  // filled from both sides like a gap, not taken from the unreliable hand points.
+  const int finger = idx(bone::left_index_proximal);
+  const glm::quat a = about(glm::vec3(0.f, 0.f, 1.f), 0.5f);
+  std::vector<proxy_pose> in;
+  for (int i = 0; i < 150; ++i) {
+    proxy_pose p = frame_at(i);
+    p.rotations[finger] = a;
+    if (i >= 60 && i < 80) {
+      p.confidence[idx(bone::left_lower_arm)] = 0.1f;
+      p.rotations[finger] = about(glm::vec3(1.f, 0.f, 0.f), 1.5f);  // garbage
+    }
+    in.push_back(p);
+  }
+  const auto out = run(in);
+  for (int i = 60; i < 80; ++i) {
+    EXPECT_LT(degrees_between(out[i].rotations[finger], a), 0.01f) << i;
+    EXPECT_EQ(out[i].confidence[finger], 1.f);  // the input's confidence is written unchanged
+  }
+}
+
+TEST(OfflineSmoother, TimeGoingBackStartsANewSegmentAndNothingMixes) {
+  const glm::quat a = about(glm::vec3(1.f, 0.f, 0.f), 0.5f);
+  const glm::quat b = about(glm::vec3(0.f, 1.f, 0.f), -0.5f);
+  std::vector<proxy_pose> in;
+  for (int i = 0; i < 60; ++i) {
+    proxy_pose p = frame_at(i);
+    p.rotations[k_arm] = a;
+    in.push_back(p);
+  }
+  for (int i = 0; i < 60; ++i) {  // the times start again at 0
+    proxy_pose p = frame_at(i);
+    p.rotations[k_arm] = b;
+    p.confidence[k_arm] = i < 10 ? 0.f : 1.f;  // a gap at the start of the new segment
+    in.push_back(p);
+  }
+  const auto out = run(in);
+  ASSERT_EQ(out.size(), 120u);
+  for (int i = 0; i < 60; ++i) EXPECT_LT(degrees_between(out[i].rotations[k_arm], a), 0.01f);
+  // The gap is not filled from the old segment: it is held from the new one's side.
+  for (int i = 60; i < 120; ++i) EXPECT_LT(degrees_between(out[i].rotations[k_arm], b), 0.01f);
+  EXPECT_DOUBLE_EQ(out[60].t, 0.0);
+}
+
+TEST(OfflineSmoother, NonFiniteInputGivesFiniteOutput) {
+  std::vector<proxy_pose> in;
+  for (int i = 0; i < 90; ++i) {
+    proxy_pose p = frame_at(i);
+    if (i % 7 == 0) p.rotations[k_arm] = glm::quat(NAN, 0.f, 0.f, 1.f);
+    if (i % 5 == 0) p.hips_position.y = INFINITY;
+    if (i % 3 == 0) p.expressions[2] = NAN;
+    if (i % 11 == 0) p.confidence[3] = NAN;
+    in.push_back(p);
+  }
+  in[40].t = NAN;
+  const auto out = run(in);
+  ASSERT_EQ(out.size(), in.size());
+  for (const proxy_pose& p : out) {
+    for (int b = 0; b < k_bone_count; ++b) ASSERT_TRUE(is_finite(p.rotations[b]));
+    ASSERT_TRUE(is_finite(p.hips_position));
+    for (float e : p.expressions) ASSERT_TRUE(std::isfinite(e));
+  }
+}
+
+TEST(OfflineSmoother, WindowIsBoundedAndNothingIsAllocatedPerFrame) {
+  offline_smoother_options o;
+  offline_smoother s(o);
+  proxy_pose in = frame_at(0), out;
+  // The window at 30 fps: 1.5 s ahead + 3 sigma (0.6 s) behind + the centre.
+  const int bound = int(std::ceil((s.lookahead_seconds() + 3.0 * 0.2) * k_fps)) + 2;
+  const long before = g_allocations.load();
+  long popped = 0;
+  int most = 0;
+  for (int i = 0; i < 18000; ++i) {
+    in.t = i / k_fps;
+    in.rotations[k_arm] = about(glm::vec3(1.f, 0.f, 0.f), float(std::sin(i * 0.1)));
+    in.confidence[k_arm] = (i / 40) % 3 == 0 ? 0.f : 1.f;  // gaps as well
+    ASSERT_TRUE(s.push(in));
+    while (s.pop(out)) ++popped;
+    most = std::max(most, s.buffered());
+  }
+  s.finish();
+  while (s.pop(out)) ++popped;
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(popped, 18000);
+  EXPECT_LE(most, bound);  // does not grow with the length of the stream
+  EXPECT_LE(most, s.capacity());
+}
+
+TEST(OfflineSmoother, HighFrameRateBeyondTheCapacityStillStreams) {
+  offline_smoother_options o;
+  o.capacity_frames = 16;  // far less than 1.5 s at 30 fps
+  offline_smoother s(o);
+  proxy_pose p = frame_at(0), out;
+  long popped = 0;
+  for (int i = 0; i < 200; ++i) {
+    p.t = i / k_fps;
+    ASSERT_TRUE(s.push(p));
+    while (s.pop(out)) ++popped;
+    ASSERT_LE(s.buffered(), 16);
+  }
+  s.finish();
+  while (s.pop(out)) ++popped;
+  EXPECT_EQ(popped, 200);
+}
+
+}  // namespace
+}  // namespace avatarmap
