@@ -8,8 +8,9 @@ packages=(build-essential cmake ninja-build pkg-config
           libgtest-dev libgmock-dev libbenchmark-dev libstb-dev python3
           libavformat-dev libavcodec-dev libavutil-dev libswscale-dev
           python3-onnx python3-numpy)  # python3-onnx: the tflite -> ONNX converter (tools/convert)
-# The fuzz run (scripts/test.sh) needs clang with its sanitizer runtime.
-if [ "${AVATARMAP_SKIP_FUZZ:-0}" != 1 ]; then
+# The fuzz run and the sanitizer run (scripts/test.sh, scripts/sanitize.sh) need clang with its
+# sanitizer runtime.
+if [ "${AVATARMAP_SKIP_FUZZ:-0}" != 1 ] || [ "${AVATARMAP_SKIP_SANITIZE:-0}" != 1 ]; then
   packages+=(clang libclang-rt-14-dev)
 fi
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what is missing, prepares the capture models (npm), builds, runs a short libFuzzer
-# run of the readers and parsers, then every test (ctest). Tests on real data read $AVATARMAP_TEST_DATA (default: ../shared/data beside
-# the checkout, when it exists) and skip with a message without it.
+# run of the readers and parsers, then every test (ctest), then the sanitizer run
+# (scripts/sanitize.sh). Tests on real data read $AVATARMAP_TEST_DATA (default: ../shared/data
+# beside the checkout, when it exists) and skip with a message without it.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/scripts/setup.sh"
@@ -19,5 +20,10 @@ build="${AVATARMAP_BUILD_DIR:-$root/build}"
 if [ "${AVATARMAP_SKIP_FUZZ:-0}" != 1 ]; then
   "$root/tools/fuzz/run.sh" "${AVATARMAP_FUZZ_SECONDS:-15}"
 fi
-cd "$build"
-ctest --output-on-failure -j "${AVATARMAP_JOBS:-$(nproc)}"
+(cd "$build" && ctest --output-on-failure -j "${AVATARMAP_JOBS:-$(nproc)}")
+# The same tests again on an ASan + UBSan build, then every fuzz corpus replayed through the
+# sanitized fuzz targets (scripts/sanitize.sh; about 6 min on 2 cores). AVATARMAP_SKIP_SANITIZE=1
+# skips it.
+if [ "${AVATARMAP_SKIP_SANITIZE:-0}" != 1 ]; then
+  "$root/scripts/sanitize.sh"
+fi

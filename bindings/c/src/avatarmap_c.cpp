@@ -392,7 +392,12 @@ AVATARMAP_C_API void avm_version(int* out_major, int* out_minor, int* out_patch)
 AVATARMAP_C_API const char* avm_version_string(void) { return AVATARMAP_VERSION_STRING; }
 
 AVATARMAP_C_API const char* avm_status_string(avm_status status) {
-  switch (status) {
+  // A C caller may pass any int: read it as one (an out-of-range value is not an avm_status in
+  // C++, and switching on it would be undefined).
+  int value = 0;
+  static_assert(sizeof value == sizeof status, "avm_status is an int");
+  std::memcpy(&value, &status, sizeof value);
+  switch (value) {
     case AVM_OK:
       return "ok";
     case AVM_ERROR_INVALID_ARGUMENT:
