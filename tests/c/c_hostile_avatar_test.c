@@ -12,17 +12,7 @@
 
 #include "avatarmap/avatarmap.h"
 #include "check.h"
-
-static int contains(const char* s, const char* part) {
-  return s != NULL && strstr(s, part) != NULL;
-}
-
-static int file_exists(const char* path) {
-  FILE* f = fopen(path, "rb");
-  if (f == NULL) return 0;
-  fclose(f);
-  return 1;
-}
+#include "test_util.h"
 
 static void write_bytes(const char* path, const char* bytes, size_t n) {
   FILE* f = fopen(path, "wb");
@@ -119,14 +109,6 @@ static void write_glb(const char* path, const char* json, long delta) {
   memset(b + 20 + n, ' ', padded - n);
   write_bytes(path, (const char*)b, total);
   free(b);
-}
-
-static void rest_pose(double t, avm_pose* p) {
-  int b;
-  memset(p, 0, sizeof *p);
-  p->t = t;
-  p->hips_position[1] = 0.95f;
-  for (b = 0; b < AVM_BONE_COUNT; ++b) p->rotations[b][3] = 1.f;
 }
 
 static const char* k_secret = "TOP-SECRET-c4e1b2";

@@ -15,6 +15,7 @@
 
 #include "avatarmap/avatarmap.h"
 #include "check.h"
+#include "test_util.h"
 
 #if defined(__has_feature)
 #if __has_feature(address_sanitizer)
@@ -26,14 +27,6 @@
 #endif
 
 #ifndef AVM_TEST_ASAN
-static void rest_pose(double t, avm_pose* p) {
-  int b;
-  memset(p, 0, sizeof *p);
-  p->t = t;
-  p->hips_position[1] = 0.95f;
-  for (b = 0; b < AVM_BONE_COUNT; ++b) p->rotations[b][3] = 1.f;
-}
-
 /* In the child: 2 frames 80,000 s apart written at 50 fps = 4,000,001 frames (under the
  * 4,194,304 limit) of about 1 KB each: far over 512 MiB. Exit code 0 when the call failed as
  * it should, 1..4 naming what was wrong. */

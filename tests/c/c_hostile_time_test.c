@@ -11,25 +11,7 @@
 
 #include "avatarmap/avatarmap.h"
 #include "check.h"
-
-static int contains(const char* s, const char* part) {
-  return s != NULL && strstr(s, part) != NULL;
-}
-
-static int file_exists(const char* path) {
-  FILE* f = fopen(path, "rb");
-  if (f == NULL) return 0;
-  fclose(f);
-  return 1;
-}
-
-static void rest_pose(double t, avm_pose* p) {
-  int b;
-  memset(p, 0, sizeof *p);
-  p->t = t;
-  p->hips_position[1] = 0.95f;
-  for (b = 0; b < AVM_BONE_COUNT; ++b) p->rotations[b][3] = 1.f;
-}
+#include "test_util.h"
 
 /* A clip of two rest poses at t0 and t1 (NULL when they cannot be added). */
 static avm_clip* two_frames(double t0, double t1) {
