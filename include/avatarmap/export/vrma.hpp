@@ -71,10 +71,11 @@ struct vrma_clip {
 /// the bone's animated model-space rotation times the inverse of its rest one, the local
 /// rotation is N(p)⁻¹ N(b) where p is the nearest mapped ancestor in the VRM humanoid
 /// hierarchy (identity for hips' parent). For a plain chain this is VRM 1.0's normalised
-/// rotation W·L⁻¹·q·W⁻¹ (W, L: the bone's world and local rest rotations; docs/conventions.md). Node scale is applied to positions only (rotations assume uniform scale).
-/// Interpolation: LINEAR (slerp on the shortest arc for rotations), STEP, CUBICSPLINE (cubic
-/// Hermite on the value and tangent components, rotations normalised). Outside a channel's key
-/// range its first or last value holds. lookAt is not read.
+/// rotation W·L⁻¹·q·W⁻¹ (W, L: the bone's world and local rest rotations; docs/conventions.md).
+/// Node scale is applied to positions only (rotations assume uniform scale). Interpolation: LINEAR
+/// (slerp on the shortest arc for rotations), STEP, CUBICSPLINE (cubic Hermite on the value and
+/// tangent components, rotations normalised). Outside a channel's key range its first or last value
+/// holds. lookAt is not read.
 ///
 /// Fails, with a message that names the file and the problem, when the file cannot be read or
 /// is not glTF/GLB, lacks the VRMC_vrm_animation extension or its humanoid.humanBones, maps a

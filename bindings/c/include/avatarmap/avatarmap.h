@@ -369,8 +369,8 @@ AVATARMAP_C_API const char* avm_solver_last_error(const avm_solver* solver);
 
 /* ---- files --------------------------------------------------------------------------- */
 
-/* Solves a whole *.landmarks.jsonl file into a *.pose.jsonl file (docs/file-formats.md): every frame
- * is solved as by avm_solver_push() and smoothed as options->file_filter says (by default
+/* Solves a whole *.landmarks.jsonl file into a *.pose.jsonl file (docs/file-formats.md): every
+ * frame is solved as by avm_solver_push() and smoothed as options->file_filter says (by default
  * offline: zero-lag smoothing and gap filling with a 1.5 s lookahead, memory bounded by
  * its window; AVM_FILE_FILTER_LIVE gives exactly avm_solver_push()'s filtering); no
  * resampling. The image size of the
