@@ -12,6 +12,7 @@ namespace {
 
 const char* k_eval_help =
     "Usage: avatarmap eval-pose TRUTH.pose.jsonl SOLVED.pose.jsonl [--json]\n"
+    "       avatarmap eval-pose --jitter SOLVED.pose.jsonl [--json]\n"
     "\n"
     "Compares solved poses with the true ones written by `avatarmap synth --truth`, frame by\n"
     "frame at the same times: the mean angle between true and solved bone directions (world\n"
@@ -20,6 +21,9 @@ const char* k_eval_help =
     "a bone in a burst; 'marked' is over those bones only). Angles in degrees.\n"
     "\n"
     "Options:\n"
+    "  --jitter SOLVED  no truth: the RMS of the second time derivative of the bones' world\n"
+    "           directions (deg/s^2), overall and per group; steadier is smaller; compare\n"
+    "           files at the same frame rate (real video: defaults against a reference)\n"
     "  --json   one JSON object on standard output instead of the table\n"
     "  --tolerance MS   time difference allowed between matched frames (default 0.5)\n";
 
@@ -52,6 +56,32 @@ int run_eval_pose(int argc, char** argv) {
     return 0;
   }
   const bool json = a.flag("--json");
+  std::string jitter_path;
+  if (a.value("--jitter", jitter_path)) {
+    if (!a.error().empty() || !a.check_no_options() || !a.rest().empty()) {
+      std::fprintf(stderr, "avatarmap eval-pose: %s\n",
+                   !a.error().empty() ? a.error().c_str()
+                                      : "--jitter takes one SOLVED.pose.jsonl (see --help)");
+      return 2;
+    }
+    pose_jitter j;
+    if (const status st = measure_pose_jitter(jitter_path, j); !st.ok()) {
+      std::fprintf(stderr, "avatarmap eval-pose: %s\n", st.message().c_str());
+      return 1;
+    }
+    if (json) {
+      std::printf(
+          "{\"frames\":%ld,\"rms\":%.4f,\"torso\":%.4f,\"arms\":%.4f,\"legs\":%.4f,"
+          "\"fingers\":%.4f}\n",
+          j.frames, j.rms, j.groups[0], j.groups[1], j.groups[2], j.groups[3]);
+      return 0;
+    }
+    std::printf("%ld frames; RMS angular acceleration of bone directions in deg/s^2\n", j.frames);
+    std::printf("%8s %8s %8s %8s %8s\n", "overall", "torso", "arms", "legs", "fingers");
+    std::printf("%8.1f %8.1f %8.1f %8.1f %8.1f\n", j.rms, j.groups[0], j.groups[1], j.groups[2],
+                j.groups[3]);
+    return 0;
+  }
   pose_accuracy_options options;
   double ms = 0;
   if (a.number("--tolerance", ms)) {

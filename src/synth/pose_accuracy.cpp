@@ -190,4 +190,61 @@ status evaluate_pose_files(const std::string& truth_path, const std::string& sol
   return {};
 }
 
+status measure_pose_jitter(const std::string& path, pose_jitter& out) {
+  out = pose_jitter{};
+  pose_reader reader;
+  if (status st = reader.open(path); !st.ok()) return st;
+  // The world directions of the last three frames (a ring) and their times.
+  std::array<std::array<glm::dvec3, k_bone_count>, 3> dirs{};
+  std::array<double, 3> times{};
+  std::array<double, k_direction_group_count> sum{};
+  std::array<long, k_direction_group_count> count{};
+  proxy_pose p;
+  std::array<glm::quat, k_bone_count> world;
+  for (;;) {
+    const read_result r = reader.next(p);
+    if (r == read_result::error) return status::error(reader.error());
+    if (r == read_result::end) break;
+    if (out.frames > 0 && !(p.t > times[(out.frames - 1) % 3])) {
+      char msg[160];
+      std::snprintf(msg, sizeof msg, ":%ld: time %.6g s is not after the previous frame's",
+                    reader.line(), p.t);
+      return status::error(path + msg + " (eval-pose --jitter needs increasing times)");
+    }
+    for (int b = 0; b < k_bone_count; ++b)
+      if (!usable(p.rotations[b])) p.rotations[b] = identity_quat();
+    compute_world_rotations(p, world);
+    const int k = static_cast<int>(out.frames % 3);
+    times[k] = p.t;
+    for (int b = 0; b < k_bone_count; ++b)
+      dirs[k][b] = glm::normalize(
+          glm::dvec3(glm::normalize(world[b]) * bone_rest_direction(static_cast<bone>(b))));
+    ++out.frames;
+    if (out.frames < 3) continue;
+    const int k0 = static_cast<int>((out.frames - 3) % 3),
+              k1 = static_cast<int>((out.frames - 2) % 3);
+    const double dt0 = times[k1] - times[k0], dt1 = times[k] - times[k1];
+    for (int b = 0; b < k_bone_count; ++b) {
+      const accuracy_group g = bone_accuracy_group(static_cast<bone>(b));
+      if (g == accuracy_group::head) continue;
+      const glm::dvec3 a = ((dirs[k][b] - dirs[k1][b]) / dt1 - (dirs[k1][b] - dirs[k0][b]) / dt0) /
+                           (0.5 * (dt0 + dt1));
+      const double deg = glm::length(a) * k_rad_to_deg;
+      sum[static_cast<int>(g)] += deg * deg;
+      ++count[static_cast<int>(g)];
+    }
+  }
+  if (out.frames < 3)
+    return status::error(path + ": fewer than three frames (jitter needs at least three)");
+  double all = 0.0;
+  long n = 0;
+  for (int g = 0; g < k_direction_group_count; ++g) {
+    out.groups[g] = count[g] > 0 ? std::sqrt(sum[g] / static_cast<double>(count[g])) : 0.0;
+    all += sum[g];
+    n += count[g];
+  }
+  out.rms = n > 0 ? std::sqrt(all / static_cast<double>(n)) : 0.0;
+  return {};
+}
+
 }  // namespace avatarmap

@@ -226,3 +226,50 @@ TEST(PoseAccuracy, FilesAreMatchedByTime) {
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.message().find("absent.pose.jsonl"), std::string::npos) << st.message();
 }
+
+// A bone turning at a constant rate w about an axis across it: its direction's acceleration is
+// the centripetal w^2 (radians per second squared); bones that do not move give 0.
+TEST(PoseJitter, ConstantTurnGivesTheCentripetalAcceleration) {
+  avatarmap::test::temp_dir dir("pose_jitter");
+  const double w = 2.0, dt = 0.01;
+  std::vector<proxy_pose> poses;
+  for (int i = 0; i < 200; ++i) {
+    proxy_pose p;
+    p.set_rest();
+    p.t = i * dt;
+    p[bone::left_upper_arm] = axis_angle(glm::vec3(0.f, 0.f, 1.f), static_cast<float>(w * p.t));
+    poses.push_back(p);
+  }
+  const std::string path = dir.file("turn.pose.jsonl");
+  write_poses(path, poses);
+  pose_jitter j;
+  ASSERT_TRUE(measure_pose_jitter(path, j).ok());
+  EXPECT_EQ(j.frames, 200);
+  // The upper arm, lower arm and hand of the left arm move rigidly (their rest directions lie
+  // across the z axis); the shoulders and the right arm stay: 3 of the arms group's 8 bones.
+  const double deg = w * w * 180.0 / 3.14159265358979323846;
+  EXPECT_NEAR(j.groups[static_cast<int>(accuracy_group::arms)], deg * std::sqrt(3.0 / 8.0),
+              deg * 1e-3);
+  EXPECT_NEAR(j.groups[static_cast<int>(accuracy_group::legs)], 0.0, 1e-6);
+  EXPECT_NEAR(j.groups[static_cast<int>(accuracy_group::torso)], 0.0, 1e-6);
+}
+
+TEST(PoseJitter, RefusesShortFilesAndTimesGoingBack) {
+  avatarmap::test::temp_dir dir("pose_jitter");
+  std::vector<proxy_pose> poses(2);
+  poses[0].set_rest();
+  poses[1].set_rest();
+  poses[1].t = 0.1;
+  const std::string path = dir.file("short.pose.jsonl");
+  write_poses(path, poses);
+  pose_jitter j;
+  const status st = measure_pose_jitter(path, j);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("fewer than three frames"), std::string::npos) << st.message();
+  poses.push_back(poses[0]);  // t = 0 after t = 0.1
+  write_poses(path, poses);
+  const status back = measure_pose_jitter(path, j);
+  ASSERT_FALSE(back.ok());
+  EXPECT_NE(back.message().find("not after the previous frame"), std::string::npos)
+      << back.message();
+}

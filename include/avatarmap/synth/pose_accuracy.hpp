@@ -83,4 +83,19 @@ struct pose_accuracy_options {
 status evaluate_pose_files(const std::string& truth_path, const std::string& solved_path,
                            pose_accuracy& out, const pose_accuracy_options& options = {});
 
+/// Jitter of one *.pose.jsonl file (no truth needed; real video): for each measured bone (the
+/// direction groups above) the second time derivative of its world direction,
+/// a_t = ((u_{t+1} - u_t) / dt_1 - (u_t - u_{t-1}) / dt_0) / ((dt_0 + dt_1) / 2) with u the unit
+/// direction vector, and its root mean square over frames and bones, in degrees per second
+/// squared (|a| in radians per second squared times 180/pi). Smaller is steadier; compare files
+/// at the same frame rate (it grows with the rate for the same noise).
+struct pose_jitter {
+  long frames = 0;                                       // frames read
+  double rms = 0.0;                                      // every measured bone, deg/s^2
+  std::array<double, k_direction_group_count> groups{};  // torso, arms, legs, fingers
+};
+/// Fails (naming the file and line) on a read error, times that do not increase, or fewer than
+/// three frames.
+status measure_pose_jitter(const std::string& path, pose_jitter& out);
+
 }  // namespace avatarmap
