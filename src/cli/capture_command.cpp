@@ -17,7 +17,7 @@
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/overlay_output.hpp"
-#include "cli/prefetch_ring.hpp"
+#include "jobs/prefetch_ring.hpp"
 
 namespace avatarmap::cli {
 namespace {
@@ -166,7 +166,7 @@ int run_capture(int argc, char** argv) {
   estimate_args ea;
   ea.hands = ec.hands;
   ea.face = ec.face;
-  prefetch_ring<decoded> ring(3, decode);
+  jobs_detail::prefetch_ring<decoded> ring(3, decode);
   for (;;) {
     decoded& d = ring.next();
     if (d.kind == read_result::end) break;

@@ -273,18 +273,23 @@ status atomic_file::fail(const std::string& what, int err) {
 status atomic_file::write(const void* data, std::size_t n) {
   if (fd_ < 0)
     return status::error(error_.empty() ? path_ + ": write to a file that is not open" : error_);
+  if (const int e = write_all(fd_, data, n); e != 0) return fail("write failed", e);
+  return {};
+}
+
+int write_all(int fd, const void* data, std::size_t n) {
   const char* p = static_cast<const char*>(data);
   while (n > 0) {
-    const ssize_t w = ::write(fd_, p, n);
+    const ssize_t w = ::write(fd, p, n);
     if (w < 0) {
       if (errno == EINTR) continue;
-      return fail("write failed", errno);
+      return errno;
     }
-    if (w == 0) return fail("write failed", ENOSPC);
+    if (w == 0) return ENOSPC;
     p += w;
     n -= static_cast<std::size_t>(w);
   }
-  return {};
+  return 0;
 }
 
 status atomic_file::commit() {

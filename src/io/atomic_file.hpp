@@ -86,6 +86,10 @@ status create_temp_file(const std::string& path, int& out_fd, std::string& out_t
 /// `path` is as it was.
 status commit_temp_file(const std::string& temp_path, const std::string& path);
 
+/// Writes all `n` bytes to `fd`, retrying short writes and EINTR: 0, or the errno of the
+/// failure (ENOSPC when the system accepts nothing).
+int write_all(int fd, const void* data, std::size_t n);
+
 /// Writes `bytes` to `path` atomically (open + write + commit).
 status write_file_atomically(const std::string& path, std::string_view bytes);
 

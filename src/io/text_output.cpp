@@ -44,16 +44,10 @@ bool text_output::flush() {
     return false;
   }
   if (is_stdout_) {
-    std::size_t done = 0;
-    while (done < pos_) {
-      const ssize_t n = ::write(STDOUT_FILENO, buf_.data() + done, pos_ - done);
-      if (n < 0) {
-        if (errno == EINTR) continue;
-        failed_ = true;
-        error_ = "standard output: write failed: " + std::string(std::strerror(errno));
-        return false;
-      }
-      done += static_cast<std::size_t>(n);
+    if (const int e = write_all(STDOUT_FILENO, buf_.data(), pos_); e != 0) {
+      failed_ = true;
+      error_ = "standard output: write failed: " + std::string(std::strerror(e));
+      return false;
     }
   } else if (status s = file_.write(buf_.data(), pos_); !s) {
     failed_ = true;  // file_ has removed its temporary file already
