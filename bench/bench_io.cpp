@@ -1,10 +1,14 @@
 // Throughput of the *.landmarks.jsonl reader and the *.pose.jsonl writer (frames/s and
-// bytes/s). Inputs are generated in memory with the library's own writers. Baseline:
-// nlohmann::json parsing the same lines (parse only, without converting to frames).
+// bytes/s). Inputs are generated in memory with the library's own writers. Baselines:
+// nlohmann::json parsing the same lines (parse only, without converting to frames), the
+// reader's digit-at-a-time number path alone (io/json_number.hpp), and memchr over the text
+// (finding the line ends: the floor of any line reader). A build with
+// -DAVATARMAP_WITH_SIMDJSON=ON measures simdjson's on-demand parser in place of ours.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -13,6 +17,8 @@
 
 #include "avatarmap/io/landmark_file.hpp"
 #include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/synth/synth_recording.hpp"
+#include "io/json_number.hpp"
 
 namespace avatarmap {
 namespace {
@@ -76,8 +82,29 @@ std::string make_landmark_text(int frames, bool all_parts) {
   return text;
 }
 
-void parse_memory(benchmark::State& state, bool all_parts) {
-  const std::string text = make_landmark_text(k_frames, all_parts);
+// A full holistic recording as `avatarmap synth --scenario noisy` writes it (~23 kB a frame).
+std::string make_holistic_text(int frames) {
+  const std::string path = temp_path("holistic.jsonl");
+  landmark_writer w;
+  landmark_file_header h;
+  h.image_width = 1280;
+  h.image_height = 720;
+  h.fps = 30;
+  if (!w.open(path, h)) return {};
+  synth_recording synth(synth_scenario_options(synth_scenario::noisy, 7));
+  proxy_pose truth;
+  landmark_frame f;
+  for (int i = 0; i < frames; ++i) {
+    synth.generate(i / 30.0, truth, f);
+    (void)w.write(f);
+  }
+  (void)w.commit();
+  std::string text = slurp(path);
+  std::remove(path.c_str());
+  return text;
+}
+
+void parse_text(benchmark::State& state, const std::string& text) {
   landmark_frame f;
   std::int64_t frames = 0;
   for (auto _ : state) {
@@ -95,9 +122,40 @@ void parse_memory(benchmark::State& state, bool all_parts) {
   state.counters["bytes_per_frame"] = static_cast<double>(text.size()) / k_frames;
 }
 
+void parse_memory(benchmark::State& state, bool all_parts) {
+  parse_text(state, make_landmark_text(k_frames, all_parts));
+}
+
 // items_per_second = frames/s.
 void BM_parse_landmarks_pose_only(benchmark::State& state) { parse_memory(state, false); }
 void BM_parse_landmarks_all_parts(benchmark::State& state) { parse_memory(state, true); }
+
+// The synthetic holistic recording; range(0) = 0: the digit path alone (no vector number
+// path, no compact point path).
+void BM_parse_landmarks_holistic(benchmark::State& state) {
+  const bool saved = io_detail::json_vector_path();
+  io_detail::json_vector_path() = state.range(0) != 0;
+  parse_text(state, make_holistic_text(k_frames));
+  io_detail::json_vector_path() = saved;
+}
+
+// Floor: finding the line ends of the same text (what any line reader does first).
+void BM_find_line_ends_holistic(benchmark::State& state) {
+  const std::string text = make_holistic_text(k_frames);
+  std::int64_t lines = 0;
+  for (auto _ : state) {
+    const char* p = text.data();
+    const char* end = p + text.size();
+    while (const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p))) {
+      p = static_cast<const char*>(nl) + 1;
+      ++lines;
+    }
+    benchmark::DoNotOptimize(p);
+  }
+  state.SetItemsProcessed(lines);
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) *
+                          static_cast<std::int64_t>(text.size()));
+}
 
 // The same through a real file (block reads included).
 void BM_parse_landmarks_pose_only_file(benchmark::State& state) {
@@ -198,6 +256,8 @@ BENCHMARK(BM_parse_landmarks_pose_only)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_parse_landmarks_pose_only_file)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_parse_landmarks_pose_only_nlohmann)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_parse_landmarks_all_parts)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_parse_landmarks_holistic)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_find_line_ends_holistic)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_write_pose_lines)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_write_landmarks_pose_only)->Unit(benchmark::kMillisecond);
 

@@ -12,6 +12,8 @@
 #include <string>
 #include <string_view>
 
+#include "io/json_number.hpp"
+
 namespace avatarmap::io_detail {
 
 /// Deepest nesting of arrays and objects skip_value() accepts in an unknown key's value: a
@@ -64,7 +66,8 @@ struct json_cursor {
   /// magnitudes give +-inf (overflow) or 0/subnormal (underflow), as strtof/strtod do.
   bool parse_float(float& out, bool* was_null = nullptr) {
     skip_ws();
-    if (fast_float(out)) {
+    if (const char* q = json_scan_float(begin, p, end, out)) {
+      p = q;
       if (was_null) *was_null = false;
       return true;
     }
@@ -104,94 +107,6 @@ struct json_cursor {
   bool eat_null();
 
  private:
-  /// Clinger's fast path: a number of at most 19 digits whose mantissa m is at most 2^53 and a
-  /// decimal exponent within +-22 is exactly m * 10^e with m and 10^|e| exact doubles, so one IEEE
-  /// multiplication or division gives the correctly rounded double d. Rounding d to float
-  /// is then correct unless d lies exactly halfway between two floats (the true value may
-  /// not): those, subnormal and out-of-range results, and anything unusual fall back to
-  /// std::from_chars. Returns false without consuming anything when it cannot decide.
-  bool fast_float(float& out) {
-    static constexpr double k_pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                           1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                                           1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
-    const char* q = p;
-    bool negative = false;
-    if (q < end && *q == '-') {
-      negative = true;
-      ++q;
-    }
-    if (q >= end || *q < '0' || *q > '9') return false;
-    std::uint64_t m = 0;
-    int digits = 0;  // all digits read into m; at most 19 so that m cannot overflow
-    int exp10 = 0;
-    if (*q == '0') {
-      ++q;
-      if (q < end && *q >= '0' && *q <= '9') return false;  // leading zero: not JSON
-    } else {
-      while (q < end && *q >= '0' && *q <= '9') {
-        if (++digits > 19) return false;
-        m = m * 10 + static_cast<unsigned>(*q - '0');
-        ++q;
-      }
-    }
-    if (q < end && *q == '.') {
-      ++q;
-      const char* first = q;
-      // Eight digits at a time while they last (SWAR, as in fast_float).
-      while (end - q >= 8 && digits + 8 <= 19) {
-        std::uint64_t v;
-        std::memcpy(&v, q, 8);
-        if ((((v & 0xF0F0F0F0F0F0F0F0u) |
-              (((v + 0x0606060606060606u) & 0xF0F0F0F0F0F0F0F0u) >> 4)) != 0x3333333333333333u))
-          break;
-        v -= 0x3030303030303030u;
-        v = (v * 10) + (v >> 8);
-        v = (((v & 0x000000FF000000FFu) * 0x000F424000000064u) +
-             (((v >> 16) & 0x000000FF000000FFu) * 0x0000271000000001u)) >>
-            32;
-        m = m * 100000000u + static_cast<std::uint32_t>(v);
-        digits += 8;
-        exp10 -= 8;
-        q += 8;
-      }
-      while (q < end && *q >= '0' && *q <= '9') {
-        if (++digits > 19) return false;
-        m = m * 10 + static_cast<unsigned>(*q - '0');
-        --exp10;
-        ++q;
-      }
-      if (q == first) return false;  // "1." is not JSON
-    }
-    if (m > (std::uint64_t{1} << 53)) return false;
-    if (q < end && (*q == 'e' || *q == 'E')) {
-      ++q;
-      bool eneg = false;
-      if (q < end && (*q == '+' || *q == '-')) eneg = *q++ == '-';
-      if (q >= end || *q < '0' || *q > '9') return false;
-      int e = 0;
-      while (q < end && *q >= '0' && *q <= '9') {
-        if (e > 1000) return false;
-        e = e * 10 + (*q - '0');
-        ++q;
-      }
-      exp10 += eneg ? -e : e;
-    }
-    if (exp10 < -22 || exp10 > 22) return false;
-    double d = static_cast<double>(m);
-    d = exp10 < 0 ? d / k_pow10[-exp10] : d * k_pow10[exp10];
-    if (m != 0) {
-      if (!(d >= 1.1754943508222875e-38 && d <= 3.4028234663852886e38)) return false;
-      std::uint64_t bits;
-      std::memcpy(&bits, &d, sizeof bits);
-      // A float midpoint has a 1 followed by 28 zeros below the float's last mantissa bit.
-      if ((bits & 0x1fffffffu) == 0x10000000u) return false;
-    }
-    float f = static_cast<float>(d);
-    out = negative ? -f : f;
-    p = q;
-    return true;
-  }
-
   bool parse_float_slow(float& out, bool* was_null);
   bool parse_double_slow(double& out, bool* was_null);
   /// Reads a non-finite token or an out-of-range number as a double (shared slow path).

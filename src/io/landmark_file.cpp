@@ -10,6 +10,12 @@
 #include "io/jsonl_reader_core.hpp"
 #include "io/text_output.hpp"
 
+#if AVATARMAP_HAVE_SIMDJSON
+#include <simdjson.h>
+
+#include <vector>
+#endif
+
 namespace avatarmap {
 
 using io_detail::json_cursor;
@@ -109,6 +115,87 @@ bool parse_point(json_cursor& c, landmark& out) {
   return true;
 }
 
+// Points in the compact form the writers produce, "[x,y,z],[x,y,z,v,p],..." without white
+// space and with plain decimals (json_number.hpp), read from c.p (a point's '[') into
+// storage[count...] (`overflow` beyond `capacity`). Returns true after consuming the
+// array's closing ']'; false, with c.p at the start of the first point it could not read
+// this way (and `count` its index), when the text differs in any way: parse_point then
+// reads that point, so the values and the error messages do not depend on which path ran.
+//
+// The delimiters (',' ']' '}') of 64 bytes at a time are found first, as a bit mask; each
+// value then lies between two of them. The position of the next value so depends on one
+// bit operation, not on the digits before it, and the processor reads several numbers at
+// once.
+bool read_compact_points(json_cursor& c, landmark* storage, int capacity, landmark& overflow,
+                         int& count) {
+#if AVATARMAP_JSON_SSE2
+  using io_detail::number_detail::delimiter_mask64;
+  using io_detail::number_detail::lowest_bit;
+  using io_detail::number_detail::plain_decimal;
+  // Blocks of 64 bytes are read while 64 bytes are left on the line; plain_decimal reads
+  // the 16 bytes before a token's end, so the first point must start 16 bytes into it.
+  const char* point = c.p;
+  if (point - c.begin < io_detail::k_float_scan_lookback || c.end - point < 64 ||
+      !io_detail::json_vector_path())
+    return false;
+  const char* block = point;
+  std::uint64_t bits = delimiter_mask64(block);  // delimiters in [block, block + 64) not used yet
+  // The next delimiter, or nullptr near the end of the line.
+  auto next_delimiter = [&]() -> const char* {
+    while (bits == 0) {
+      block += 64;
+      if (c.end - block < 64) return nullptr;
+      bits = delimiter_mask64(block);
+    }
+    const char* d = block + lowest_bit(bits);
+    bits &= bits - 1;
+    return d;
+  };
+  while (point < c.end && *point == '[') {
+    float v[5];
+    int n = 0;
+    const char* value = point + 1;
+    const char* d = nullptr;
+    bool closed = false;
+    for (;;) {
+      d = next_delimiter();
+      if (d == nullptr || d == value || d - value > 15 || !plain_decimal(value, d, v[n])) break;
+      ++n;
+      if (*d == ']') {
+        closed = true;
+        break;
+      }
+      if (*d != ',' || n == 5) break;
+      value = d + 1;
+    }
+    if (!closed || n < 3) break;
+    // The point is good; it counts when ',' or the array's ']' follows at once.
+    const char* after = next_delimiter();
+    if (after != d + 1 || *after == '}') break;
+    landmark& out = count < capacity ? storage[count] : overflow;
+    out.x = v[0];
+    out.y = v[1];
+    out.z = v[2];
+    out.visibility = n > 3 ? v[3] : 1.f;
+    out.presence = n > 4 ? v[4] : 1.f;
+    ++count;
+    if (*after == ']') {
+      c.p = after + 1;
+      return true;
+    }
+    point = after + 1;
+  }
+  c.p = point;
+#else
+  (void)c;
+  (void)storage;
+  (void)capacity;
+  (void)overflow;
+  (void)count;
+#endif
+  return false;
+}
+
 bool parse_points(json_cursor& c, landmark* storage, int capacity, frame_context& ctx,
                   int& out_count) {
   out_count = 0;
@@ -117,6 +204,7 @@ bool parse_points(json_cursor& c, landmark* storage, int capacity, frame_context
   if (c.eat(']')) return true;
   landmark overflow;
   for (;;) {
+    if (read_compact_points(c, storage, capacity, overflow, out_count)) break;
     ctx.point = out_count;
     if (!parse_point(c, out_count < capacity ? storage[out_count] : overflow)) return false;
     ++out_count;
@@ -151,6 +239,91 @@ struct landmark_reader::impl {
   landmark_file_header header;
   long frame_index = 0;  // frame lines seen (good or bad), for t = index / fps
   std::string scratch;
+#if AVATARMAP_HAVE_SIMDJSON
+  simdjson::ondemand::parser simd_parser;
+  std::vector<char> padded;  // the line and simdjson's padding after it
+
+  // The frame with simdjson's on-demand API. False, with `out` in any state, when the line
+  // must go to the own scanner instead: whatever simdjson rejects, and whatever the scanner
+  // reads differently or reports (unknown and header keys, null values, counts out of
+  // range, numbers outside the normal float range or halfway between two floats).
+  bool parse_frame_simdjson(std::string_view line, landmark_frame& out, bool& has_t) {
+    namespace od = simdjson::ondemand;
+    // Room for twice the longest line so far: lines of a recording differ in length, and
+    // growing by the exact amount would allocate again and again.
+    if (line.size() > simd_parser.capacity() &&
+        simd_parser.allocate(2 * line.size()) != simdjson::SUCCESS)
+      return false;
+    if (padded.size() < line.size() + simdjson::SIMDJSON_PADDING)
+      padded.resize(2 * line.size() + simdjson::SIMDJSON_PADDING);
+    std::memcpy(padded.data(), line.data(), line.size());
+    od::document doc;
+    od::object object;
+    if (simd_parser.iterate(padded.data(), line.size(), padded.size()).get(doc) ||
+        doc.get_object().get(object))
+      return false;
+    for (auto member : object) {
+      std::string_view key;
+      od::value value;
+      if (member.unescaped_key().get(key) || member.value().get(value)) return false;
+      if (key == "t") {
+        if (value.get_double().get(out.t) || !std::isfinite(out.t)) return false;
+        has_t = true;
+        continue;
+      }
+      const int part = part_from_key(key);
+      if (part < 0) return false;
+      const auto fp = static_cast<frame_part>(part);
+      bool is_null = false;
+      if (value.is_null().get(is_null)) return false;
+      if (is_null) {
+        out.set(fp, false);
+        continue;
+      }
+      int capacity = 0;
+      landmark* storage = part_storage(out, fp, capacity);
+      int count = 0;
+      od::array points;
+      if (value.get_array().get(points)) return false;
+      for (auto item : points) {
+        od::array point;
+        if (item.get_array().get(point) || count == capacity) return false;
+        float v[5];
+        int n = 0;
+        for (auto x : point) {
+          double d = 0.0;
+          if (n == 5 || x.get_double().get(d)) return false;
+          // The correctly rounded double rounds to the correctly rounded float unless it
+          // lies halfway between two floats; subnormal and out-of-range results are the
+          // scanner's.
+          std::uint64_t b;
+          std::memcpy(&b, &d, sizeof b);
+          if ((d != 0.0 &&
+               !(std::abs(d) >= 1.1754943508222875e-38 && std::abs(d) <= 3.4028234663852886e38)) ||
+              (b & 0x1fffffffu) == 0x10000000u)
+            return false;
+          v[n++] = static_cast<float>(d);
+        }
+        if (n < 3) return false;
+        landmark& p = storage[count++];
+        p.x = v[0];
+        p.y = v[1];
+        p.z = v[2];
+        p.visibility = n > 3 ? v[3] : 1.f;
+        p.presence = n > 4 ? v[4] : 1.f;
+      }
+      if (fp == frame_part::face) {
+        if (count != k_face_mesh_count && count != k_face_mesh_iris_count) return false;
+        out.face_count = count;
+      } else if (count != capacity) {
+        return false;
+      }
+      out.set(fp, true);
+    }
+    // Nothing after the object (white space is no token).
+    return doc.current_location().error() == simdjson::OUT_OF_BOUNDS;
+  }
+#endif
 
   status parse_header(std::string_view line) {
     json_cursor c(line.data(), line.data() + line.size());
@@ -232,7 +405,16 @@ struct landmark_reader::impl {
     json_cursor c(line.data(), line.data() + line.size());
     frame_context ctx;
     bool has_t = false;
-    bool ok = [&]() {
+#if AVATARMAP_HAVE_SIMDJSON
+    const bool simd_ok = io_detail::json_vector_path() && parse_frame_simdjson(line, out, has_t);
+    if (!simd_ok) {
+      out.clear();
+      has_t = false;
+    }
+#else
+    const bool simd_ok = false;
+#endif
+    bool ok = simd_ok || [&]() {
       if (!c.eat('{')) return c.fail_expected("'{' (each line must be one JSON object: a frame)");
       if (c.eat('}')) return true;
       for (;;) {
@@ -279,7 +461,7 @@ struct landmark_reader::impl {
         return c.fail_expected("',' or '}' after a member of the frame");
       }
     }();
-    if (ok) {
+    if (ok && !simd_ok) {
       c.skip_ws();
       if (!c.at_end()) ok = c.fail("unexpected text after the frame object (expected end of line)");
     }

@@ -31,7 +31,7 @@ status text_output::open(const std::string& path) {
   } else if (status s = file_.open(path); !s) {
     return s;
   }
-  buf_.assign(k_buffer_size, '\0');
+  buf_.assign(k_buffer_size + k_slack, '\0');
   open_ = true;
   return {};
 }
@@ -60,8 +60,8 @@ bool text_output::flush() {
 
 bool text_output::write(std::string_view s) {
   while (!s.empty()) {
-    if (pos_ == buf_.size() && !flush()) return false;
-    const std::size_t n = std::min(s.size(), buf_.size() - pos_);
+    if (pos_ == capacity() && !flush()) return false;
+    const std::size_t n = std::min(s.size(), capacity() - pos_);
     put(s.substr(0, n));
     s.remove_prefix(n);
   }

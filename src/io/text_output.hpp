@@ -3,8 +3,9 @@
 // fsynced and renamed over PATH by commit(), the replaced file's mode kept, removed on
 // failure and on SIGINT/SIGTERM). Destroying an uncommitted output removes the temporary
 // file and leaves PATH untouched. "-" writes to standard output (not atomic; commit() only
-// flushes). Numbers are written with std::to_chars (shortest text that reads back to the
-// same value); non-finite numbers are written as null.
+// flushes). Numbers are written as the shortest text that reads back to the same value
+// (std::to_chars's characters; floats through float_text.hpp, which is faster); non-finite
+// numbers are written as null.
 #pragma once
 
 #include <charconv>
@@ -16,6 +17,7 @@
 
 #include "avatarmap/core/status.hpp"
 #include "io/atomic_file.hpp"
+#include "io/float_text.hpp"
 
 namespace avatarmap::io_detail {
 
@@ -38,7 +40,7 @@ class text_output {
   /// error (then error() says why). `n` must be at most k_reserve_max.
   static constexpr std::size_t k_reserve_max = 4096;
   bool reserve(std::size_t n) {
-    if (pos_ + n <= buf_.size()) return true;
+    if (pos_ + n <= capacity()) return true;
     return flush();
   }
   /// Unchecked appends: call reserve() first.
@@ -52,8 +54,8 @@ class text_output {
     // Identity rotations and unused weights are common; skip the shortest-digits search.
     if (v == 0.f && !std::signbit(v)) return put('0');
     if (v == 1.f) return put('1');
-    pos_ = static_cast<std::size_t>(
-        std::to_chars(buf_.data() + pos_, buf_.data() + buf_.size(), v).ptr - buf_.data());
+    // Writes up to k_shortest_float_room bytes: within the slack after capacity().
+    pos_ = static_cast<std::size_t>(write_shortest_float(buf_.data() + pos_, v) - buf_.data());
   }
   void put_number(double v) {
     if (!std::isfinite(v)) return put("null");
@@ -78,6 +80,11 @@ class text_output {
 
  private:
   void discard();
+  /// Bytes reserve() hands out; buf_ has k_slack more, for the fixed-size blocks that
+  /// write_shortest_float writes.
+  static constexpr std::size_t k_slack = 48;
+  static_assert(k_slack >= k_shortest_float_room);
+  std::size_t capacity() const { return buf_.size() > k_slack ? buf_.size() - k_slack : 0; }
 
   atomic_file file_;
   bool open_ = false;
