@@ -13,7 +13,9 @@ namespace avatarmap::cli {
 inline constexpr const char* k_filter_names = "offline, live or none (or euro, landmarks, both)";
 
 /// Sets `job`'s filters from a --filter value: offline (zero-phase smoothing and gap filling,
-/// the default), live (the causal One Euro filter on the solved poses), none; and the older
+/// the default), live (pose_filter, the causal filter on the solved poses: One Euro plus a
+/// short constant-velocity extrapolation of the rotations, with pose_filter_options'
+/// defaults unless --min-cutoff / --beta change them), none; and the older
 /// names: euro = live, landmarks = One Euro on the landmarks before solving and nothing
 /// after, both = landmarks and live. False (job unchanged) for any other value.
 inline bool apply_filter_option(const std::string& value, solve_file_job& job) {

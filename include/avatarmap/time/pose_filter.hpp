@@ -32,20 +32,27 @@ inline float frame_dt(bool has_last, double last_t, double t) noexcept {
 }  // namespace detail
 
 /// Options of pose_filter. The defaults are tuned for human motion captured at 25-30 fps by a
-/// monocular estimator, whose jitter sits mostly above ~3 Hz while deliberate motion at rest
-/// speeds is below ~1 Hz:
-/// - rotation: 1.5 Hz at rest (jitter of a still limb is damped ~5x at 10 Hz); beta 0.5 s/rad
-///   raises the cutoff to ~3.5 Hz at 4 rad/s (a brisk arm swing) and ~6.5 Hz at 10 rad/s (a
-///   punch), keeping the lag of fast moves to a few tens of milliseconds.
+/// monocular estimator (docs/smoothing.md, "Live: lag against jitter", has the sweep they were
+/// chosen from with tools/eval/live_filter.sh):
+/// - rotation: One Euro at 0.7 Hz at rest, beta 0.3 s/rad on the speed measured as the angle
+///   from the last output (one_euro_speed::output_change), that speed low-passed at 1 Hz;
+///   then extrapolated along the low-passed angular velocity by 3/4 of the low-pass's own lag,
+///   at most 50 ms. At 30 fps a bone turning steadily at 1, 3 and 6 rad/s is trailed by about
+///   39, 13 and 9 ms (the One Euro filter of 1.5 Hz / beta 0.5 without extrapolation, the
+///   default before 0.2: 56, 35 and 24 ms), a still noisy bone jitters ~15% less than with
+///   it, and a turn at 3 rad/s that stops dead is overshot by ~4 degrees for ~0.3 s.
 /// - position (hips, metres): 1 Hz at rest (the root is the noisiest, most visible signal),
 ///   beta 2 s/m: ~4 Hz at walking speed (1.5 m/s), ~7 Hz for a jump.
 /// - expression (weights 0..1): 3 Hz at rest, beta 1 s: a blink (0 -> 1 in ~0.1 s, ~10/s)
 ///   gets ~13 Hz, i.e. passes almost unfiltered while flicker of a still face is damped.
-/// - d_cutoff 1 Hz everywhere, as the paper recommends.
+/// - d_cutoff 1 Hz for position and expressions, as the paper recommends.
 struct pose_filter_options {
-  one_euro_params rotation{1.5f, 0.5f, 1.0f};
+  one_euro_params rotation{0.7f, 0.3f, 1.0f};
   one_euro_params position{1.0f, 2.0f, 1.0f};
   one_euro_params expression{3.0f, 1.0f, 1.0f};
+  /// How the rotations' speed is measured and how far they are extrapolated (one_euro.hpp).
+  one_euro_quat_options rotation_options{one_euro_speed::output_change, 0.75f, 0.05f,
+                                         one_euro_velocity::filtered};
   bool enabled = true;  // false: apply() copies its input and keeps no history
 };
 
@@ -59,7 +66,10 @@ class pose_filter {
   /// that disabling clears it.
   void set_options(const pose_filter_options& options) noexcept {
     options_ = options;
-    for (auto& f : rotations_) f.set_params(options.rotation);
+    for (auto& f : rotations_) {
+      f.set_params(options.rotation);
+      f.set_options(options.rotation_options);
+    }
     position_.set_params(options.position);
     for (auto& f : expressions_) f.set_params(options.expression);
     if (!options.enabled) reset();
