@@ -88,6 +88,26 @@ TEST(FollowObservations, HeadHoldsUnderPerspectiveForAnyFieldOfView) {
   EXPECT_GT(wrong.head_mean, right.head_mean + 0.5);
 }
 
+TEST(FollowObservations, HandConfidenceIsItsPointsVisibility) {
+  // MediaPipe's hand model writes no visibility (1); a file that marks a hand's points as
+  // barely visible gets a barely-confident hand, which the offline smoother then fills.
+  synth_recording rec(synth_scenario_options(synth_scenario::clean, 3));
+  proxy_pose truth;
+  landmark_frame frame;
+  rec.generate(0.5, truth, frame);
+  for (landmark& l : frame.left_hand) l.visibility = 0.2f;
+  for (landmark& l : frame.left_hand_world) l.visibility = 0.2f;
+  solver_options o;
+  o.image_width = 1280.f;
+  o.image_height = 720.f;
+  frame_solver solver(o);
+  frame_measurement m;
+  solver.measure(frame, m);
+  EXPECT_NEAR(m.bones[idx(bone::left_hand)].confidence, 0.2f, 1e-6f);
+  EXPECT_NEAR(m.bones[idx(bone::left_index_distal)].confidence, 0.2f, 1e-6f);
+  EXPECT_EQ(m.bones[idx(bone::right_hand)].confidence, 1.f);
+}
+
 // A pinhole camera written out: world points (MediaPipe's axes: x right, y down, z away from
 // the camera, metres about the hips) seen from depth tz, offset (tx, ty), focal f pixels.
 landmark_frame pinhole_frame(double f, double tx, double ty, double tz, float w, float h,

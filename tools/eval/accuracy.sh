@@ -6,7 +6,8 @@
 # Environment: AVATARMAP (the tool; default build/avatarmap beside this checkout),
 #   SECONDS_PER_RUN (default 20), FPS (default 30), SIZE (default 1280x720),
 #   FILTERS (default "default none": solve's defaults, and --filter none for comparison),
-#   KEEP (a folder to keep the files in; default: a temporary folder, removed).
+#   KEEP (a folder to keep the files in; default: a temporary folder, removed),
+#   SOLVE_ARGS (more options for every solve, e.g. "--smoothing 1.5").
 # For each seed and scenario (clean, noisy) it synthesises a recording with its truth, solves
 # it with each filter setting and prints one row of mean errors in degrees: bone directions
 # overall and per group, head orientation, and over the bones in low-visibility bursts
@@ -51,7 +52,7 @@ for scene in clean noisy; do
       args=()
       [ "$filter" = default ] || args=(--filter "$filter")
       "$exe" solve "$base.landmarks.jsonl" -o "$base.$filter.pose.jsonl" --quiet \
-        ${args[@]+"${args[@]}"} 2>/dev/null
+        ${args[@]+"${args[@]}"} ${SOLVE_ARGS:-} 2>/dev/null
       json=$("$exe" eval-pose "$base.truth.pose.jsonl" "$base.$filter.pose.jsonl" --json)
       row=$(python3 -c '
 import json, sys
