@@ -329,22 +329,29 @@ TEST(OfflineSmoother, LowConfidenceBoneFollowsItsMeasurement) {
   EXPECT_LT(worst, 10.f);
 }
 
-TEST(OfflineSmoother, BarelySeenFingersAreFilledNotSmoothed) {
-  // A hand whose own points are barely visible (confidence 0.1): its fingers are filled from
-  // both sides like a gap, not taken from the unreliable points (an arm at 0.1 is smoothed).
+// 150 frames of a still left index finger at `a`, with garbage rotations during frames 60-79
+// where `low_bone` has confidence 0.1 (the finger itself, or its lower arm).
+std::vector<proxy_pose> finger_burst(const glm::quat& a, int low_bone) {
   const int finger = idx(bone::left_index_proximal);
-  const glm::quat a = about(glm::vec3(0.f, 0.f, 1.f), 0.5f);
   std::vector<proxy_pose> in;
   for (int i = 0; i < 150; ++i) {
     proxy_pose p = frame_at(i);
     p.rotations[finger] = a;
     if (i >= 60 && i < 80) {
-      p.confidence[finger] = 0.1f;
+      p.confidence[low_bone] = 0.1f;
       p.rotations[finger] = about(glm::vec3(1.f, 0.f, 0.f), 1.5f);  // garbage
     }
     in.push_back(p);
   }
-  const auto out = run(in);
+  return in;
+}
+
+TEST(OfflineSmoother, BarelySeenFingersAreFilledNotSmoothed) {
+  // A hand whose own points are barely visible (confidence 0.1): its fingers are filled from
+  // both sides like a gap, not taken from the unreliable points (an arm at 0.1 is smoothed).
+  const int finger = idx(bone::left_index_proximal);
+  const glm::quat a = about(glm::vec3(0.f, 0.f, 1.f), 0.5f);
+  const auto out = run(finger_burst(a, finger));
   for (int i = 60; i < 80; ++i) {
     EXPECT_LT(degrees_between(out[i].rotations[finger], a), 0.01f) << i;
     EXPECT_EQ(out[i].confidence[finger], 0.1f);  // the input's confidence is written unchanged
@@ -357,16 +364,7 @@ TEST(OfflineSmoother, HandFollowsItsArmWhenAsked) {
   // are then filled from both sides.
   const int finger = idx(bone::left_index_proximal);
   const glm::quat a = about(glm::vec3(0.f, 0.f, 1.f), 0.5f);
-  std::vector<proxy_pose> in;
-  for (int i = 0; i < 150; ++i) {
-    proxy_pose p = frame_at(i);
-    p.rotations[finger] = a;
-    if (i >= 60 && i < 80) {
-      p.confidence[idx(bone::left_lower_arm)] = 0.1f;
-      p.rotations[finger] = about(glm::vec3(1.f, 0.f, 0.f), 1.5f);  // garbage
-    }
-    in.push_back(p);
-  }
+  const std::vector<proxy_pose> in = finger_burst(a, idx(bone::left_lower_arm));
   offline_smoother_options o;
   o.hands_follow_arms = true;
   const auto out = run(in, o);
