@@ -110,8 +110,16 @@ int run_eval_pose(int argc, char** argv) {
     std::printf(",");
     print_figures_json("low_visibility", acc.low_visibility);
     std::printf(",");
-    print_stats_json("marked", acc.marked, false);
-    std::printf("}\n");
+    print_stats_json("marked", acc.marked, true);
+    std::printf("\"bones\":{");
+    bool first = true;
+    for (int b = 0; b < k_bone_count; ++b) {
+      if (acc.bones[b].count == 0) continue;
+      std::printf("%s", first ? "" : ",");
+      first = false;
+      print_stats_json(std::string(bone_name(static_cast<bone>(b))).c_str(), acc.bones[b], false);
+    }
+    std::printf("}}\n");
     return 0;
   }
   std::printf("%ld frames, %ld with low-visibility bones; mean angles in degrees\n", acc.frames,

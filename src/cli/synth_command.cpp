@@ -356,14 +356,19 @@ int run_import_tfjs(int argc, char** argv) {
         "\n"
         "Converts tfjs-models' reference BlazePose landmarks (a JSON list of frames of 33\n"
         "[x_px, y_px, z] image points, and one of 33 [x, y, z] world points in metres) into\n"
-        "*.landmarks.jsonl. --size is the video's size in pixels, --fps its frame rate.\n",
+        "*.landmarks.jsonl. --size is the video's size in pixels, --fps its frame rate.\n"
+        "\n"
+        "  --hand left|right   the files are a hand recording (21 points per frame, e.g.\n"
+        "                      asl_hand.full.json + asl_hand_3d.full.json), written as that hand\n"
+        "                      (the files do not say which)\n",
         stdout);
     return 0;
   }
-  std::string out, size;
+  std::string out, size, hand;
   double fps = 0;
   a.value("--output", out, "-o");
   a.value("--size", size);
+  a.value("--hand", hand);
   a.number("--fps", fps);
   int w = 0, h = 0;
   if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 2 || out.empty() ||
@@ -374,7 +379,16 @@ int run_import_tfjs(int argc, char** argv) {
                  a.error().empty() ? "" : ": ", a.error().c_str());
     return 2;
   }
-  status st = import_tfjs_pose(a.rest()[0], a.rest()[1], w, h, fps, out);
+  if (!hand.empty() && hand != "left" && hand != "right") {
+    std::fprintf(stderr, "avatarmap import-tfjs: --hand is left or right, got '%s'\n",
+                 hand.c_str());
+    return 2;
+  }
+  status st = hand.empty()
+                  ? import_tfjs_pose(a.rest()[0], a.rest()[1], w, h, fps, out)
+                  : import_tfjs_hand(a.rest()[0], a.rest()[1], w, h, fps, hand == "left", out);
+  if (!st.ok() && hand.empty() && st.message().find("array of 21") != std::string::npos)
+    st = status::error(st.message() + " (a hand recording: add --hand left|right)");
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap import-tfjs: %s\n", st.message().c_str());
     return 1;

@@ -305,6 +305,9 @@ status solve_file_job::run(solve_file_summary& s) const {
   if (!st.ok()) return fail(job_failure::output_io, st);
   s.seconds = seconds_since(t0);
   if (s.frames == 0) s.hips_height_min = s.hips_height_max = 0.f;
+  s.horizontal_fov_degrees = state->solver.horizontal_fov_degrees();
+  s.fov_estimated = solve_options.horizontal_fov_degrees == 0.f;
+  s.fov_evidence_frames = state->solver.fov_evidence_frames();
   return {};
 }
 

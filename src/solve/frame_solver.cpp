@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "solve/solve_body.hpp"
+#include "solve/solve_camera.hpp"
 #include "solve/solve_face.hpp"
 #include "solve/solve_geometry.hpp"
 #include "solve/solve_hands.hpp"
@@ -19,9 +20,15 @@ namespace avatarmap {
 
 using namespace solve_detail;
 
+namespace {
+// Field of view assumed until the pose has told better, and its uncertainty (a fraction of
+// the focal length: 60 +-30 % covers ~45-80 degrees).
+constexpr float k_prior_fov_degrees = 60.f;
+constexpr double k_prior_focal_fraction = 0.3;
+}  // namespace
+
 frame_solver::frame_solver(const solver_options& options)
     : options_(options.validate().ok() ? options : solver_options{}) {
-  focal_per_width_ = 0.5f / std::tan(0.5f * options_.horizontal_fov_degrees * k_deg);
   reset();
 }
 
@@ -40,6 +47,30 @@ void frame_solver::reset() {
   expressions_held_.fill(0.f);
   last_t_ = 0.0;
   started_ = false;
+  const bool estimate_fov = options_.horizontal_fov_degrees == 0.f;
+  const float fov = estimate_fov ? k_prior_fov_degrees : options_.horizontal_fov_degrees;
+  focal_per_width_ = 0.5f / std::tan(0.5f * fov * k_deg);
+  const double sd = k_prior_focal_fraction * focal_per_width_;
+  focal_information_ = 1.0 / (sd * sd);
+  focal_weighted_sum_ = focal_information_ * focal_per_width_;
+  focal_frames_ = 0;
+}
+
+float frame_solver::horizontal_fov_degrees() const {
+  return 2.f * std::atan(0.5f / focal_per_width_) / k_deg;
+}
+
+void frame_solver::update_focal(const landmark_frame& in) {
+  if (options_.horizontal_fov_degrees != 0.f || !(options_.image_width > 0.f)) return;
+  const focal_evidence e = estimate_focal(in, options_.image_width, options_.image_height,
+                                          options_.confidence.found_above);
+  if (!(e.information > 0.0)) return;
+  // In units of the image width, as focal_per_width_.
+  const double w = options_.image_width;
+  focal_information_ += e.information * w * w;
+  focal_weighted_sum_ += e.information * w * w * (e.focal / w);
+  focal_per_width_ = static_cast<float>(focal_weighted_sum_ / focal_information_);
+  ++focal_frames_;
 }
 
 void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const {
@@ -77,6 +108,7 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
   if (started_ && t < last_t_) reset();  // a new take
   started_ = true;
   last_t_ = t;
+  update_focal(in);
 
   frame_measurement& m = scratch_;
   measure(in, m);

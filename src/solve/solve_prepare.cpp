@@ -61,13 +61,17 @@ void prepare_hand(const landmark_frame& in, const solver_options& o, int side, p
   const float sx = ((side == 1) != o.mirror) ? -1.f : 1.f;
   const float kx = world ? sx : sx * f.width, ky = world ? -1.f : -f.height,
               kz = world ? -1.f : -f.width;
+  // Confidence: the points' mean (MediaPipe's hand model writes none, which reads as 1; a
+  // file that marks occluded points lowers it). 0 when any point is not finite.
   bool finite = true;
+  float sum = 0.f;
   for (int i = 0; i < k_hand_landmark_count; ++i) {
     const float x = src[i].x * kx, y = src[i].y * ky, z = src[i].z * kz;
     if (x * 0.f + y * 0.f + z * 0.f != 0.f) finite = false;  // NaN or infinite
     h.p[i] = glm::vec3(x, y, z);
+    sum += landmark_confidence(src[i]);
   }
-  h.c = finite ? 1.f : 0.f;
+  h.c = finite ? sum / float(k_hand_landmark_count) : 0.f;
 }
 
 void prepare_face(const landmark_frame& in, const solver_options& o, prepared_frame& f) {

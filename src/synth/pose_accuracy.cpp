@@ -104,6 +104,7 @@ void accumulate_pose_accuracy(const proxy_pose& truth, const proxy_pose& solved,
     const glm::vec3 rest = bone_rest_direction(static_cast<bone>(b));
     const double deg = bad[b] ? 180.0 : angle_degrees(wt[b] * rest, glm::normalize(ws[b]) * rest);
     add(acc.all, static_cast<int>(g), deg);
+    acc.bones[b].add(deg);
     if (low_frame) add(acc.low_visibility, static_cast<int>(g), deg);
     if (truth.confidence[b] < k_low_visibility_marker) acc.marked.add(deg);
   }
@@ -111,6 +112,7 @@ void accumulate_pose_accuracy(const proxy_pose& truth, const proxy_pose& solved,
   const double head =
       bad[h] ? 180.0 : rotation_angle(glm::normalize(glm::inverse(ws[h]) * wt[h])) * k_rad_to_deg;
   acc.all.head.add(head);
+  acc.bones[h].add(head);
   if (low_frame) acc.low_visibility.head.add(head);
 }
 

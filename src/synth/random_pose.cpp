@@ -57,10 +57,21 @@ proxy_pose random_pose(std::mt19937& rng, const random_pose_limits& L) {
   p.confidence.fill(1.f);
   p.hips_position = glm::vec3(uniform(rng, -L.hips_xz_range, L.hips_xz_range), L.hips_height,
                               uniform(rng, -L.hips_xz_range, L.hips_xz_range));
-  p[bone::hips] = axis_angle(k_y, sym(rng, L.hips_yaw)) * axis_angle(k_x, sym(rng, L.hips_lean)) *
-                  axis_angle(k_z, sym(rng, L.hips_lean));
+  const glm::quat hips_yaw = axis_angle(k_y, sym(rng, L.hips_yaw));
+  const glm::quat lean =
+      axis_angle(k_x, sym(rng, L.hips_lean)) * axis_angle(k_z, sym(rng, L.hips_lean));
+  p[bone::hips] = hips_yaw * lean;
   if (L.coupled_deviation >= 0.f) {
-    const glm::quat bend = xyz_rotation(rng, L.spine);
+    glm::quat bend = xyz_rotation(rng, L.spine);
+    if (L.pelvis_share_max > 0.f) {
+      // Lumbopelvic rhythm: the lean drawn above is the whole torso's; the pelvis takes a
+      // share of it, the three spine bones a third of the rest each.
+      const float share = uniform(rng, L.pelvis_share_min, L.pelvis_share_max);
+      p[bone::hips] = hips_yaw * quat_fraction(lean, share);
+      bend = axis_angle(k_y, sym(rng, L.spine)) * quat_fraction(lean, (1.f - share) / 3.f) *
+             axis_angle(k_x, sym(rng, L.spine_free_lean)) *
+             axis_angle(k_z, sym(rng, L.spine_free_lean));
+    }
     for (bone b : {bone::spine, bone::chest, bone::upper_chest})
       p[b] = bend * xyz_rotation(rng, L.coupled_deviation);
     const glm::quat half_turn = quat_fraction(xyz_rotation(rng, L.head), 0.5f);

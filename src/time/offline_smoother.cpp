@@ -14,7 +14,20 @@ namespace {
 // Kernels reach 3 sigma: the weight there is 1.1 % of the centre's.
 constexpr double k_kernel_reach = 3.0;
 constexpr int k_first_finger = static_cast<int>(bone::left_thumb_metacarpal);
+// Hands and fingers seen with a low confidence are filled as gaps, not smoothed: a few
+// millimetres of error turn a 2-4 cm finger bone, so a barely-seen hand's points say little.
+constexpr bool hand_or_finger(int b) {
+  return b >= k_first_finger || b == idx(bone::left_hand) || b == idx(bone::right_hand);
+}
 constexpr int k_fingers_per_hand = 15;
+// Noise adaptation (offline_smoother_options::adapt_to_noise): the mean size of the observed
+// bones' second differences (radians per sample) of the reference recordings the sigmas were
+// tuned on (the synthetic noisy scenario without bursts, 30 fps, tuning seeds 1-3), per group
+// (body, fingers); the running mean's time constant (seconds); the clamp of the factor.
+constexpr double k_reference_noise[2] = {0.22, 0.93};
+constexpr double k_reference_fps = 30.0;
+constexpr double k_noise_seconds = 4.0;
+constexpr double k_min_noise_factor = 0.25, k_max_noise_factor = 1.0;
 // Longest hold, ease or gap accepted (a window of minutes would be a mistake, not a choice).
 constexpr float k_max_gap_option_seconds = 60.f;
 constexpr int k_min_capacity = 8;
@@ -55,6 +68,8 @@ status offline_smoother_options::validate() const {
   if (!(finite_at_least(low_confidence_sigma_seconds, 0.f) &&
         strength * low_confidence_sigma_seconds <= 2.f))
     return range("low_confidence_sigma_seconds", "finite, >= 0 and at most 2 s x strength");
+  if (!(min_sigma_frames >= 0.f && min_sigma_frames <= 10.f))
+    return range("min_sigma_frames", "in [0, 10]");
   if (degree != 0 && degree != 2) return range("degree", "0 or 2");
   if (!(observed_above >= 0.f && observed_above <= 1.f))
     return range("observed_above", "in [0, 1]");
@@ -110,6 +125,11 @@ void offline_smoother::reset() noexcept {
   finished_ = false;
   has_last_t_ = false;
   last_t_ = 0.0;
+  sigma_floor_ = 0.0;
+  sigma_widest_ = 0.0;
+  noise_.fill(0.0);
+  noise_dt_ = 0.0;
+  noise_weight_ = 0.0;
   last_good_.fill(identity_quat());
   last_good_t_.fill(0.0);
   last_good_segment_.fill(-1);
@@ -155,7 +175,52 @@ bool offline_smoother::push(const proxy_pose& in) noexcept {
     cap(bone::right_lower_arm, bone::right_hand, bone::right_thumb_metacarpal);
   }
   s.position_ok = is_finite(in.hips_position);
+  if (options_.adapt_to_noise) observe_noise();
   return true;
+}
+
+// The newest three poses of one segment give, per bone observed in all three, the second
+// difference of its rotation: the change of the per-frame turn, d = r(q1^-1 q2) - r(q0^-1 q1)
+// with r the rotation vector (2 x the vector part, small angles), rescaled to the mean step
+// when the steps differ. For noise of n radians per sample it is ~n * sqrt(6) per axis; real
+// motion adds its acceleration x dt^2, small against noise at video rates.
+void offline_smoother::observe_noise() noexcept {
+  if (count_ < 3) return;
+  const slot& a = at(count_ - 3);
+  const slot& b = at(count_ - 2);
+  const slot& c = at(count_ - 1);
+  if (a.segment != c.segment || b.segment != c.segment) return;
+  const double dt0 = b.pose.t - a.pose.t, dt1 = c.pose.t - b.pose.t;
+  if (!(dt0 > 0.0) || !(dt1 > 0.0) || !std::isfinite(dt0 + dt1)) return;
+  const double mean_dt = 0.5 * (dt0 + dt1);
+  const float k0 = float(mean_dt / dt0), k1 = float(mean_dt / dt1);
+  const float threshold = options_.observed_above;
+  double sum[2] = {0.0, 0.0};
+  int n[2] = {0, 0};
+  for (int i = 0; i < k_bone_count; ++i) {
+    if (!(a.weight[i] >= threshold && b.weight[i] >= threshold && c.weight[i] >= threshold))
+      continue;
+    const glm::quat d0 = glm::conjugate(a.pose.rotations[i]) * b.pose.rotations[i];
+    const glm::quat d1 = glm::conjugate(b.pose.rotations[i]) * c.pose.rotations[i];
+    const float s0 = d0.w < 0.f ? -2.f : 2.f, s1 = d1.w < 0.f ? -2.f : 2.f;
+    const glm::vec3 v =
+        (s1 * k1) * glm::vec3(d1.x, d1.y, d1.z) - (s0 * k0) * glm::vec3(d0.x, d0.y, d0.z);
+    // Bones that do not change at all (set by a prior: toes, clavicles) tell nothing.
+    const float len = glm::length(v);
+    if (!(len > 1e-6f)) continue;
+    const int g = i >= k_first_finger ? 1 : 0;
+    sum[g] += len;
+    ++n[g];
+  }
+  if (n[0] + n[1] == 0) return;
+  // A running mean over about k_noise_seconds: plain while less than that has been seen.
+  const double w = std::min(mean_dt, k_noise_seconds);
+  const double total = std::min(noise_weight_ + w, k_noise_seconds);
+  const double alpha = w / std::max(total, w);
+  for (int g = 0; g < 2; ++g)
+    if (n[g] > 0) noise_[g] += alpha * (sum[g] / n[g] - noise_[g]);
+  noise_dt_ += alpha * (mean_dt - noise_dt_);
+  noise_weight_ = total;
 }
 
 bool offline_smoother::ready() const noexcept {
@@ -177,7 +242,9 @@ bool offline_smoother::pop(proxy_pose& out) noexcept {
   while (centre_ > 0 && ref >= 0) {
     const slot& oldest = at(0);
     const slot& r = at(std::min(centre_, count_ - 1));
-    if (oldest.segment == r.segment && !(r.pose.t - oldest.pose.t > past_seconds_)) break;
+    const double past =
+        std::max({past_seconds_, k_kernel_reach * sigma_floor_, k_kernel_reach * sigma_widest_});
+    if (oldest.segment == r.segment && !(r.pose.t - oldest.pose.t > past)) break;
     head_ = head_ + 1 == capacity_ ? 0 : head_ + 1;
     --count_;
     --centre_;
@@ -274,9 +341,43 @@ void offline_smoother::emit(proxy_pose& out) noexcept {
   out.t = c.pose.t;
   out.confidence = c.pose.confidence;
   const float k = options_.strength;
-  const float sigma_body = k * options_.body_sigma_seconds;
-  const float sigma_finger = k * options_.finger_sigma_seconds;
-  const float sigma_low = k * options_.low_confidence_sigma_seconds;
+  // The frame interval around the centre (the mean of the steps to its neighbours in the same
+  // segment) sets the least sigma: min_sigma_frames of it, within a third of the lookahead.
+  {
+    double steps = 0.0;
+    int n = 0;
+    if (ci > 0 && at(ci - 1).segment == c.segment) {
+      steps += c.pose.t - at(ci - 1).pose.t;
+      ++n;
+    }
+    if (ci + 1 < count_ && at(ci + 1).segment == c.segment) {
+      steps += at(ci + 1).pose.t - c.pose.t;
+      ++n;
+    }
+    const double floor = n > 0 ? options_.min_sigma_frames * steps / n : 0.0;
+    sigma_floor_ = k > 0.f && std::isfinite(floor) && floor > 0.0
+                       ? std::min(floor, lookahead_ / k_kernel_reach)
+                       : 0.0;
+  }
+  const float floor = static_cast<float>(sigma_floor_);
+  // Noise adaptation: width x (noise density / the reference's)^(1/7), within a third of the
+  // lookahead (the kernel's reach must fit the window).
+  float factor[2] = {1.f, 1.f};
+  if (options_.adapt_to_noise && noise_weight_ > 0.0 && noise_dt_ > 0.0) {
+    for (int g = 0; g < 2; ++g) {
+      const double ratio = noise_[g] / k_reference_noise[g];
+      const double density = ratio * ratio * (noise_dt_ * k_reference_fps);
+      factor[g] =
+          float(std::clamp(std::pow(density, 1.0 / 7.0), k_min_noise_factor, k_max_noise_factor));
+    }
+  }
+  const float widest = float(lookahead_ / k_kernel_reach);
+  const float sigma_body =
+      std::max(std::min(k * options_.body_sigma_seconds * factor[0], widest), floor);
+  const float sigma_finger =
+      std::max(std::min(k * options_.finger_sigma_seconds * factor[1], widest), floor);
+  sigma_widest_ = std::max(sigma_body, sigma_finger);
+  const float sigma_low = std::max(k * options_.low_confidence_sigma_seconds, floor);
   ++version_;  // the ring moved: every kernel table is stale
   const double tc = c.pose.t;
   const float threshold = options_.observed_above;
@@ -298,7 +399,8 @@ void offline_smoother::emit(proxy_pose& out) noexcept {
     // the bone went, so it is smoothed over a wider window with every frame weighted by its
     // confidence (observed neighbours dominate near the gap's ends).
     const float own = c.pose.confidence[b];
-    if (options_.low_confidence_sigma_seconds > 0.f && own > 0.f && own == c.weight[b]) {
+    if (options_.low_confidence_sigma_seconds > 0.f && own > 0.f && own == c.weight[b] &&
+        !hand_or_finger(b)) {
       smooth_rotation(kernel_for(k_low_confidence_table, ci, sigma_low), b, weighting::confidence,
                       out.rotations[b]);
       continue;
@@ -351,8 +453,8 @@ void offline_smoother::emit(proxy_pose& out) noexcept {
   }
 
   // Hips position and expressions: plain Gaussian means over the segment.
-  const double sigma_pos = k * options_.position_sigma_seconds;
-  const double sigma_expr = k * options_.expression_sigma_seconds;
+  const double sigma_pos = std::max(k * options_.position_sigma_seconds, floor);
+  const double sigma_expr = std::max(k * options_.expression_sigma_seconds, floor);
   const double reach = k_kernel_reach * std::max(sigma_pos, sigma_expr);
   glm::vec3 pos_sum(0.f);
   float pos_w = 0.f;

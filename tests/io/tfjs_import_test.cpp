@@ -138,6 +138,46 @@ TEST(tfjs_data, import_tfjs_pose_converts_the_squats) {
   std::remove(path.c_str());
 }
 
+TEST(tfjs_data, import_tfjs_hand_converts_the_asl_recording) {
+  if (test::test_data_dir().empty()) GTEST_SKIP() << test::k_no_test_data;
+  const std::string image_path = test::test_data_path("motion/tfjs-models/asl_hand.full.json");
+  const std::string world_path = test::test_data_path("motion/tfjs-models/asl_hand_3d.full.json");
+  const nlohmann::json image = load(image_path), world = load(world_path);
+  const std::string path = temp_file("asl_import");
+  const int w = 620, h = 1080;
+  // A hand file read as a pose says what to do.
+  status bad = import_tfjs_pose(image_path, world_path, w, h, 25.0, path);
+  EXPECT_NE(bad.message().find("expected an array of 33 points, got an array of 21"),
+            std::string::npos)
+      << bad.message();
+  status s = import_tfjs_hand(image_path, world_path, w, h, 25.0, false, path);
+  ASSERT_TRUE(s.ok()) << s.message();
+  landmark_reader r;
+  ASSERT_TRUE(r.open(path).ok());
+  landmark_frame f;
+  std::size_t n = 0;
+  while (r.next(f) == read_result::frame) {
+    ASSERT_LT(n, image.size());
+    EXPECT_DOUBLE_EQ(f.t, n / 25.0);
+    EXPECT_TRUE(f.has(frame_part::right_hand));
+    EXPECT_TRUE(f.has(frame_part::right_hand_world));
+    EXPECT_FALSE(f.has(frame_part::left_hand));
+    EXPECT_FALSE(f.has(frame_part::pose));
+    for (int k = 0; k < 21; ++k) {
+      const auto& p = image[n][static_cast<std::size_t>(k)];
+      const auto& q = world[n][static_cast<std::size_t>(k)];
+      EXPECT_NEAR(f.right_hand[k].x, p[0].get<double>() / w, 1e-6);
+      EXPECT_NEAR(f.right_hand[k].y, p[1].get<double>() / h, 1e-6);
+      EXPECT_NEAR(f.right_hand[k].z, p[2].get<double>() / w, 1e-6);
+      EXPECT_NEAR(f.right_hand_world[k].x, q[0].get<double>(), 1e-6);
+      EXPECT_NEAR(f.right_hand_world[k].z, q[2].get<double>(), 1e-6);
+    }
+    ++n;
+  }
+  EXPECT_EQ(n, image.size());
+  std::remove(path.c_str());
+}
+
 TEST(tfjs_import, rejects_bad_arguments_and_files) {
   const std::string out = temp_file("bad_import");
   EXPECT_FALSE(import_tfjs_pose("a", "b", 0, 10, 5, out).ok());

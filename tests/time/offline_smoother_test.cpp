@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <new>
+#include <random>
 #include <vector>
 
 #include "avatarmap/core/rotation.hpp"
@@ -166,7 +167,12 @@ TEST(OfflineSmoother, ZeroPhaseASineComesOutWithoutDelay) {
     p.rotations[k_arm] = about(glm::vec3(1.f, 0.f, 0.f), a);
     in.push_back(p);
   }
-  const auto out = run(in);
+  // The quadratic fit alone, at a body sigma of 0.1 s (the default is 0.15 s, and narrower on
+  // cleaner input: adapt_to_noise).
+  offline_smoother_options o;
+  o.body_sigma_seconds = 0.10f;
+  o.adapt_to_noise = false;
+  const auto out = run(in, o);
   ASSERT_EQ(out.size(), in.size());
   // Each peak of the output is at the input's peak frame (within one frame): 0.25 s + k s.
   for (int k = 1; k < 9; ++k) {
@@ -323,26 +329,130 @@ TEST(OfflineSmoother, LowConfidenceBoneFollowsItsMeasurement) {
   EXPECT_LT(worst, 10.f);
 }
 
-TEST(OfflineSmoother, HandFollowsItsArm) {
-  // The arm in a burst (confidence 0.1) and the hand model sure of itself (1): the fingers are
-  // filled from both sides like a gap, not taken from the unreliable hand points.
+// 150 frames of a still left index finger at `a`, with garbage rotations during frames 60-79
+// where `low_bone` has confidence 0.1 (the finger itself, or its lower arm).
+std::vector<proxy_pose> finger_burst(const glm::quat& a, int low_bone) {
   const int finger = idx(bone::left_index_proximal);
-  const glm::quat a = about(glm::vec3(0.f, 0.f, 1.f), 0.5f);
   std::vector<proxy_pose> in;
   for (int i = 0; i < 150; ++i) {
     proxy_pose p = frame_at(i);
     p.rotations[finger] = a;
     if (i >= 60 && i < 80) {
-      p.confidence[idx(bone::left_lower_arm)] = 0.1f;
+      p.confidence[low_bone] = 0.1f;
       p.rotations[finger] = about(glm::vec3(1.f, 0.f, 0.f), 1.5f);  // garbage
     }
     in.push_back(p);
   }
-  const auto out = run(in);
+  return in;
+}
+
+TEST(OfflineSmoother, BarelySeenFingersAreFilledNotSmoothed) {
+  // A hand whose own points are barely visible (confidence 0.1): its fingers are filled from
+  // both sides like a gap, not taken from the unreliable points (an arm at 0.1 is smoothed).
+  const int finger = idx(bone::left_index_proximal);
+  const glm::quat a = about(glm::vec3(0.f, 0.f, 1.f), 0.5f);
+  const auto out = run(finger_burst(a, finger));
+  for (int i = 60; i < 80; ++i) {
+    EXPECT_LT(degrees_between(out[i].rotations[finger], a), 0.01f) << i;
+    EXPECT_EQ(out[i].confidence[finger], 0.1f);  // the input's confidence is written unchanged
+  }
+}
+
+TEST(OfflineSmoother, HandFollowsItsArmWhenAsked) {
+  // hands_follow_arms (off by default: a close-up of a hand has a sure hand model and an arm
+  // the body model barely sees): the arm in a burst (0.1) caps the sure hand's fingers, which
+  // are then filled from both sides.
+  const int finger = idx(bone::left_index_proximal);
+  const glm::quat a = about(glm::vec3(0.f, 0.f, 1.f), 0.5f);
+  const std::vector<proxy_pose> in = finger_burst(a, idx(bone::left_lower_arm));
+  offline_smoother_options o;
+  o.hands_follow_arms = true;
+  const auto out = run(in, o);
+  const auto plain = run(in);
   for (int i = 60; i < 80; ++i) {
     EXPECT_LT(degrees_between(out[i].rotations[finger], a), 0.01f) << i;
     EXPECT_EQ(out[i].confidence[finger], 1.f);  // the input's confidence is written unchanged
   }
+  // Without it the sure hand is believed.
+  EXPECT_GT(degrees_between(plain[70].rotations[finger], a), 30.f);
+}
+
+TEST(OfflineSmoother, LowFrameRatesAreStillSmoothed) {
+  // 5 fps: a body sigma of 0.1 s is half a frame; the one-frame floor smooths
+  // alternating noise on a still arm, and a slow swing is kept.
+  const double fps = 5.0;
+  std::vector<proxy_pose> in;
+  for (int i = 0; i < 60; ++i) {
+    proxy_pose p = frame_at(i);
+    p.t = i / fps;
+    p.rotations[k_arm] = about(glm::vec3(1.f, 0.f, 0.f), (i % 2 ? 1.f : -1.f) * 0.1f);
+    in.push_back(p);
+  }
+  offline_smoother_options floor, no_floor;
+  floor.body_sigma_seconds = no_floor.body_sigma_seconds = 0.1f;
+  floor.adapt_to_noise = no_floor.adapt_to_noise = false;
+  no_floor.min_sigma_frames = 0.f;
+  const auto floored = run(in, floor), bare = run(in, no_floor);
+  const glm::quat still = identity_quat();
+  EXPECT_GT(degrees_between(bare[30].rotations[k_arm], still), 4.f);  // barely smoothed
+  EXPECT_LT(degrees_between(floored[30].rotations[k_arm], still), 2.f);
+  offline_smoother_options bad;
+  bad.min_sigma_frames = -1.f;
+  EXPECT_NE(bad.validate().message().find("min_sigma_frames"), std::string::npos);
+}
+
+TEST(OfflineSmoother, OneSidedKernelsDoNotExtrapolate) {
+  // At a segment's start the kernel sees only the future: a local quadratic fitted there
+  // weighs the first sample by more than 1 (and its neighbours negatively), so a first sample
+  // off by some angle would come out further off. It must not exceed its own error.
+  for (int gap : {0, 1}) {
+    SCOPED_TRACE(gap);
+    std::vector<proxy_pose> in;
+    const float amp = 0.1f;
+    for (int i = 0; i < 60; ++i) {
+      proxy_pose p = frame_at(i);
+      if (i == 0) p.rotations[k_arm] = about(glm::vec3(0.f, 1.f, 0.f), amp);
+      if (gap == 1 && i > 0 && i < 4) p.confidence[k_arm] = 0.f;  // and a hole after it
+      in.push_back(p);
+    }
+    const auto out = run(in);
+    EXPECT_LE(degrees_between(out[0].rotations[k_arm], identity_quat()), amp * 57.3f);
+  }
+}
+
+// A swing of the arm (peak speed 3 rad/s) plus Gaussian noise of `noise` radians per axis;
+// returns the mean error of the smoothed arm against the swing.
+float swing_error(float noise, bool adapt, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> n(0.f, 1.f);
+  auto truth = [](double t) { return about(glm::vec3(1.f, 0.f, 0.f), float(std::sin(3.0 * t))); };
+  std::vector<proxy_pose> in;
+  for (int i = 0; i < 600; ++i) {
+    proxy_pose p = frame_at(i);
+    const glm::vec3 e(n(rng), n(rng), n(rng));
+    p.rotations[k_arm] =
+        truth(p.t) * glm::quat(1.f, 0.5f * noise * e.x, 0.5f * noise * e.y, 0.5f * noise * e.z);
+    p.rotations[k_arm] = glm::normalize(p.rotations[k_arm]);
+    in.push_back(p);
+  }
+  offline_smoother_options o;
+  o.adapt_to_noise = adapt;
+  const auto out = run(in, o);
+  double sum = 0.0;
+  for (int i = 60; i < 540; ++i) sum += degrees_between(out[i].rotations[k_arm], truth(i / k_fps));
+  return float(sum / 480.0);
+}
+
+TEST(OfflineSmoother, AdaptsItsWidthToTheNoise) {
+  // Exact input: adapting narrows the kernels, so a fast swing keeps its peaks.
+  const float exact_fixed = swing_error(0.f, false, 1), exact_adapted = swing_error(0.f, true, 1);
+  EXPECT_LT(exact_adapted, 0.5f * exact_fixed);
+  EXPECT_LT(exact_adapted, 0.1f);
+  // Much noisier than the reference: never wider than the tuned sigmas (wider would flatten
+  // fast motion), so the same as without adapting.
+  EXPECT_FLOAT_EQ(swing_error(0.3f, true, 2), swing_error(0.3f, false, 2));
+  offline_smoother_options o;
+  EXPECT_TRUE(o.adapt_to_noise);  // the default
 }
 
 TEST(OfflineSmoother, TimeGoingBackStartsANewSegmentAndNothingMixes) {
@@ -392,8 +502,9 @@ TEST(OfflineSmoother, WindowIsBoundedAndNothingIsAllocatedPerFrame) {
   offline_smoother_options o;
   offline_smoother s(o);
   proxy_pose in = frame_at(0), out;
-  // The window at 30 fps: 1.5 s ahead + 3 sigma (0.6 s) behind + the centre.
-  const int bound = int(std::ceil((s.lookahead_seconds() + 3.0 * 0.2) * k_fps)) + 2;
+  // The window at 30 fps: 1.5 s ahead + at most as much behind (3 sigma of the widest kernel,
+  // which noise adaptation keeps within the lookahead) + the centre.
+  const int bound = int(std::ceil(2.0 * s.lookahead_seconds() * k_fps)) + 2;
   const long before = g_allocations.load();
   long popped = 0;
   int most = 0;

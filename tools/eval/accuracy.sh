@@ -6,12 +6,15 @@
 # Environment: AVATARMAP (the tool; default build/avatarmap beside this checkout),
 #   SECONDS_PER_RUN (default 20), FPS (default 30), SIZE (default 1280x720),
 #   FILTERS (default "default none": solve's defaults, and --filter none for comparison),
-#   KEEP (a folder to keep the files in; default: a temporary folder, removed).
+#   KEEP (a folder to keep the files in; default: a temporary folder, removed),
+#   SOLVE_ARGS (more options for every solve, e.g. "--smoothing 1.5").
 # For each seed and scenario (clean, noisy) it synthesises a recording with its truth, solves
-# it with each filter setting and prints one row of mean errors in degrees: bone directions
-# overall and per group, head orientation, and over the bones in low-visibility bursts
-# ("low-vis"; "-" when the recording has none). A last row per scenario and filter gives the
-# mean over the seeds. Needs python3 (to read eval-pose --json).
+# it with each filter setting and prints one row of mean errors in degrees ("-" where a
+# recording has no low-visibility burst). A last row per scenario and filter gives the mean
+# over the seeds. Columns: bone-direction error overall and per group, head orientation,
+# "body" (torso, arms and legs together), "lv-frame" (every bone on the frames with a
+# low-visibility burst) and "lv-bone" (the bones of the limbs in a burst only). Needs python3
+# (to read eval-pose --json).
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")/../.." && pwd)
@@ -39,8 +42,8 @@ else
   trap 'rm -rf "$work"' EXIT
 fi
 
-printf '%-6s %-6s %-8s %8s %8s %8s %8s %8s %8s %8s\n' seed scene filter overall torso arms \
-  legs fingers head low-vis
+printf '%-6s %-6s %-8s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n' seed scene filter overall torso arms \
+  legs fingers head body lv-frame lv-bone
 declare -A sums counts
 for scene in clean noisy; do
   for seed in "${seeds[@]}"; do
@@ -51,21 +54,24 @@ for scene in clean noisy; do
       args=()
       [ "$filter" = default ] || args=(--filter "$filter")
       "$exe" solve "$base.landmarks.jsonl" -o "$base.$filter.pose.jsonl" --quiet \
-        ${args[@]+"${args[@]}"} 2>/dev/null
+        ${args[@]+"${args[@]}"} ${SOLVE_ARGS:-} 2>/dev/null
       json=$("$exe" eval-pose "$base.truth.pose.jsonl" "$base.$filter.pose.jsonl" --json)
       row=$(python3 -c '
 import json, sys
-d = json.loads(sys.stdin.read()); a = d["all"]; m = d["marked"]
+d = json.loads(sys.stdin.read()); a = d["all"]; m = d["marked"]; lv = d["low_visibility"]
 v = [a[k]["mean"] for k in ("overall", "torso", "arms", "legs", "fingers", "head")]
-print(" ".join("%.4f" % x for x in v), "%.4f" % m["mean"] if m["count"] > 0 else "-")
+n = sum(a[k]["count"] for k in ("torso", "arms", "legs"))
+v.append(sum(a[k]["mean"] * a[k]["count"] for k in ("torso", "arms", "legs")) / max(n, 1))
+f = lambda s, ok: "%.4f" % s if ok else "-"
+print(" ".join("%.4f" % x for x in v), f(lv["overall"]["mean"], lv["overall"]["count"] > 0),
+      f(m["mean"], m["count"] > 0))
 ' <<<"$json")
-      read -r o t a l f h m <<<"$row"
-      lv=$m
-      [ "$m" = - ] || lv=$(printf '%.2f' "$m")
-      printf '%-6s %-6s %-8s %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8s\n' "$seed" "$scene" \
-        "$filter" "$o" "$t" "$a" "$l" "$f" "$h" "$lv"
+      read -r o t a l f h body lf m <<<"$row"
+      fmt() { [ "$1" = - ] && echo - || printf '%.2f' "$1"; }
+      printf '%-6s %-6s %-8s %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8s %8s\n' "$seed" "$scene" \
+        "$filter" "$o" "$t" "$a" "$l" "$f" "$h" "$body" "$(fmt "$lf")" "$(fmt "$m")"
       key="$scene $filter"
-      vals=("$o" "$t" "$a" "$l" "$f" "$h" "$m")
+      vals=("$o" "$t" "$a" "$l" "$f" "$h" "$body" "$lf" "$m")
       for i in "${!vals[@]}"; do
         [ "${vals[$i]}" = - ] && continue
         sums[$key.$i]=$(awk -v x="${sums[$key.$i]:-0}" -v y="${vals[$i]}" 'BEGIN{print x + y}')
@@ -76,7 +82,7 @@ print(" ".join("%.4f" % x for x in v), "%.4f" % m["mean"] if m["count"] > 0 else
   for filter in $filters; do
     key="$scene $filter"
     means=()
-    for i in 0 1 2 3 4 5 6; do
+    for i in 0 1 2 3 4 5 6 7 8; do
       if [ -n "${counts[$key.$i]:-}" ]; then
         means+=("$(awk -v x="${sums[$key.$i]}" -v n="${counts[$key.$i]}" \
           'BEGIN{printf "%.2f", x / n}')")
@@ -84,8 +90,7 @@ print(" ".join("%.4f" % x for x in v), "%.4f" % m["mean"] if m["count"] > 0 else
         means+=(-)
       fi
     done
-    printf '%-6s %-6s %-8s %8s %8s %8s %8s %8s %8s %8s\n' mean "$scene" "$filter" \
-      "${means[0]}" "${means[1]}" "${means[2]}" "${means[3]}" "${means[4]}" "${means[5]}" \
-      "${means[6]}"
+    printf '%-6s %-6s %-8s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n' mean "$scene" "$filter" \
+      "${means[@]}"
   done
 done

@@ -1,5 +1,6 @@
 // Import of the TensorFlow.js pose-detection test recordings (tfjs-models, e.g.
-// pose_squats.full.json + pose_squats_3d.full.json) into a *.landmarks.jsonl file.
+// pose_squats.full.json + pose_squats_3d.full.json, or a hand recording) into a
+// *.landmarks.jsonl file.
 #pragma once
 
 #include <string>
@@ -19,6 +20,14 @@ namespace avatarmap {
 /// image_width/image_height/fps are not positive.
 status import_tfjs_pose(const std::string& image_json, const std::string& world_json,
                         int image_width, int image_height, double fps,
+                        const std::string& out_landmarks_path);
+
+/// The same for a hand recording of tfjs-models' hand-pose-detection tests (e.g.
+/// asl_hand.full.json + asl_hand_3d.full.json): frames of 21 points, written as the left or
+/// the right hand (`left`; the files do not say which) with its world points (metres). The
+/// errors are those of import_tfjs_pose, with 21 points per frame.
+status import_tfjs_hand(const std::string& image_json, const std::string& world_json,
+                        int image_width, int image_height, double fps, bool left,
                         const std::string& out_landmarks_path);
 
 }  // namespace avatarmap

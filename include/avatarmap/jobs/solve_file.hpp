@@ -79,6 +79,12 @@ struct solve_file_summary {
   bool image_size_assumed = false;  // neither the job nor the file gave one: square pixels
   float hips_height_min = 0.f;      // range of the filtered hips_position.y (metres)
   float hips_height_max = 0.f;
+  /// The camera's horizontal field of view solved with (degrees): the option when given, else
+  /// the solver's estimate from the pose at the end of the run (fov_estimated), from
+  /// fov_evidence_frames frames (0: the pose told nothing and 60 degrees was assumed).
+  float horizontal_fov_degrees = 0.f;
+  bool fov_estimated = false;
+  long fov_evidence_frames = 0;
   /// Why the run failed (none on success).
   job_failure failure = job_failure::none;
 };

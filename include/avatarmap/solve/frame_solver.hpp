@@ -59,6 +59,13 @@ class frame_solver {
 
   const solver_options& options() const { return options_; }
 
+  /// The horizontal field of view in use (degrees): options().horizontal_fov_degrees when
+  /// given, else the estimate so far (60 before any evidence).
+  float horizontal_fov_degrees() const;
+  /// Frames whose pose told something about the field of view (0 when it was given, or when
+  /// no frame's image and world points formed one pinhole view, e.g. MediaPipe's own output).
+  long fov_evidence_frames() const { return focal_frames_; }
+
  private:
   // The gate stage (src/solve/solve_gate.cpp): this frame's measurement -> what is shown.
   void gate_bones(const frame_measurement& m, double t, proxy_pose& out);
@@ -66,9 +73,16 @@ class frame_solver {
   void gate_expressions(const frame_measurement& m, double t,
                         std::array<float, k_expression_count>& out);
   const glm::quat& previous_world(int b) const;
+  // Adds this frame's evidence on the focal length (horizontal_fov_degrees 0 only).
+  void update_focal(const landmark_frame& in);
 
   solver_options options_;
   float focal_per_width_ = 1.f;  // focal length / image width, from the field of view
+  // Field of view estimated from the pose (horizontal_fov_degrees 0): the information-weighted
+  // sum of the frames' focal lengths with a prior (src/solve/solve_camera.hpp).
+  double focal_information_ = 0.0;
+  double focal_weighted_sum_ = 0.0;
+  long focal_frames_ = 0;
   std::array<rotation_gate, k_bone_count> bones_{};           // output = the local rotation shown
   mutable std::array<glm::quat, k_bone_count> prev_world_{};  // memo of previous_world()
   mutable std::array<unsigned, k_bone_count> world_stamp_{};

@@ -46,9 +46,12 @@ struct solver_options {
   /// Share (0..1) of the wrist's twist about the forearm moved from the hand to the lower arm
   /// (the forearm's radius and ulna do most of the turning).
   float forearm_twist_share = 0.6f;
-  /// Horizontal field of view of the camera in degrees; used only to turn the person's image
-  /// scale into depth for hips_position X/Z.
-  float horizontal_fov_degrees = 60.f;
+  /// Horizontal field of view of the camera in degrees: it undoes the perspective of a face
+  /// seen off the optical axis (the head's rotation) and turns the person's image scale into
+  /// depth (hips_position X/Z). 0 (the default) = unknown: estimated over the take from the
+  /// pose's image and world points (needs image_width/height; 60 degrees until the pose has
+  /// told better, and without a size or world points).
+  float horizontal_fov_degrees = 0.f;
   /// Hips height used while the legs have never been seen (metres).
   float rest_hips_height = 0.95f;
 
@@ -69,8 +72,9 @@ struct solver_options {
       return status::error("confidence hold/ease/regain seconds must be finite and >= 0");
     if (bad01(hips_lean_share)) return status::error("hips_lean_share must be in [0, 1]");
     if (bad01(forearm_twist_share)) return status::error("forearm_twist_share must be in [0, 1]");
-    if (!(horizontal_fov_degrees > 1.f && horizontal_fov_degrees < 179.f))
-      return status::error("horizontal_fov_degrees must be in (1, 179)");
+    if (!(horizontal_fov_degrees == 0.f ||
+          (horizontal_fov_degrees > 1.f && horizontal_fov_degrees < 179.f)))
+      return status::error("horizontal_fov_degrees must be 0 (estimate) or in (1, 179)");
     if (!(rest_hips_height > 0.f && rest_hips_height < 10.f))
       return status::error("rest_hips_height must be in (0, 10) metres");
     return {};

@@ -63,6 +63,9 @@ struct pose_accuracy {
   accuracy_figures all;             // every frame
   accuracy_figures low_visibility;  // low-visibility frames only
   angle_stats marked;               // marked bones only (bone directions)
+  /// Per bone over every frame: the direction error (head: its orientation error; eyes and
+  /// jaw stay empty). For finding which bone a group's figure comes from.
+  std::array<angle_stats, k_bone_count> bones;
 };
 
 /// Adds one frame (truth and solved at the same time) to `acc`. Non-finite or zero

@@ -26,9 +26,10 @@ namespace avatarmap {
 
 struct random_motion_options {
   /// Ranges of the key poses (random_pose()). The defaults here differ from
-  /// random_pose_limits' in three fields: finger_side_bend 10 degrees (non-hinge fingers),
-  /// coupled_deviation 2 degrees (the spine bends as one, the neck turns with the head) and
-  /// hips_xz_range 0.15 m (the person stays near the spot the camera is aimed at).
+  /// random_pose_limits' in these fields: finger_side_bend 10 degrees (non-hinge fingers),
+  /// coupled_deviation 2 degrees (the spine bends as one, the neck turns with the head),
+  /// pelvis_share 0.3-0.7 (a lean is shared by the pelvis and the spine, the lumbopelvic
+  /// rhythm) and hips_xz_range 0.15 m (the person stays near the spot the camera is aimed at).
   random_pose_limits limits = default_limits();
   /// Top speed of arms and fingers (rad/s, > 0).
   float max_wrist_speed = 6.f;
@@ -37,6 +38,8 @@ struct random_motion_options {
     random_pose_limits l;
     l.finger_side_bend = 10.f;
     l.coupled_deviation = 2.f;
+    l.pelvis_share_min = 0.3f;
+    l.pelvis_share_max = 0.7f;
     l.hips_xz_range = 0.15f;
     return l;
   }

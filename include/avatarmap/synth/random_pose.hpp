@@ -58,6 +58,16 @@ struct random_pose_limits {
   /// part no landmark can tell apart). Negative (the default): the five are drawn
   /// independently, as before.
   float coupled_deviation = -1.f;
+  /// Lumbopelvic rhythm (only with coupled_deviation >= 0): when pelvis_share_max > 0, a
+  /// person leans as a whole: one lean (about X and Z, each in +-hips_lean) is split between
+  /// the pelvis, which takes a share drawn in [pelvis_share_min, pelvis_share_max], and the
+  /// spine, chest and upperChest, which take a third each of the rest; on top of that the
+  /// spine chain's shared rotation keeps its twist (+-spine about Y) and only +-spine_free_lean
+  /// per axis of lean of its own. 0 (the default): the hips lean and the spine bend are drawn
+  /// independently, as before.
+  float pelvis_share_min = 0.f;
+  float pelvis_share_max = 0.f;
+  float spine_free_lean = 5.f;
   float eye_yaw = 25.f;
   float eye_pitch = 15.f;
   bool fingers = true;      // else finger bones stay at rest

@@ -54,13 +54,28 @@ struct offline_smoother_options {
   /// Scale on every sigma below (the CLI's --smoothing). 0 = no smoothing (gap filling only).
   float strength = 1.f;
   /// Gaussian sigma for torso, head, eyes, jaw, arms, legs.
-  float body_sigma_seconds = 0.10f;
+  float body_sigma_seconds = 0.15f;
   /// Gaussian sigma for the 30 finger bones (5 mm of landmark noise on 2-4 cm bones).
-  float finger_sigma_seconds = 0.20f;
+  float finger_sigma_seconds = 0.30f;
   /// Gaussian sigma for the hips position.
   float position_sigma_seconds = 0.05f;
   /// Gaussian sigma for the expression weights.
   float expression_sigma_seconds = 0.03f;
+  /// Least sigma in frame intervals (of the frames around the centre), for every sigma above
+  /// while strength > 0: at a low frame rate a sigma of a fraction of a frame would smooth
+  /// nothing (5 fps video: 0.1 s is half a frame). 1 frame keeps 30 fps unchanged (its sigmas
+  /// are 1.5-6 frames, the expressions' 0.9) and gives 0.2 s at 5 fps. Capped at a third of
+  /// the lookahead (the kernel's reach must fit the window). 0 = no floor.
+  float min_sigma_frames = 1.f;
+  /// Noise-adaptive widths: the sigmas above are for the noise of the synthetic "noisy"
+  /// scenario at 30 fps (10 mm body, 5 mm hand points); each group's (body, fingers) sigma is
+  /// scaled by (noise density / that reference)^(1/7), the rate at which a local quadratic's
+  /// best width grows with its noise, clamped to [1/4, 3/2] (wider would flatten fast motion). The
+  /// noise is measured on the input as it streams (second differences of the observed bones'
+  /// rotations, a running mean over ~4 s) and its density is per-sample noise^2 / frame rate, so
+  /// exact landmarks are barely smoothed and noisier capture is smoothed more. false = the sigmas
+  /// as given.
+  bool adapt_to_noise = true;
   /// Rotations: 0 = Gaussian-weighted mean; 2 = local quadratic regression with the same
   /// weights (keeps the peaks of fast motion; see docs/smoothing.md).
   int degree = 2;
@@ -69,7 +84,7 @@ struct offline_smoother_options {
   /// A hand and its fingers count as observed only as far as their lower arm is: hand
   /// landmarks are found in a crop placed by the body's wrist, so when the body model marks the
   /// arm as barely visible the hand's points are unreliable even when the hand model is sure.
-  bool hands_follow_arms = true;
+  bool hands_follow_arms = false;
   /// Bones seen with a low confidence of their own (0 < confidence < observed_above):
   /// smoothed with this sigma, every frame weighted by its confidence, instead of filled.
   /// 0 = fill them as gaps.
@@ -84,7 +99,8 @@ struct offline_smoother_options {
   int capacity_frames = 256;
 
   /// Checks every field: strength and sigmas finite and >= 0 (sigmas > 0), observed_above in
-  /// [0, 1], times finite and >= 0 (max_gap, hold, ease at most 60 s), capacity_frames in
+  /// [0, 1], times finite and >= 0 (max_gap, hold, ease at most 60 s), min_sigma_frames in
+  /// [0, 10], capacity_frames in
   /// [8, 65536]. The message names the field and its range.
   status validate() const;
 };
@@ -144,6 +160,14 @@ class offline_smoother {
   offline_smoother_options options_;
   double lookahead_ = 0.0;
   double past_seconds_ = 0.0;  // history kept behind the centre (3 sigma)
+  double sigma_floor_ = 0.0;   // min_sigma_frames x the last centre's frame interval (capped)
+  double sigma_widest_ = 0.0;  // widest adapted sigma used at the last centre
+  void observe_noise() noexcept;
+  // Running mean of the second differences' size per group (body, fingers), radians per
+  // sample, and of the frame interval; weights (seconds of evidence, capped).
+  std::array<double, 2> noise_{};
+  double noise_dt_ = 0.0;
+  double noise_weight_ = 0.0;
   int capacity_ = 0;
   std::unique_ptr<slot[]> slots_;
   std::unique_ptr<float[]> kernel_storage_;      // the tables' w and u, capacity_ each

@@ -254,7 +254,9 @@ typedef struct avm_solver_options {
   float confidence_regain_seconds; /* a found bone blends in over this long; 0.15 */
   float hips_lean_share;           /* [0, 1] share of the torso lean given to the hips; 0.5 */
   float forearm_twist_share;       /* [0, 1] share of wrist twist moved to the forearm; 0.6 */
-  float horizontal_fov_degrees;    /* camera's horizontal field of view, (1, 179); 60 */
+  float horizontal_fov_degrees;    /* camera's horizontal field of view, (1, 179), or 0 (the
+                                      default): estimated from the pose's image and world points
+                                      (needs the image size; 60 until the pose tells better) */
   float rest_hips_height;          /* metres, (0, 10), used while legs were never seen; 0.95 */
 
   /* -- One Euro filter applied to each solved pose (avm_solver_push, avm_solve_file);

@@ -1,0 +1,118 @@
+// Stage 1b of the solver: focal length from the body's image and world points. See
+// solve_camera.hpp.
+#include "solve/solve_camera.hpp"
+
+#include <cmath>
+
+#include "solve/solve_prepare.hpp"
+
+namespace avatarmap::solve_detail {
+namespace {
+
+// Fewest confident points for a fit (two equations each, four unknowns): a fit through a
+// handful of points is dominated by their noise.
+constexpr int k_min_points = 8;
+// Plausible focal lengths, as a multiple of the image width: fields of view from ~19 to
+// ~112 degrees. Estimates outside are dropped (a frame whose world and image points disagree).
+constexpr double k_min_focal_per_width = 0.3;
+constexpr double k_max_focal_per_width = 3.0;
+// Nearest plausible camera (metres from the hips).
+constexpr double k_min_depth = 0.2;
+// Largest residual standard deviation (as a fraction of the image width) of a frame whose
+// image and world points are one pinhole view. Exact or 3-D-noisy points fit to well under a
+// pixel; independent noise of ~10 mm on image and world points at 1.5-4 m is ~0.3 % of the
+// width; MediaPipe's own world points disagree with its image points by ~2 % (its world model
+// is a separate regression, not a projection), so real video keeps the prior.
+constexpr double k_max_residual_per_width = 0.01;
+// Least residual standard deviation assumed (pixels): exact synthetic points would otherwise
+// claim infinite information.
+constexpr double k_min_residual_px = 0.5;
+
+// Solves the 4x4 system a x = b in place (Gaussian elimination with partial pivoting);
+// false when singular.
+bool solve4(double a[4][4], double b[4], double x[4]) {
+  int row[4] = {0, 1, 2, 3};
+  for (int c = 0; c < 4; ++c) {
+    int best = c;
+    for (int r = c + 1; r < 4; ++r)
+      if (std::fabs(a[row[r]][c]) > std::fabs(a[row[best]][c])) best = r;
+    std::swap(row[c], row[best]);
+    const double p = a[row[c]][c];
+    if (!(std::fabs(p) > 1e-12)) return false;
+    for (int r = c + 1; r < 4; ++r) {
+      const double k = a[row[r]][c] / p;
+      for (int j = c; j < 4; ++j) a[row[r]][j] -= k * a[row[c]][j];
+      b[row[r]] -= k * b[row[c]];
+    }
+  }
+  for (int c = 3; c >= 0; --c) {
+    double s = b[row[c]];
+    for (int j = c + 1; j < 4; ++j) s -= a[row[c]][j] * x[j];
+    x[c] = s / a[row[c]][c];
+  }
+  return true;
+}
+
+}  // namespace
+
+focal_evidence estimate_focal(const landmark_frame& in, float width, float height,
+                              float min_confidence) {
+  focal_evidence e;
+  if (!in.has(frame_part::pose) || !in.has(frame_part::pose_world) || !(width > 0.f) ||
+      !(height > 0.f))
+    return e;
+  // Normal equations of the unknowns (Tz, f, f Tx, f Ty), rows [du, -X, -1, 0] and
+  // [dv, -Y, 0, -1] with right-hand sides -du Z and -dv Z.
+  double n[4][4] = {}, r[4] = {};
+  double rows[2 * k_pose_landmark_count][5];
+  int m = 0;
+  for (int i = 0; i < k_pose_landmark_count; ++i) {
+    const landmark& p = in.pose[i];
+    const landmark& w = in.pose_world[i];
+    if (std::min(landmark_confidence(p), landmark_confidence(w)) < min_confidence) continue;
+    const double du = (double(p.x) - 0.5) * width, dv = (double(p.y) - 0.5) * height;
+    const double eq[2][5] = {{du, -double(w.x), -1.0, 0.0, -du * w.z},
+                             {dv, -double(w.y), 0.0, -1.0, -dv * w.z}};
+    for (const auto& q : eq) {
+      for (int j = 0; j < 5; ++j) rows[m][j] = q[j];
+      ++m;
+    }
+  }
+  if (m < 2 * k_min_points) return e;
+  for (int k = 0; k < m; ++k)
+    for (int i = 0; i < 4; ++i) {
+      for (int j = 0; j < 4; ++j) n[i][j] += rows[k][i] * rows[k][j];
+      r[i] += rows[k][i] * rows[k][4];
+    }
+  double a[4][4], b[4], x[4];
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) a[i][j] = n[i][j];
+    b[i] = r[i];
+  }
+  if (!solve4(a, b, x)) return e;
+  const double tz = x[0], f = x[1];
+  if (!(tz > k_min_depth) || !(f > k_min_focal_per_width * width) ||
+      !(f < k_max_focal_per_width * width))
+    return e;
+  // Residual variance, in pixels^2 at the hips' depth (the equations are in pixels x metres).
+  double rss = 0.0;
+  for (int k = 0; k < m; ++k) {
+    double s = -rows[k][4];
+    for (int j = 0; j < 4; ++j) s += rows[k][j] * x[j];
+    rss += s * s;
+  }
+  const double residual2 = rss / double(m - 4) / (tz * tz);
+  const double max_residual = k_max_residual_per_width * width;
+  if (!(residual2 <= max_residual * max_residual)) return e;
+  const double sigma2 = std::max(residual2, k_min_residual_px * k_min_residual_px);
+  // Variance of f: sigma^2 (N^-1)_ff, with N scaled to pixels (divide the equations by Tz).
+  double unit[4] = {0.0, 1.0, 0.0, 0.0}, col[4];
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) a[i][j] = n[i][j] / (tz * tz);
+  if (!solve4(a, unit, col) || !(col[1] > 0.0)) return e;
+  e.focal = f;
+  e.information = 1.0 / (sigma2 * col[1]);
+  return e;
+}
+
+}  // namespace avatarmap::solve_detail
