@@ -264,8 +264,8 @@ typedef struct avm_solver_options {
    *    betas finite, >= 0 (rotation: seconds per radian, position: seconds per metre,
    *    expressions: seconds per unit weight). -- */
   int32_t filter_rotations;    /* filter the bone rotations; 1 */
-  float rotation_min_cutoff;   /* 1.5 */
-  float rotation_beta;         /* 0.5 */
+  float rotation_min_cutoff;   /* 0.7 (plus pose_filter.hpp's 3/4-lag extrapolation) */
+  float rotation_beta;         /* 0.3 */
   float rotation_d_cutoff;     /* cutoff of the speed estimate; 1.0 */
   int32_t filter_position;     /* filter hips_position; 1 */
   float position_min_cutoff;   /* 1.0 */
