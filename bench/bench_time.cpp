@@ -1,13 +1,18 @@
 // Time filtering and resampling (avatarmap/time/*): cost per frame of pose_filter on a full
 // proxy_pose (55 rotations + hips + 16 expressions), landmark_filter on a full frame
-// (33 + 33 + 4 x 21 + 478 points), and pose_resampler::sample() (interpolating and
-// extrapolating), with a proxy_pose copy as the floor.
+// (33 + 33 + 4 x 21 + 478 points), offline_smoother (push + pop) on solved poses of the
+// synthetic noisy scenario, and pose_resampler::sample() (interpolating and extrapolating),
+// with a proxy_pose copy as the floor.
 #include <benchmark/benchmark.h>
 
 #include <cstring>
 #include <memory>
 #include <random>
+#include <vector>
 
+#include "avatarmap/solve/frame_solver.hpp"
+#include "avatarmap/synth/synth_recording.hpp"
+#include "avatarmap/time/offline_smoother.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
 
@@ -89,6 +94,51 @@ void bm_landmark_filter_apply(benchmark::State& state) {
   state.counters["points"] = 2 * 33 + 4 * 21 + 478;
 }
 BENCHMARK(bm_landmark_filter_apply);
+
+// 20 s of the noisy scenario at 30 fps (noise, low-visibility bursts that leave gaps) solved
+// as `solve` does for the offline smoother (the smoother, not the causal gate, decides what
+// was observed).
+const std::vector<proxy_pose>& solved_noisy_poses() {
+  static const std::vector<proxy_pose> poses = [] {
+    const synth_options so = synth_scenario_options(synth_scenario::noisy, 7);
+    synth_recording rec(so);
+    solver_options o;
+    o.image_width = static_cast<float>(so.image_width);
+    o.image_height = static_cast<float>(so.image_height);
+    o.confidence.lost_below = 0.f;
+    o.confidence.found_above = 0.f;
+    frame_solver solver(o);
+    auto frame = std::make_unique<landmark_frame>();
+    proxy_pose truth, solved;
+    std::vector<proxy_pose> out;
+    for (int i = 0; i < 600; ++i) {
+      rec.generate(i / 30.0, truth, *frame);
+      solver.solve(*frame, solved);
+      out.push_back(solved);
+    }
+    return out;
+  }();
+  return poses;
+}
+
+// One pose in, one out (the window full): arg 1 = noise-adaptive widths (the default), 0 =
+// the sigmas as given.
+void bm_offline_smoother(benchmark::State& state) {
+  const std::vector<proxy_pose>& poses = solved_noisy_poses();
+  offline_smoother_options o;
+  o.adapt_to_noise = state.range(0) != 0;
+  offline_smoother s(o);
+  proxy_pose in, out;
+  long i = 0;
+  for (auto _ : state) {
+    in = poses[static_cast<size_t>(i % static_cast<long>(poses.size()))];
+    in.t = static_cast<double>(i++) / 30.0;
+    s.push(in);
+    while (s.pop(out)) benchmark::DoNotOptimize(out);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(bm_offline_smoother)->Arg(1)->Arg(0)->ArgName("adapt");
 
 void bm_resampler_push(benchmark::State& state) {
   pose_cycle c;

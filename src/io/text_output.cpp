@@ -1,5 +1,6 @@
 #include "io/text_output.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,7 +11,23 @@ namespace avatarmap::io_detail {
 
 namespace {
 constexpr std::size_t k_buffer_size = std::size_t{1} << 20;
+
+// Asks the kernel to start writing `n` bytes at `offset` of `fd` to the disk now, without
+// waiting (Linux; elsewhere nothing): commit()'s fsync then waits for the last buffer rather
+// than for the whole file (~30 ms for a 67 MB pose file), and the disk works while the
+// command computes. Advisory: a failure (a pipe, a file system without it) is ignored; write
+// errors still surface at write() or fsync.
+void start_writeback(int fd, unsigned long long offset, std::size_t n) {
+#if defined(__linux__)
+  (void)::sync_file_range(fd, static_cast<off_t>(offset), static_cast<off_t>(n),
+                          SYNC_FILE_RANGE_WRITE);
+#else
+  (void)fd;
+  (void)offset;
+  (void)n;
+#endif
 }
+}  // namespace
 
 text_output::~text_output() { discard(); }
 
@@ -26,6 +43,7 @@ status text_output::open(const std::string& path) {
   failed_ = false;
   error_.clear();
   pos_ = 0;
+  written_ = 0;
   if (path == "-") {
     is_stdout_ = true;
   } else if (status s = file_.open(path); !s) {
@@ -53,6 +71,9 @@ bool text_output::flush() {
     failed_ = true;  // file_ has removed its temporary file already
     error_ = s.message();
     return false;
+  } else {
+    start_writeback(file_.fd(), written_, pos_);
+    written_ += pos_;
   }
   pos_ = 0;
   return true;

@@ -3,9 +3,10 @@
 // fsynced and renamed over PATH by commit(), the replaced file's mode kept, removed on
 // failure and on SIGINT/SIGTERM). Destroying an uncommitted output removes the temporary
 // file and leaves PATH untouched. "-" writes to standard output (not atomic; commit() only
-// flushes). Numbers are written as the shortest text that reads back to the same value
-// (std::to_chars's characters; floats through float_text.hpp, which is faster); non-finite
-// numbers are written as null.
+// flushes). Each buffer written to a file is handed to the disk at once (sync_file_range on
+// Linux), so that commit()'s fsync finds little left to write. Numbers are written as the
+// shortest text that reads back to the same value (std::to_chars's characters; floats through
+// float_text.hpp, which is faster); non-finite numbers are written as null.
 #pragma once
 
 #include <charconv>
@@ -94,6 +95,7 @@ class text_output {
   std::string error_;
   std::vector<char> buf_;
   std::size_t pos_ = 0;
+  unsigned long long written_ = 0;  // bytes flushed to the file so far
 };
 
 }  // namespace avatarmap::io_detail

@@ -13,13 +13,18 @@ namespace avatarmap::jobs_detail {
 class frame_prefetcher {
  public:
   /// Takes over an opened reader. When stop_at_error, reading stops after the first
-  /// malformed line (it is still delivered, as an error).
-  frame_prefetcher(landmark_reader& reader, bool stop_at_error, int capacity = 64)
-      : ring_(capacity, [&reader, stop_at_error](slot& s) {
-          s.kind = reader.next(s.frame);
-          if (s.kind == read_result::error) s.error = reader.error();
-          return !(s.kind == read_result::end || (s.kind == read_result::error && stop_at_error));
-        }) {}
+  /// malformed line (it is still delivered, as an error). Frames are handed over `batch` at a
+  /// time (prefetch_ring.hpp): one wake-up of the caller per batch, not per frame.
+  frame_prefetcher(landmark_reader& reader, bool stop_at_error, int capacity = 64, int batch = 16)
+      : ring_(
+            capacity,
+            [&reader, stop_at_error](slot& s) {
+              s.kind = reader.next(s.frame);
+              if (s.kind == read_result::error) s.error = reader.error();
+              return !(s.kind == read_result::end ||
+                       (s.kind == read_result::error && stop_at_error));
+            },
+            batch) {}
 
   /// Waits for the next item. For read_result::frame, `frame()` is valid until release();
   /// for read_result::error, `error()` says what and where. read_result::end ends the stream.

@@ -3,10 +3,21 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
 
 #include "avatarmap/core/rotation.hpp"
 #include "avatarmap/solve/confidence_gate.hpp"
+
+// smooth_rotations works on 4 bones at once in the compilers' vector type where there is one
+// (GCC, Clang: SSE2 on every x86-64 processor, NEON on ARM), else on plain arrays. Each lane
+// does the same IEEE operations as scalar code would, so the results do not depend on it.
+#if defined(__GNUC__) || defined(__clang__)
+#define AVATARMAP_SMOOTHER_VECTORS 1
+#else
+#define AVATARMAP_SMOOTHER_VECTORS 0
+#endif
 
 namespace avatarmap {
 
@@ -20,6 +31,18 @@ constexpr bool hand_or_finger(int b) {
   return b >= k_first_finger || b == idx(bone::left_hand) || b == idx(bone::right_hand);
 }
 constexpr int k_fingers_per_hand = 15;
+// Body bones (torso, head, limbs) and fingers: kernel tables 0 and 1, with their own sigmas.
+constexpr int group_of(int b) { return b >= k_first_finger ? 1 : 0; }
+// Index of the lowest set bit of x != 0.
+inline int lowest_bit(std::uint64_t x) {
+#if defined(__GNUC__) || defined(__clang__)
+  return __builtin_ctzll(x);
+#else
+  int i = 0;
+  while (!((x >> i) & 1u)) ++i;
+  return i;
+#endif
+}
 // Noise adaptation (offline_smoother_options::adapt_to_noise): the mean size of the observed
 // bones' second differences (radians per sample) of the reference recordings the sigmas were
 // tuned on (the synthetic noisy scenario without bursts, 30 fps, tuning seeds 1-3), per group
@@ -32,6 +55,19 @@ constexpr double k_min_noise_factor = 0.25, k_max_noise_factor = 1.0;
 constexpr float k_max_gap_option_seconds = 60.f;
 constexpr int k_min_capacity = 8;
 constexpr int k_max_capacity = 65536;
+// smooth_rotations computes k_lanes bones at once. Their values are kept apart from the poses
+// (offline_smoother::lanes_), by blocks of k_lanes bones: for block B and the pose in slot s,
+// the rows of lane_row one after the other, k_lanes floats each, at ((B x capacity) + s) x
+// k_block_floats, so that one block's rows of successive poses are next to each other in
+// memory (the order smooth_rotations reads them in).
+constexpr int k_lanes = 4;
+constexpr int k_padded_bones = (k_bone_count + k_lanes - 1) / k_lanes * k_lanes;
+constexpr int k_lane_blocks = k_padded_bones / k_lanes;
+// The rotations' x, y, z, w (padding: identity), the weights and the weights where they count
+// as observed (weight >= observed_above, else 0); padding 0.
+enum lane_row { k_row_x, k_row_y, k_row_z, k_row_w, k_row_weight, k_row_observed, k_row_count };
+constexpr int k_block_floats = k_row_count * k_lanes;
+static_assert(k_bone_count <= 64, "slot::ones is one bit per bone");
 
 bool finite_at_least(float v, float lo) { return std::isfinite(v) && v >= lo; }
 
@@ -91,6 +127,9 @@ struct offline_smoother::slot {
   std::array<float, k_bone_count> weight;
   int segment = 0;
   bool position_ok = true;
+  int index = 0;                    // in slots_ (and in lanes_)
+  std::uint64_t observed_bits = 0;  // bit b: weight[b] >= observed_above
+  std::uint64_t ones = 0;           // bit b: weight[b] is exactly 1
 };
 
 offline_smoother::offline_smoother(const offline_smoother_options& options) : options_(options) {
@@ -107,12 +146,16 @@ offline_smoother::offline_smoother(const offline_smoother_options& options) : op
   if (!std::isfinite(lookahead_)) lookahead_ = 0.0;
   capacity_ = options_.capacity_frames;
   slots_.reset(new slot[static_cast<size_t>(capacity_)]);
-  kernel_storage_.reset(new float[static_cast<size_t>(2 * k_table_count * capacity_)]);
-  slot_storage_.reset(new const slot*[static_cast<size_t>(k_table_count * capacity_)]);
+  for (int i = 0; i < capacity_; ++i) slots_[static_cast<size_t>(i)].index = i;
+  lanes_.reset(new float[static_cast<size_t>(k_lane_blocks) * static_cast<size_t>(capacity_) *
+                         k_block_floats]);
+  kernel_storage_.reset(new float[static_cast<size_t>(3 * k_table_count * capacity_)]);
+  index_storage_.reset(new int[static_cast<size_t>(k_table_count * capacity_)]);
   for (int t = 0; t < k_table_count; ++t) {
-    tables_[t].w = kernel_storage_.get() + 2 * t * capacity_;
+    tables_[t].w = kernel_storage_.get() + 3 * t * capacity_;
     tables_[t].u = tables_[t].w + capacity_;
-    tables_[t].slots = slot_storage_.get() + t * capacity_;
+    tables_[t].coefficient = tables_[t].u + capacity_;
+    tables_[t].index = index_storage_.get() + t * capacity_;
   }
   reset();
 }
@@ -133,6 +176,15 @@ void offline_smoother::reset() noexcept {
   last_good_.fill(identity_quat());
   last_good_t_.fill(0.0);
   last_good_segment_.fill(-1);
+}
+
+float* offline_smoother::lanes_of_block(int block) const noexcept {
+  return lanes_.get() + static_cast<size_t>(block) * static_cast<size_t>(capacity_) *
+                            static_cast<size_t>(k_block_floats);
+}
+
+float* offline_smoother::lanes_of(const slot& s, int block) const noexcept {
+  return lanes_of_block(block) + static_cast<size_t>(s.index) * k_block_floats;
 }
 
 offline_smoother::slot& offline_smoother::at(int i) const noexcept {
@@ -175,6 +227,22 @@ bool offline_smoother::push(const proxy_pose& in) noexcept {
     cap(bone::right_lower_arm, bone::right_hand, bone::right_thumb_metacarpal);
   }
   s.position_ok = is_finite(in.hips_position);
+  s.ones = s.observed_bits = 0;
+  for (int b = 0; b < k_padded_bones; ++b) {
+    const bool real = b < k_bone_count;
+    const glm::quat q = real ? s.pose.rotations[b] : identity_quat();
+    const float w = real ? s.weight[b] : 0.f;
+    float* lane = lanes_of(s, b / k_lanes) + b % k_lanes;
+    lane[k_row_x * k_lanes] = q.x;
+    lane[k_row_y * k_lanes] = q.y;
+    lane[k_row_z * k_lanes] = q.z;
+    lane[k_row_w * k_lanes] = q.w;
+    lane[k_row_weight * k_lanes] = w;
+    const bool observed = real && w >= options_.observed_above;
+    lane[k_row_observed * k_lanes] = observed ? w : 0.f;
+    if (observed) s.observed_bits |= std::uint64_t{1} << b;
+    if (real && w == 1.f) s.ones |= std::uint64_t{1} << b;
+  }
   if (options_.adapt_to_noise) observe_noise();
   return true;
 }
@@ -195,18 +263,40 @@ void offline_smoother::observe_noise() noexcept {
   const double mean_dt = 0.5 * (dt0 + dt1);
   const float k0 = float(mean_dt / dt0), k1 = float(mean_dt / dt1);
   const float threshold = options_.observed_above;
+  // The size of every bone's second difference, in lanes: d0 = conj(a) b, d1 = conj(b) c
+  // (glm's quaternion product, term for term), v = 2 (k1 d1 - k0 d0) in the vector parts.
+  alignas(16) float size[k_padded_bones];
+  for (int block = 0; block < k_lane_blocks; ++block) {
+    const float* pa = lanes_of(a, block);
+    const float* pb = lanes_of(b, block);
+    const float* pc = lanes_of(c, block);
+    for (int l = 0; l < k_lanes; ++l) {
+      const float aw = pa[k_row_w * k_lanes + l], ax = -pa[k_row_x * k_lanes + l],
+                  ay = -pa[k_row_y * k_lanes + l], az = -pa[k_row_z * k_lanes + l];
+      const float bw = pb[k_row_w * k_lanes + l], bx = pb[k_row_x * k_lanes + l],
+                  by = pb[k_row_y * k_lanes + l], bz = pb[k_row_z * k_lanes + l];
+      const float cw = pc[k_row_w * k_lanes + l], cx = pc[k_row_x * k_lanes + l],
+                  cy = pc[k_row_y * k_lanes + l], cz = pc[k_row_z * k_lanes + l];
+      const float d0w = aw * bw - ax * bx - ay * by - az * bz;
+      const float d0x = aw * bx + ax * bw + ay * bz - az * by;
+      const float d0y = aw * by + ay * bw + az * bx - ax * bz;
+      const float d0z = aw * bz + az * bw + ax * by - ay * bx;
+      const float d1w = bw * cw + bx * cx + by * cy + bz * cz;
+      const float d1x = bw * cx - bx * cw - by * cz + bz * cy;
+      const float d1y = bw * cy - by * cw - bz * cx + bx * cz;
+      const float d1z = bw * cz - bz * cw - bx * cy + by * cx;
+      const float s0 = (d0w < 0.f ? -2.f : 2.f) * k0, s1 = (d1w < 0.f ? -2.f : 2.f) * k1;
+      const float vx = s1 * d1x - s0 * d0x, vy = s1 * d1y - s0 * d0y, vz = s1 * d1z - s0 * d0z;
+      size[block * k_lanes + l] = std::sqrt(vx * vx + vy * vy + vz * vz);
+    }
+  }
   double sum[2] = {0.0, 0.0};
   int n[2] = {0, 0};
   for (int i = 0; i < k_bone_count; ++i) {
     if (!(a.weight[i] >= threshold && b.weight[i] >= threshold && c.weight[i] >= threshold))
       continue;
-    const glm::quat d0 = glm::conjugate(a.pose.rotations[i]) * b.pose.rotations[i];
-    const glm::quat d1 = glm::conjugate(b.pose.rotations[i]) * c.pose.rotations[i];
-    const float s0 = d0.w < 0.f ? -2.f : 2.f, s1 = d1.w < 0.f ? -2.f : 2.f;
-    const glm::vec3 v =
-        (s1 * k1) * glm::vec3(d1.x, d1.y, d1.z) - (s0 * k0) * glm::vec3(d0.x, d0.y, d0.z);
     // Bones that do not change at all (set by a prior: toes, clavicles) tell nothing.
-    const float len = glm::length(v);
+    const float len = size[i];
     if (!(len > 1e-6f)) continue;
     const int g = i >= k_first_finger ? 1 : 0;
     sum[g] += len;
@@ -259,9 +349,6 @@ const offline_smoother::kernel_table& offline_smoother::kernel_for(int table, in
                                                                    float sigma) noexcept {
   kernel_table& k = tables_[table];
   if (k.centre == centre && k.sigma == sigma && k.version == version_) return k;
-  k.centre = centre;
-  k.sigma = sigma;
-  k.version = version_;
   const slot& c = at(centre);
   const double reach = k_kernel_reach * sigma;
   int lo = centre, hi = centre;
@@ -273,66 +360,267 @@ const offline_smoother::kernel_table& offline_smoother::kernel_for(int table, in
     while (lo > 0 && within(lo - 1)) --lo;
     while (hi + 1 < count_ && within(hi + 1)) ++hi;
   }
+  // At a steady frame rate the times around one centre repeat around the next: where u is the
+  // same float as the previous table's at the same place, so is the weight (to ~1e-16 of its
+  // value), and its exponential is skipped; when every u is, so are the moments.
+  const bool same_shape =
+      k.sigma == sigma && k.hi >= k.lo && k.lo - k.centre == lo - centre && k.hi - k.lo == hi - lo;
+  bool same = same_shape;
+  k.centre = centre;
+  k.sigma = sigma;
+  k.version = version_;
   k.lo = lo;
   k.hi = hi;
+  k.ones = ~std::uint64_t{0};
   for (int j = lo; j <= hi; ++j) {
-    k.slots[j - lo] = &at(j);
+    const int i = j - lo;
+    k.index[i] = at(j).index;
+    k.ones &= at(j).ones;
     const double dt = at(j).pose.t - c.pose.t;
-    k.w[j - lo] = j == centre ? 1.f : kernel(dt, sigma);
-    k.u[j - lo] = j == centre ? 0.f : float(dt / sigma);
+    const float u = j == centre ? 0.f : float(dt / sigma);
+    if (same_shape && k.u[i] == u) continue;
+    same = false;
+    k.u[i] = u;
+    k.w[i] = j == centre ? 1.f : kernel(dt, sigma);
   }
+  if (!same) k.has_moments = false;
   return k;
 }
 
-// Gaussian-weighted estimate of bone b at the kernel's centre, over the poses the kernel
+namespace {
+// k_lanes floats, one bone each, and the few operations smooth_rotations needs; each rounds as
+// the scalar operation does, lane by lane.
+struct lanes4 {
+#if AVATARMAP_SMOOTHER_VECTORS
+  typedef float f __attribute__((vector_size(16)));
+  typedef std::int32_t i __attribute__((vector_size(16)));
+  f v;
+  static lanes4 load(const float* p) {
+    lanes4 r;
+    std::memcpy(&r.v, p, sizeof r.v);
+    return r;
+  }
+  static lanes4 splat(float x) { return {f{x, x, x, x}}; }
+  void store(float* p) const { std::memcpy(p, &v, sizeof v); }
+  friend lanes4 operator+(lanes4 a, lanes4 b) { return {a.v + b.v}; }
+  friend lanes4 operator*(lanes4 a, lanes4 b) { return {a.v * b.v}; }
+  // x where x > 0, else 0.
+  lanes4 positive() const { return {(f)((i)v & (v > f{}))}; }
+  // -x where `sign` < 0, else x.
+  lanes4 flipped_where_negative(lanes4 sign) const {
+    return {(f)((i)v ^ ((sign.v < f{}) & (i{} + INT32_MIN)))};
+  }
+#else
+  float v[4];
+  static lanes4 load(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
+  static lanes4 splat(float x) { return {{x, x, x, x}}; }
+  void store(float* p) const {
+    for (int l = 0; l < 4; ++l) p[l] = v[l];
+  }
+  friend lanes4 operator+(lanes4 a, lanes4 b) {
+    for (int l = 0; l < 4; ++l) a.v[l] += b.v[l];
+    return a;
+  }
+  friend lanes4 operator*(lanes4 a, lanes4 b) {
+    for (int l = 0; l < 4; ++l) a.v[l] *= b.v[l];
+    return a;
+  }
+  lanes4 positive() const {
+    lanes4 r;
+    for (int l = 0; l < 4; ++l) r.v[l] = v[l] > 0.f ? v[l] : 0.f;
+    return r;
+  }
+  lanes4 flipped_where_negative(lanes4 sign) const {
+    lanes4 r;
+    for (int l = 0; l < 4; ++l) r.v[l] = sign.v[l] < 0.f ? -v[l] : v[l];
+    return r;
+  }
+#endif
+};
+static_assert(k_lanes == 4, "lanes4 holds one block");
+
+// Moments of the weights in u (|u| <= 3, so floats keep ~6 digits of the 3x3 system) -> the
+// estimate at the centre as a sum over the poses: the value at u = 0 of the weighted
+// least-squares quadratic is sum_j (c00 + c01 u_j + c02 u_j^2) w_j / d q_j, with c0i the
+// cofactors of the moments' matrix and d its determinant (in double); a nearly singular
+// system (too few distinct times, or all weight at one end; d relative to the product of the
+// diagonal) or degree 0 gives the weighted mean, sum_j w_j / m0 q_j. Returns a, b, c with
+// each pose's factor = (a + b u_j + c u_j^2) w_j, formed as a w + b (w u) + c (w u) u.
+void regression_coefficients(const float m[5], bool quadratic, float& a, float& b, float& c) {
+  const float m0 = m[0], m1 = m[1], m2 = m[2], m3 = m[3], m4 = m[4];
+  const double c00 = double(m2) * m4 - double(m3) * m3, c01 = double(m3) * m2 - double(m1) * m4,
+               c02 = double(m1) * m3 - double(m2) * m2;
+  const double det = m0 * c00 + m1 * c01 + m2 * c02;
+  if (quadratic && det > 1e-6 * m0 * m2 * m4 && det > 0.0) {
+    a = float(c00 / det);
+    b = float(c01 / det);
+    c = float(c02 / det);
+  } else {
+    a = m0 > 0.f ? float(1.0 / m0) : 0.f;
+    b = c = 0.f;
+  }
+}
+
+// One block of bones [b0, b0 + k_lanes) over one kernel's n poses.
+struct lane_block {
+  int n = 0;
+  const float* lanes = nullptr;  // the block's lanes of slot 0
+  const int* index = nullptr;    // per pose: its slot
+  int centre = 0;                // the centre's slot
+  const float* w = nullptr;      // kernel weights
+  const float* u = nullptr;      // dt / sigma
+  // Per pose, the factor shared by every lane (bones with weight 1 in every pose), or null:
+  // then each lane's weight is w x (observed x by_observed + weight x by_weight + uniform),
+  // exactly one selector 1 (0 where not positive: no pose counts with a weight <= 0).
+  const float* shared = nullptr;
+  const float* by_observed = nullptr;
+  const float* by_weight = nullptr;
+  const float* uniform = nullptr;
+  bool quadratic = true;
+};
+
+// The block's sums sum_j factor_j q_j (each q_j flipped to the centre's hemisphere: the sign of
+// the 4D dot product, summed x, y, z, w) into out[4][k_lanes] (x, y, z, w).
+void smooth_block(const lane_block& in, float* out) {
+  using L = lanes4;
+  auto row = [&](int slot, int r) {
+    return L::load(in.lanes + slot * k_block_floats + r * k_lanes);
+  };
+  const L rx = row(in.centre, k_row_x), ry = row(in.centre, k_row_y), rz = row(in.centre, k_row_z),
+          rw = row(in.centre, k_row_w);
+  L sx = L::splat(0.f), sy = sx, sz = sx, sw = sx;
+  auto add = [&](int slot, L factor) {
+    const L qx = row(slot, k_row_x), qy = row(slot, k_row_y), qz = row(slot, k_row_z),
+            qw = row(slot, k_row_w);
+    const L dot = rx * qx + ry * qy + rz * qz + rw * qw;
+    factor = factor.flipped_where_negative(dot);
+    sx = sx + factor * qx;
+    sy = sy + factor * qy;
+    sz = sz + factor * qz;
+    sw = sw + factor * qw;
+  };
+  if (in.shared) {
+    for (int j = 0; j < in.n; ++j) add(in.index[j], L::splat(in.shared[j]));
+  } else {
+    const L sel_observed = L::load(in.by_observed), sel_weight = L::load(in.by_weight),
+            sel_uniform = L::load(in.uniform);
+    auto weight_of = [&](int j) {
+      const L observed = row(in.index[j], k_row_observed), weight = row(in.index[j], k_row_weight);
+      return (L::splat(in.w[j]) * (observed * sel_observed + weight * sel_weight + sel_uniform))
+          .positive();
+    };
+    L m0 = L::splat(0.f), m1 = m0, m2 = m0, m3 = m0, m4 = m0;
+    for (int j = 0; j < in.n; ++j) {
+      const L u = L::splat(in.u[j]), w = weight_of(j);
+      const L wu = w * u, wu2 = wu * u;
+      m0 = m0 + w;
+      m1 = m1 + wu;
+      m2 = m2 + wu2;
+      m3 = m3 + wu2 * u;
+      m4 = m4 + wu2 * u * u;
+    }
+    float m[5][k_lanes], ca[k_lanes], cb[k_lanes], cc[k_lanes];
+    m0.store(m[0]);
+    m1.store(m[1]);
+    m2.store(m[2]);
+    m3.store(m[3]);
+    m4.store(m[4]);
+    for (int l = 0; l < k_lanes; ++l) {
+      const float ml[5] = {m[0][l], m[1][l], m[2][l], m[3][l], m[4][l]};
+      regression_coefficients(ml, in.quadratic, ca[l], cb[l], cc[l]);
+    }
+    const L a = L::load(ca), b = L::load(cb), c = L::load(cc);
+    for (int j = 0; j < in.n; ++j) {
+      const L u = L::splat(in.u[j]), w = weight_of(j);
+      const L wu = w * u, wu2 = wu * u;
+      add(in.index[j], a * w + b * wu + c * wu2);
+    }
+  }
+  sx.store(out);
+  sy.store(out + k_lanes);
+  sz.store(out + 2 * k_lanes);
+  sw.store(out + 3 * k_lanes);
+}
+
+}  // namespace
+
+// Gaussian-weighted estimate of each bone at the kernel's centre, over the poses the kernel
 // reaches: all alike (uniform), the observed ones weighted by confidence (observed), or all
 // weighted by confidence. Degree 0: the weighted mean. Degree 2: the value at the centre of a
 // weighted least-squares quadratic in time (local quadratic regression), which follows the
 // peaks of fast motion that a mean of the same width flattens; it falls back to the mean where
-// the neighbours do not determine a quadratic (fewer than three distinct times).
-void offline_smoother::smooth_rotation(const kernel_table& k, int b, weighting how,
-                                       glm::quat& out) const noexcept {
-  const glm::quat ref = at(k.centre).pose.rotations[b];
-  if (k.lo == k.hi) {
-    out = ref;
+// the neighbours do not determine a quadratic (fewer than three distinct times). Each pose's
+// rotation is first flipped to the centre's hemisphere.
+//
+// In blocks of bones (smooth_block): the moments per lane, then sum_j factor_j q_j. Where every
+// bone of a block that counts confidence has weight 1 in every pose of the kernel, the
+// kernel's own moments and factors serve them all (computed once per kernel).
+void offline_smoother::smooth_rotations(kernel_table& k, int first, int end, const weighting* how,
+                                        glm::quat* out) const noexcept {
+  const int n = k.hi - k.lo + 1;
+  const slot& centre = at(k.centre);
+  if (n <= 1) {
+    for (int b = first; b < end; ++b)
+      if (how[b] != weighting::none) out[b] = centre.pose.rotations[b];
     return;
   }
-  // Moments of the weights in u (|u| <= 3, so floats keep ~6 digits of the 3x3 system), and
-  // the weighted sums of q, u q and u^2 q. The solve below is in double.
-  float m0 = 0, m1 = 0, m2 = 0, m3 = 0, m4 = 0;
-  glm::vec4 q0(0.f), q1(0.f), q2(0.f);
-  const float threshold = options_.observed_above;
-  for (int j = k.lo; j <= k.hi; ++j) {
-    const slot& s = *k.slots[j - k.lo];
-    const float conf = s.weight[b];
-    if (how == weighting::observed && !(conf >= threshold)) continue;
-    const float w = k.w[j - k.lo] * (how == weighting::uniform ? 1.f : conf);
-    if (!(w > 0.f)) continue;
-    const glm::quat& q = s.pose.rotations[b];
-    const float sign = ref.x * q.x + ref.y * q.y + ref.z * q.z + ref.w * q.w < 0.f ? -1.f : 1.f;
-    const glm::vec4 v = sign * glm::vec4(q.w, q.x, q.y, q.z);
-    const float u = k.u[j - k.lo], wu = w * u, wu2 = wu * u;
-    m0 += w;
-    m1 += wu;
-    m2 += wu2;
-    m3 += wu2 * u;
-    m4 += wu2 * u * u;
-    q0 += w * v;
-    q1 += wu * v;
-    q2 += wu2 * v;
+  const bool quadratic = options_.degree == 2;
+  lane_block in;
+  in.n = n;
+  in.index = k.index;
+  in.centre = centre.index;
+  in.w = k.w;
+  in.u = k.u;
+  in.quadratic = quadratic;
+  for (int b0 = first / k_lanes * k_lanes; b0 < end; b0 += k_lanes) {
+    float by_observed[k_lanes], by_weight[k_lanes], uniform[k_lanes];
+    bool active = false, shared = true;
+    for (int l = 0; l < k_lanes; ++l) {
+      const int b = b0 + l;
+      const weighting h = b >= first && b < end ? how[b] : weighting::none;
+      active = active || h != weighting::none;
+      by_observed[l] = h == weighting::observed || h == weighting::none ? 1.f : 0.f;
+      by_weight[l] = h == weighting::confidence ? 1.f : 0.f;
+      uniform[l] = h == weighting::uniform ? 1.f : 0.f;
+      if ((h == weighting::observed && !((k.ones >> b) & 1u)) || h == weighting::confidence)
+        shared = false;
+    }
+    if (!active) continue;
+    if (shared && !k.has_moments) {
+      float m[5] = {};
+      for (int j = 0; j < n; ++j) {
+        const float w = k.w[j] > 0.f ? k.w[j] : 0.f, u = k.u[j];
+        const float wu = w * u, wu2 = wu * u;
+        m[0] += w;
+        m[1] += wu;
+        m[2] += wu2;
+        m[3] += wu2 * u;
+        m[4] += wu2 * u * u;
+      }
+      float a, b, c;
+      regression_coefficients(m, quadratic, a, b, c);
+      for (int j = 0; j < n; ++j) {
+        const float w = k.w[j] > 0.f ? k.w[j] : 0.f, u = k.u[j];
+        const float wu = w * u, wu2 = wu * u;
+        k.coefficient[j] = a * w + b * wu + c * wu2;
+      }
+      k.has_moments = true;
+    }
+    in.shared = shared ? k.coefficient : nullptr;
+    in.by_observed = by_observed;
+    in.by_weight = by_weight;
+    in.uniform = uniform;
+    in.lanes = lanes_of_block(b0 / k_lanes);
+    float r[4 * k_lanes];
+    smooth_block(in, r);
+    for (int l = 0; l < k_lanes; ++l) {
+      const int b = b0 + l;
+      if (b < first || b >= end || how[b] == weighting::none) continue;
+      out[b] =
+          normalized_or(glm::quat(r[3 * k_lanes + l], r[l], r[k_lanes + l], r[2 * k_lanes + l]),
+                        centre.pose.rotations[b]);
+    }
   }
-  double r[4];
-  const double c00 = double(m2) * m4 - double(m3) * m3, c01 = double(m3) * m2 - double(m1) * m4,
-               c02 = double(m1) * m3 - double(m2) * m2;
-  const double det = m0 * c00 + m1 * c01 + m2 * c02;
-  // Relative to the product of the diagonal: a nearly singular system (too few distinct times,
-  // or all weight at one end) is solved as a mean instead.
-  if (options_.degree == 2 && det > 1e-6 * m0 * m2 * m4 && det > 0.0) {
-    for (int c = 0; c < 4; ++c) r[c] = (c00 * q0[c] + c01 * q1[c] + c02 * q2[c]) / det;
-  } else {
-    for (int c = 0; c < 4; ++c) r[c] = m0 > 0.0 ? q0[c] / m0 : 0.0;
-  }
-  out = normalized_or(glm::quat(float(r[0]), float(r[1]), float(r[2]), float(r[3])), ref);
 }
 
 void offline_smoother::emit(proxy_pose& out) noexcept {
@@ -385,14 +673,15 @@ void offline_smoother::emit(proxy_pose& out) noexcept {
   ease.hold_seconds = options_.hold_seconds;
   ease.ease_seconds = options_.ease_seconds;
 
+  // Which kernel each bone takes at the centre: its group's (observed, or observed nowhere
+  // within reach: uniform) or the low-confidence one; the rest are gaps, filled below.
+  std::array<weighting, k_padded_bones> how{}, how_low{};  // weighting::none
+  bool group_used[2] = {false, false}, low_used = false;
+  std::uint64_t gaps = 0;
   for (int b = 0; b < k_bone_count; ++b) {
-    const int group = b >= k_first_finger ? k_finger_table : k_body_table;
-    const float sigma = b >= k_first_finger ? sigma_finger : sigma_body;
     if (c.weight[b] >= threshold) {
-      smooth_rotation(kernel_for(group, ci, sigma), b, weighting::observed, out.rotations[b]);
-      last_good_[b] = out.rotations[b];
-      last_good_t_[b] = tc;
-      last_good_segment_[b] = c.segment;
+      how[b] = weighting::observed;
+      group_used[group_of(b)] = true;
       continue;
     }
     // Seen, but barely (its own confidence low and not zero): the measurement still says where
@@ -401,46 +690,85 @@ void offline_smoother::emit(proxy_pose& out) noexcept {
     const float own = c.pose.confidence[b];
     if (options_.low_confidence_sigma_seconds > 0.f && own > 0.f && own == c.weight[b] &&
         !hand_or_finger(b)) {
-      smooth_rotation(kernel_for(k_low_confidence_table, ci, sigma_low), b, weighting::confidence,
-                      out.rotations[b]);
+      how_low[b] = weighting::confidence;
+      low_used = true;
       continue;
     }
-    // A gap: the sides are the last observed output before and the next observed pose within
-    // the lookahead (same segment).
-    const bool has_left = last_good_segment_[b] == c.segment && std::isfinite(tc);
-    const double a = has_left ? tc - last_good_t_[b] : 0.0;
-    int next = -1;
-    for (int j = ci + 1; j < count_; ++j) {
-      const slot& s = at(j);
-      if (s.segment != c.segment || !(s.pose.t - tc <= lookahead_)) break;
-      if (s.weight[b] >= threshold) {
-        next = j;
-        break;
-      }
-    }
-    if (!has_left && next < 0) {
+    gaps |= std::uint64_t{1} << b;
+  }
+  // A gap's sides: the last observed output before and the next observed pose within the
+  // lookahead (same segment), found for every gap in one pass.
+  std::array<int, k_bone_count> next;
+  next.fill(-1);
+  std::uint64_t pending = gaps;
+  for (int j = ci + 1; j < count_ && pending != 0; ++j) {
+    const slot& s = at(j);
+    if (s.segment != c.segment || !(s.pose.t - tc <= lookahead_)) break;
+    std::uint64_t found = pending & s.observed_bits;
+    pending &= ~found;
+    for (; found != 0; found &= found - 1) next[lowest_bit(found)] = j;
+  }
+  const bool has_time = std::isfinite(tc);
+  for (std::uint64_t g = gaps; g != 0; g &= g - 1) {
+    const int b = lowest_bit(g);
+    if (!(last_good_segment_[b] == c.segment && has_time) && next[b] < 0) {
       // Observed nowhere within reach: what the input says (the solver's hold, ease or prior).
-      smooth_rotation(kernel_for(group, ci, sigma), b, weighting::uniform, out.rotations[b]);
-      continue;
+      how[b] = weighting::uniform;
+      group_used[group_of(b)] = true;
+      gaps &= ~(std::uint64_t{1} << b);
     }
-    glm::quat right{};
-    double z = 0.0;
-    if (next >= 0) {
-      smooth_rotation(kernel_for(k_next_table, next, sigma), b, weighting::observed, right);
-      z = at(next).pose.t - tc;
+  }
+  static_assert(k_body_table == 0 && k_finger_table == 1, "a group's table is its number");
+  const float group_sigma[2] = {sigma_body, sigma_finger};
+  const int group_first[2] = {0, k_first_finger}, group_end[2] = {k_first_finger, k_bone_count};
+  for (int g = 0; g < 2; ++g) {
+    if (!group_used[g]) continue;
+    kernel_for(g, ci, group_sigma[g]);
+    smooth_rotations(tables_[g], group_first[g], group_end[g], how.data(), out.rotations.data());
+  }
+  if (low_used) {
+    kernel_for(k_low_confidence_table, ci, sigma_low);
+    smooth_rotations(tables_[k_low_confidence_table], 0, k_bone_count, how_low.data(),
+                     out.rotations.data());
+  }
+  // The right side of each gap: the bone smoothed at its next observed pose, together for the
+  // bones of one group with the same next pose (a hand and its fingers usually).
+  std::array<glm::quat, k_bone_count> right;
+  std::uint64_t todo = 0;
+  for (std::uint64_t g = gaps; g != 0; g &= g - 1)
+    if (next[lowest_bit(g)] >= 0) todo |= g & (~g + 1);
+  while (todo != 0) {
+    const int first_bone = lowest_bit(todo);
+    const int g = group_of(first_bone), at_next = next[first_bone];
+    std::array<weighting, k_padded_bones> how_next{};
+    for (std::uint64_t t = todo; t != 0; t &= t - 1) {
+      const int b = lowest_bit(t);
+      if (group_of(b) != g || next[b] != at_next) continue;
+      how_next[b] = weighting::observed;
+      todo &= ~(std::uint64_t{1} << b);
     }
-    if (has_left && next >= 0 && a + z <= options_.max_gap_seconds) {
+    kernel_for(k_next_table, at_next, group_sigma[g]);
+    smooth_rotations(tables_[k_next_table], group_first[g], group_end[g], how_next.data(),
+                     right.data());
+  }
+  for (; gaps != 0; gaps &= gaps - 1) {
+    const int b = lowest_bit(gaps);
+    const bool has_left = last_good_segment_[b] == c.segment && has_time;
+    const double a = has_left ? tc - last_good_t_[b] : 0.0;
+    const bool has_right = next[b] >= 0;
+    const double z = has_right ? at(next[b]).pose.t - tc : 0.0;
+    if (has_left && has_right && a + z <= options_.max_gap_seconds) {
       const double span = a + z;
       out.rotations[b] =
-          span > 0.0 ? slerp_shortest(last_good_[b], right, float(a / span)) : last_good_[b];
+          span > 0.0 ? slerp_shortest(last_good_[b], right[b], float(a / span)) : last_good_[b];
       continue;
     }
     glm::quat from_left{}, from_right{};
     if (has_left)
       from_left = slerp_shortest(last_good_[b], identity_quat(), hold_and_ease(a, ease).weight);
-    if (next >= 0)
-      from_right = slerp_shortest(right, identity_quat(), hold_and_ease(z, ease).weight);
-    if (has_left && next >= 0) {
+    if (has_right)
+      from_right = slerp_shortest(right[b], identity_quat(), hold_and_ease(z, ease).weight);
+    if (has_left && has_right) {
       // Each side weighted by how much of it is still held and by nearness: a side that has
       // eased fully to rest gives way to the other, and the blend is continuous everywhere.
       const double hold_left = 1.0 - hold_and_ease(a, ease).weight;
@@ -450,6 +778,12 @@ void offline_smoother::emit(proxy_pose& out) noexcept {
       out.rotations[b] = slerp_shortest(from_left, from_right, f);
     } else
       out.rotations[b] = has_left ? from_left : from_right;
+  }
+  for (int b = 0; b < k_bone_count; ++b) {
+    if (how[b] != weighting::observed) continue;
+    last_good_[b] = out.rotations[b];
+    last_good_t_[b] = tc;
+    last_good_segment_[b] = c.segment;
   }
 
   // Hips position and expressions: plain Gaussian means over the segment.

@@ -301,6 +301,61 @@ TEST(solve_file_lines, a_bad_line_fails_naming_it_or_is_skipped_and_counted) {
   }
 }
 
+TEST(solve_file_long, many_frames_in_batches_give_the_frame_by_frame_poses_and_errors) {
+  // Ten times the frames the parsing thread's ring holds and several MiB of output (the
+  // writer's buffer is written out several times), with malformed lines in the middle: both
+  // thread counts give exactly the frame-by-frame poses, skip the same lines, and stop at the
+  // same first one.
+  test::temp_dir dir{"solve_file_long"};
+  const std::string clean = dir.file("clean.landmarks.jsonl");
+  const std::string in = dir.file("in.landmarks.jsonl");
+  write_synthetic(clean, 700);
+  std::string text = test::read_text(clean), damaged;
+  std::size_t line = 0, start = 0;
+  for (std::size_t end; (end = text.find('\n', start)) != std::string::npos; start = end + 1) {
+    damaged.append(text, start, end + 1 - start);
+    if (++line == 101 || line == 334 || line == 651) damaged += "{\"t\": [oops\n";
+  }
+  test::write_text(in, damaged);
+  const std::vector<proxy_pose> want = reference_offline_poses(clean, synth_camera());
+  ASSERT_EQ(want.size(), 700u);
+  for (int threads : {1, 2}) {
+    const std::string out = dir.file("out" + std::to_string(threads) + ".pose.jsonl");
+    solve_file_job job;
+    job.input = in;
+    job.output = out;
+    job.threads = threads;
+    solve_file_summary s;
+    status st = job.run(s);  // stops at the first bad line
+    ASSERT_FALSE(st.ok());
+    EXPECT_EQ(s.failure, job_failure::input_parse);
+    EXPECT_NE(st.message().find("in.landmarks.jsonl:102"), std::string::npos) << st.message();
+    EXPECT_FALSE(std::filesystem::exists(out));
+
+    job.skip_bad_lines = true;
+    st = job.run(s);
+    ASSERT_TRUE(st.ok()) << st.message();
+    EXPECT_EQ(s.bad_lines, 3);
+    EXPECT_EQ(s.frames, 700);
+    pose_reader reader;
+    ASSERT_TRUE(reader.open(out).ok());
+    std::vector<proxy_pose> written;
+    proxy_pose p;
+    while (reader.next(p) == read_result::frame) written.push_back(p);
+    expect_same_poses(written, want, 2e-6f);  // the text round trip
+
+    job.output.clear();
+    std::vector<proxy_pose> got;
+    job.sink = [&got](const proxy_pose& q) {
+      got.push_back(q);
+      return status{};
+    };
+    st = job.run(s);
+    ASSERT_TRUE(st.ok()) << st.message();
+    expect_same_poses(got, want, 0.f);  // bit for bit
+  }
+}
+
 TEST(solve_file_inputs, a_missing_input_is_an_input_error) {
   test::temp_dir dir{"solve_file_missing"};
   solve_file_job job;

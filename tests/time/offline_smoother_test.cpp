@@ -524,6 +524,123 @@ TEST(OfflineSmoother, WindowIsBoundedAndNothingIsAllocatedPerFrame) {
   EXPECT_LE(most, s.capacity());
 }
 
+// The estimate of bone b at frame c by its definition (offline_smoother.hpp), in double: over
+// the frames within 3 sigma of the centre, each weighted by exp(-dt^2 / 2 sigma^2) x (its
+// confidence, or 1 when `uniform`), leaving out those below `observed_above` when
+// `observed_only`; each quaternion flipped to the centre's hemisphere; the value at the centre
+// of the weighted least-squares quadratic in dt / sigma (the weighted mean where the normal
+// equations are nearly singular, or for `degree` 0), normalised.
+glm::quat reference_estimate(const std::vector<proxy_pose>& in, int c, int b, float sigma,
+                             bool observed_only, bool uniform, int degree,
+                             float observed_above = 0.5f) {
+  const glm::quat ref = in[static_cast<size_t>(c)].rotations[b];
+  double m[5] = {}, q[3][4] = {};
+  for (int j = 0; j < int(in.size()); ++j) {
+    const double dt = in[static_cast<size_t>(j)].t - in[static_cast<size_t>(c)].t;
+    if (!(std::abs(dt) <= 3.0 * double(sigma))) continue;
+    const float conf = in[static_cast<size_t>(j)].confidence[b];
+    if (observed_only && !(conf >= observed_above)) continue;
+    const double w = std::exp(-0.5 * dt * dt / (double(sigma) * sigma)) * (uniform ? 1.0 : conf);
+    if (!(w > 0.0)) continue;
+    const glm::quat& r = in[static_cast<size_t>(j)].rotations[b];
+    const double sign =
+        double(ref.x) * r.x + double(ref.y) * r.y + double(ref.z) * r.z + double(ref.w) * r.w < 0.0
+            ? -1.0
+            : 1.0;
+    const double v[4] = {sign * r.x, sign * r.y, sign * r.z, sign * r.w};
+    const double u = dt / sigma;
+    for (int k = 0; k < 5; ++k) m[k] += w * std::pow(u, k);
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 4; ++i) q[k][i] += w * std::pow(u, k) * v[i];
+  }
+  // [m0 m1 m2; m1 m2 m3; m2 m3 m4] [a b c]' = q: a by Cramer's rule.
+  const double det = m[0] * (m[2] * m[4] - m[3] * m[3]) - m[1] * (m[1] * m[4] - m[3] * m[2]) +
+                     m[2] * (m[1] * m[3] - m[2] * m[2]);
+  double r[4];
+  for (int i = 0; i < 4; ++i) {
+    if (degree == 2 && det > 1e-6 * m[0] * m[2] * m[4] && det > 0.0)
+      r[i] = (q[0][i] * (m[2] * m[4] - m[3] * m[3]) - m[1] * (q[1][i] * m[4] - m[3] * q[2][i]) +
+              m[2] * (q[1][i] * m[3] - m[2] * q[2][i])) /
+             det;
+    else
+      r[i] = q[0][i] / m[0];
+  }
+  const double n = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3]);
+  return glm::quat(float(r[3] / n), float(r[0] / n), float(r[1] / n), float(r[2] / n));
+}
+
+TEST(OfflineSmoother, EstimatesEqualTheirDefinitionComputedPlainly) {
+  // Every bone moving with noise, each input quaternion's sign drawn at random (the hemisphere
+  // alignment must undo it); confidences that take each way of weighting: 1 everywhere (the
+  // kernel's own moments serve all such bones), varying in [0.5, 1] (the left arm and hand),
+  // briefly low (the right lower leg: smoothed by confidence over the wider kernel there),
+  // briefly missing (the right index finger: a gap, not compared) and never observed (the jaw:
+  // every frame alike).
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> unit(-1.f, 1.f), half(0.5f, 1.f);
+  std::normal_distribution<float> noise(0.f, 0.02f);
+  std::vector<glm::vec3> axis(k_bone_count);
+  std::vector<float> amplitude(k_bone_count), rate(k_bone_count);
+  for (int b = 0; b < k_bone_count; ++b) {
+    axis[b] = glm::normalize(glm::vec3(unit(rng), unit(rng), unit(rng)) + glm::vec3(0.f, 0.f, 2.f));
+    amplitude[b] = 1.5f * half(rng);
+    rate[b] = 4.f * half(rng);
+  }
+  const int leg = idx(bone::right_lower_leg), finger = idx(bone::right_index_proximal),
+            jaw = idx(bone::jaw);
+  auto left_arm = [](int b) {
+    return b == idx(bone::left_upper_arm) || b == idx(bone::left_lower_arm) ||
+           b == idx(bone::left_hand) ||
+           (b >= idx(bone::left_thumb_metacarpal) && b <= idx(bone::left_little_distal));
+  };
+  std::vector<proxy_pose> in;
+  for (int i = 0; i < 180; ++i) {
+    proxy_pose p = frame_at(i);
+    for (int b = 0; b < k_bone_count; ++b) {
+      glm::quat q = about(axis[b], amplitude[b] * float(std::sin(rate[b] * p.t))) *
+                    glm::quat(1.f, noise(rng), noise(rng), noise(rng));
+      q = glm::normalize(q);
+      p.rotations[b] = unit(rng) < 0.f ? -q : q;
+      if (left_arm(b)) p.confidence[b] = half(rng);
+    }
+    if (i % 9 == 4) p.confidence[leg] = 0.3f;
+    if (i >= 100 && i < 105) p.confidence[finger] = 0.f;
+    p.confidence[jaw] = 0.f;
+    in.push_back(p);
+  }
+  for (int degree : {2, 0}) {
+    offline_smoother_options o;
+    o.adapt_to_noise = false;  // the sigmas as given: body 0.15 s, fingers 0.3 s, low 0.3 s
+    o.degree = degree;
+    const auto out = run(in, o);
+    ASSERT_EQ(out.size(), in.size());
+    int compared = 0;
+    for (int c = 0; c < int(in.size()); ++c) {
+      for (int b = 0; b < k_bone_count; ++b) {
+        const float conf = in[static_cast<size_t>(c)].confidence[b];
+        const float sigma =
+            b >= idx(bone::left_thumb_metacarpal) ? o.finger_sigma_seconds : o.body_sigma_seconds;
+        glm::quat want;
+        if (b == jaw)
+          want = reference_estimate(in, c, b, sigma, false, true, degree);
+        else if (conf >= o.observed_above)
+          want = reference_estimate(in, c, b, sigma, true, false, degree);
+        else if (b == leg)
+          want = reference_estimate(in, c, b, o.low_confidence_sigma_seconds, false, false, degree);
+        else
+          continue;  // a gap
+        const glm::quat& got = out[static_cast<size_t>(c)].rotations[b];
+        for (int k = 0; k < 4; ++k)
+          ASSERT_NEAR(got[k], want[k], 1e-5f)
+              << "degree " << degree << " frame " << c << " bone "
+              << bone_name(static_cast<bone>(b)) << " component " << k;
+        ++compared;
+      }
+    }
+    EXPECT_EQ(compared, 180 * k_bone_count - 5);
+  }
+}
+
 TEST(OfflineSmoother, HighFrameRateBeyondTheCapacityStillStreams) {
   offline_smoother_options o;
   o.capacity_frames = 16;  // far less than 1.5 s at 30 fps

@@ -42,6 +42,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <memory>
 
 #include "avatarmap/core/status.hpp"
@@ -94,7 +95,7 @@ struct offline_smoother_options {
   /// Longer gaps: hold, then ease to rest (as the solver's confidence gate does).
   float hold_seconds = 0.5f;
   float ease_seconds = 1.0f;
-  /// Poses held at most (the memory bound; ~1.2 kB each). 256 frames covers the default
+  /// Poses held at most (the memory bound; ~2.8 kB each). 256 frames covers the default
   /// lookahead (1.5 s) up to ~160 fps.
   int capacity_frames = 256;
 
@@ -138,9 +139,9 @@ class offline_smoother {
   struct slot;
   slot& at(int i) const noexcept;  // i-th oldest kept pose
   bool ready() const noexcept;
-  // Which frames a kernel takes and how: all alike, observed ones by confidence, all by
-  // confidence.
-  enum class weighting { uniform, observed, confidence };
+  // Which frames a kernel takes for a bone and how: none (the bone is not computed), all
+  // alike, observed ones by confidence, all by confidence.
+  enum class weighting : std::uint8_t { none, uniform, observed, confidence };
   // Kernel weights and u = dt / sigma of the poses [lo, hi] around `centre` (indices from the
   // oldest), for one sigma; valid while `version` is the smoother's.
   struct kernel_table {
@@ -149,12 +150,18 @@ class offline_smoother {
     unsigned version = 0;
     float* w = nullptr;
     float* u = nullptr;
-    const slot** slots = nullptr;  // the poses lo..hi
+    std::uint64_t ones = 0;        // bit b: bone b has weight 1 in every pose lo..hi
+    bool has_moments = false;      // whether `coefficient` is computed (once needed)
+    float* coefficient = nullptr;  // each pose's factor in the estimate from w alone
+    int* index = nullptr;          // the poses lo..hi: their slots (slot::index)
   };
   static constexpr int k_body_table = 0, k_finger_table = 1, k_low_confidence_table = 2,
                        k_next_table = 3, k_table_count = 4;
   const kernel_table& kernel_for(int table, int centre, float sigma) noexcept;
-  void smooth_rotation(const kernel_table& k, int b, weighting how, glm::quat& out) const noexcept;
+  // The kernel's estimate at its centre of every bone b in [first, end) with how[b] != none,
+  // written to out[b] (out has k_bone_count entries).
+  void smooth_rotations(kernel_table& k, int first, int end, const weighting* how,
+                        glm::quat* out) const noexcept;
   void emit(proxy_pose& out) noexcept;
 
   offline_smoother_options options_;
@@ -170,8 +177,11 @@ class offline_smoother {
   double noise_weight_ = 0.0;
   int capacity_ = 0;
   std::unique_ptr<slot[]> slots_;
-  std::unique_ptr<float[]> kernel_storage_;      // the tables' w and u, capacity_ each
-  std::unique_ptr<const slot*[]> slot_storage_;  // the tables' slots, capacity_ each
+  std::unique_ptr<float[]> kernel_storage_;  // the tables' w, u and coefficient
+  std::unique_ptr<int[]> index_storage_;     // the tables' index, capacity_ each
+  std::unique_ptr<float[]> lanes_;           // the poses' values for smooth_rotations, by bone
+  float* lanes_of_block(int block) const noexcept;           // of slot 0
+  float* lanes_of(const slot& s, int block) const noexcept;  // of the slot of `s`
   std::array<kernel_table, k_table_count> tables_{};
   unsigned version_ = 0;  // bumped whenever the ring's indices may have moved
   int head_ = 0;          // ring index of the oldest kept pose
