@@ -47,18 +47,20 @@ void print_summary(const solve_file_job& job, const solve_file_summary& s, std::
   std::fprintf(to, "\n");
   if (s.frames > 0)
     std::fprintf(to, "hips height: %.3f .. %.3f m\n", s.hips_height_min, s.hips_height_max);
-  if (s.frames > 0 && !s.fov_estimated)
-    std::fprintf(to, "camera field of view: %.1f degrees (--fov)\n", s.horizontal_fov_degrees);
-  else if (s.frames > 0 && s.fov_evidence_frames > 0)
-    std::fprintf(to,
-                 "camera field of view: %.1f degrees, estimated from the pose in %ld frames "
-                 "(--fov DEG to set it)\n",
-                 s.horizontal_fov_degrees, s.fov_evidence_frames);
-  else if (s.frames > 0)
-    std::fprintf(to,
-                 "camera field of view: %.1f degrees assumed; the pose's image and world points "
-                 "did not tell it (--fov DEG to set it)\n",
-                 s.horizontal_fov_degrees);
+  if (s.frames > 0) {
+    if (!s.fov_estimated)
+      std::fprintf(to, "camera field of view: %.1f degrees (--fov)\n", s.horizontal_fov_degrees);
+    else if (s.fov_evidence_frames > 0)
+      std::fprintf(to,
+                   "camera field of view: %.1f degrees, estimated from the pose in %ld frames "
+                   "(--fov DEG to set it)\n",
+                   s.horizontal_fov_degrees, s.fov_evidence_frames);
+    else
+      std::fprintf(to,
+                   "camera field of view: %.1f degrees assumed; the pose's image and world "
+                   "points did not tell it (--fov DEG to set it)\n",
+                   s.horizontal_fov_degrees);
+  }
   if (s.image_size_assumed)
     std::fprintf(to,
                  "warning: the input has no image_size header and no --image-size was given: "

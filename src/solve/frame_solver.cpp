@@ -62,8 +62,7 @@ float frame_solver::horizontal_fov_degrees() const {
 
 void frame_solver::update_focal(const landmark_frame& in) {
   if (options_.horizontal_fov_degrees != 0.f || !(options_.image_width > 0.f)) return;
-  const focal_evidence e = estimate_focal(in, options_.image_width, options_.image_height,
-                                          options_.confidence.found_above);
+  const focal_evidence e = estimate_focal(in, options_.image_width, options_.image_height);
   if (!(e.information > 0.0)) return;
   // In units of the image width, as focal_per_width_.
   const double w = options_.image_width;

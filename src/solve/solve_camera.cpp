@@ -9,6 +9,9 @@
 namespace avatarmap::solve_detail {
 namespace {
 
+// Least confidence of a point used: the fit's own choice, not the solver's gate thresholds
+// (which the offline job opens to 0): an occluded point's position is a guess.
+constexpr float k_min_point_confidence = 0.5f;
 // Fewest confident points for a fit (two equations each, four unknowns): a fit through a
 // handful of points is dominated by their noise.
 constexpr int k_min_points = 8;
@@ -55,35 +58,33 @@ bool solve4(double a[4][4], double b[4], double x[4]) {
 
 }  // namespace
 
-focal_evidence estimate_focal(const landmark_frame& in, float width, float height,
-                              float min_confidence) {
+focal_evidence estimate_focal(const landmark_frame& in, float width, float height) {
   focal_evidence e;
   if (!in.has(frame_part::pose) || !in.has(frame_part::pose_world) || !(width > 0.f) ||
       !(height > 0.f))
     return e;
   // Normal equations of the unknowns (Tz, f, f Tx, f Ty), rows [du, -X, -1, 0] and
-  // [dv, -Y, 0, -1] with right-hand sides -du Z and -dv Z.
-  double n[4][4] = {}, r[4] = {};
-  double rows[2 * k_pose_landmark_count][5];
+  // [dv, -Y, 0, -1] with right-hand sides -du Z and -dv Z, and the right-hand sides' sum of
+  // squares (for the residual without a second pass: rss = y'y - x'A'y at the solution).
+  double n[4][4] = {}, r[4] = {}, yy = 0.0;
   int m = 0;
   for (int i = 0; i < k_pose_landmark_count; ++i) {
     const landmark& p = in.pose[i];
     const landmark& w = in.pose_world[i];
-    if (std::min(landmark_confidence(p), landmark_confidence(w)) < min_confidence) continue;
+    if (std::min(landmark_confidence(p), landmark_confidence(w)) < k_min_point_confidence) continue;
     const double du = (double(p.x) - 0.5) * width, dv = (double(p.y) - 0.5) * height;
     const double eq[2][5] = {{du, -double(w.x), -1.0, 0.0, -du * w.z},
                              {dv, -double(w.y), 0.0, -1.0, -dv * w.z}};
     for (const auto& q : eq) {
-      for (int j = 0; j < 5; ++j) rows[m][j] = q[j];
+      for (int row = 0; row < 4; ++row) {
+        for (int col = 0; col < 4; ++col) n[row][col] += q[row] * q[col];
+        r[row] += q[row] * q[4];
+      }
+      yy += q[4] * q[4];
       ++m;
     }
   }
   if (m < 2 * k_min_points) return e;
-  for (int k = 0; k < m; ++k)
-    for (int i = 0; i < 4; ++i) {
-      for (int j = 0; j < 4; ++j) n[i][j] += rows[k][i] * rows[k][j];
-      r[i] += rows[k][i] * rows[k][4];
-    }
   double a[4][4], b[4], x[4];
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) a[i][j] = n[i][j];
@@ -95,12 +96,7 @@ focal_evidence estimate_focal(const landmark_frame& in, float width, float heigh
       !(f < k_max_focal_per_width * width))
     return e;
   // Residual variance, in pixels^2 at the hips' depth (the equations are in pixels x metres).
-  double rss = 0.0;
-  for (int k = 0; k < m; ++k) {
-    double s = -rows[k][4];
-    for (int j = 0; j < 4; ++j) s += rows[k][j] * x[j];
-    rss += s * s;
-  }
+  const double rss = std::max(0.0, yy - (x[0] * r[0] + x[1] * r[1] + x[2] * r[2] + x[3] * r[3]));
   const double residual2 = rss / double(m - 4) / (tz * tz);
   const double max_residual = k_max_residual_per_width * width;
   if (!(residual2 <= max_residual * max_residual)) return e;

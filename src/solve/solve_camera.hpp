@@ -24,8 +24,7 @@ struct focal_evidence {
 };
 
 /// Estimate from one frame's pose and pose_world points, for an image of width x height
-/// pixels (both > 0). Points below `min_confidence` are left out.
-focal_evidence estimate_focal(const landmark_frame& in, float width, float height,
-                              float min_confidence);
+/// pixels (both > 0). Points with a confidence (visibility, presence) below 0.5 are left out.
+focal_evidence estimate_focal(const landmark_frame& in, float width, float height);
 
 }  // namespace avatarmap::solve_detail

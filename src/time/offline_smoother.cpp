@@ -298,9 +298,8 @@ void offline_smoother::observe_noise() noexcept {
     // Bones that do not change at all (set by a prior: toes, clavicles) tell nothing.
     const float len = size[i];
     if (!(len > 1e-6f)) continue;
-    const int g = i >= k_first_finger ? 1 : 0;
-    sum[g] += len;
-    ++n[g];
+    sum[group_of(i)] += len;
+    ++n[group_of(i)];
   }
   if (n[0] + n[1] == 0) return;
   // A running mean over about k_noise_seconds: plain while less than that has been seen.

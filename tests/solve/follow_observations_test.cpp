@@ -134,7 +134,7 @@ TEST(FocalEstimate, RecoversAPinholeCamerasFocalLength) {
     const float w = 1280.f, h = 720.f;
     const double f = 0.5 * w / std::tan(0.5 * fov * 3.14159265358979 / 180.0);
     const landmark_frame fr = pinhole_frame(f, 0.6, -0.2, 2.5, w, h, rng);
-    const solve_detail::focal_evidence e = solve_detail::estimate_focal(fr, w, h, 0.5f);
+    const solve_detail::focal_evidence e = solve_detail::estimate_focal(fr, w, h);
     ASSERT_GT(e.information, 0.0) << fov;
     EXPECT_NEAR(e.focal, f, 1e-3 * f) << fov;
   }
@@ -145,25 +145,50 @@ TEST(FocalEstimate, TellsNothingWithoutWorldPointsOrFromImplausibleCameras) {
   landmark_frame fr = pinhole_frame(900.0, 0.0, 0.0, 3.0, 1280.f, 720.f, rng);
   landmark_frame no_world = fr;
   no_world.set(frame_part::pose_world, false);
-  EXPECT_EQ(solve_detail::estimate_focal(no_world, 1280.f, 720.f, 0.5f).information, 0.0);
+  EXPECT_EQ(solve_detail::estimate_focal(no_world, 1280.f, 720.f).information, 0.0);
   // Too few confident points.
   landmark_frame hidden = fr;
   for (int i = 4; i < k_pose_landmark_count; ++i) hidden.pose[i].visibility = 0.1f;
-  EXPECT_EQ(solve_detail::estimate_focal(hidden, 1280.f, 720.f, 0.5f).information, 0.0);
+  EXPECT_EQ(solve_detail::estimate_focal(hidden, 1280.f, 720.f).information, 0.0);
   // A field of view of 170 degrees is not a camera the person is filmed with.
   const landmark_frame fisheye = pinhole_frame(56.0, 0.0, 0.0, 3.0, 1280.f, 720.f, rng);
-  EXPECT_EQ(solve_detail::estimate_focal(fisheye, 1280.f, 720.f, 0.5f).information, 0.0);
+  EXPECT_EQ(solve_detail::estimate_focal(fisheye, 1280.f, 720.f).information, 0.0);
   // Image and world points that are not one pinhole view (MediaPipe's world model is a
   // regression of its own: its points disagree with the image ones by ~2 % of the width).
   landmark_frame loose = fr;
   std::normal_distribution<float> n(0.f, 0.02f);
   for (int i = 0; i < k_pose_landmark_count; ++i) loose.pose[i].x += n(rng);
-  EXPECT_EQ(solve_detail::estimate_focal(loose, 1280.f, 720.f, 0.5f).information, 0.0);
+  EXPECT_EQ(solve_detail::estimate_focal(loose, 1280.f, 720.f).information, 0.0);
   // NaN points are left out, not propagated.
   landmark_frame nan = fr;
   nan.pose[3].x = std::nanf("");
-  const solve_detail::focal_evidence e = solve_detail::estimate_focal(nan, 1280.f, 720.f, 0.5f);
+  const solve_detail::focal_evidence e = solve_detail::estimate_focal(nan, 1280.f, 720.f);
   EXPECT_NEAR(e.focal, 900.0, 1.0);
+}
+
+TEST(FocalEstimate, OccludedPointsStayOutWhateverTheGateThresholds) {
+  // The offline file job opens the solver's confidence gate (thresholds 0); the field of view
+  // must still come from the visible points only, not from occluded guesses.
+  std::mt19937 rng(7);
+  const float w = 1280.f, h = 720.f;
+  const double f = 0.5 * w / std::tan(0.5 * 90.0 * 3.14159265358979 / 180.0);
+  solver_options o;
+  o.image_width = w;
+  o.image_height = h;
+  o.confidence.lost_below = o.confidence.found_above = 0.f;
+  frame_solver solver(o);
+  proxy_pose out;
+  for (int i = 0; i < 30; ++i) {
+    landmark_frame fr = pinhole_frame(f, 0.3, 0.1, 2.5, w, h, rng);
+    for (int k = 25; k < 30; ++k) {  // occluded: placed 20 % of the image away, visibility 0.1
+      fr.pose[k].x += 0.2f;
+      fr.pose[k].visibility = fr.pose_world[k].visibility = 0.1f;
+    }
+    fr.t = i / 30.0;
+    solver.solve(fr, out);
+  }
+  EXPECT_EQ(solver.fov_evidence_frames(), 30);
+  EXPECT_NEAR(solver.horizontal_fov_degrees(), 90.f, 0.1f);
 }
 
 }  // namespace
