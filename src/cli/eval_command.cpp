@@ -24,7 +24,8 @@ const char* k_eval_help =
     "  --jitter SOLVED  no truth: the RMS of the second time derivative of the bones' world\n"
     "           directions (deg/s^2), overall and per group; steadier is smaller; compare\n"
     "           files at the same frame rate (real video: defaults against a reference)\n"
-    "  --json   one JSON object on standard output instead of the table\n"
+    "  --json   one JSON object on standard output instead of the table, with every\n"
+    "           bone's figures too (\"bones\")\n"
     "  --tolerance MS   time difference allowed between matched frames (default 0.5)\n";
 
 void print_stats_json(const char* name, const angle_stats& s, bool comma) {
@@ -72,8 +73,16 @@ int run_eval_pose(int argc, char** argv) {
     if (json) {
       std::printf(
           "{\"frames\":%ld,\"rms\":%.4f,\"torso\":%.4f,\"arms\":%.4f,\"legs\":%.4f,"
-          "\"fingers\":%.4f}\n",
+          "\"fingers\":%.4f,\"bones\":{",
           j.frames, j.rms, j.groups[0], j.groups[1], j.groups[2], j.groups[3]);
+      bool first = true;
+      for (int b = 0; b < k_bone_count; ++b) {
+        if (bone_accuracy_group(static_cast<bone>(b)) == accuracy_group::head) continue;
+        std::printf("%s\"%s\":%.4f", first ? "" : ",",
+                    std::string(bone_name(static_cast<bone>(b))).c_str(), j.bones[b]);
+        first = false;
+      }
+      std::printf("}}\n");
       return 0;
     }
     std::printf("%ld frames; RMS angular acceleration of bone directions in deg/s^2\n", j.frames);

@@ -53,6 +53,7 @@ const char* k_synth_help =
     "  --body-noise MM, --hand-noise MM, --face-noise MM   the same per part\n"
     "  --low-vis F           fraction of each limb's time in low-visibility bursts, [0, 0.9]\n"
     "  --low-vis-seconds S   mean burst length (default 1)\n"
+    "  --low-vis-noise MM    extra Gaussian noise on a limb's 3-D points in a burst (30)\n"
     "  --no-hands, --no-face  leave those parts out\n";
 
 struct synth_settings {
@@ -217,6 +218,7 @@ bool parse_synth(args& a, synth_settings& s, std::string& err) {
     }
     o.low_visibility_seconds = static_cast<float>(v);
   }
+  if (!noise_option(a, "--low-vis-noise", o.low_visibility_noise_sigma, err)) return false;
   if (a.flag("--no-hands")) s.hands = false;
   if (a.flag("--no-face")) s.face = false;
   if (!a.error().empty()) {

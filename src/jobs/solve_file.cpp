@@ -120,8 +120,10 @@ status solve_file_job::run(solve_file_summary& s) const {
   }
   if (filter_mode == pose_filter_mode::offline) {
     // The smoother sees the future, so it, not the causal gate, decides what was observed.
+    // A bone found again is the measurement at once (no blend from the held rotation).
     solve_options.confidence.lost_below = 0.f;
     solve_options.confidence.found_above = 0.f;
+    solve_options.confidence.regain_seconds = 0.f;
   }
   s.image_width = solve_options.image_width;
   s.image_height = solve_options.image_height;

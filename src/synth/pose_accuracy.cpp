@@ -201,6 +201,7 @@ status measure_pose_jitter(const std::string& path, pose_jitter& out) {
   std::array<double, 3> times{};
   std::array<double, k_direction_group_count> sum{};
   std::array<long, k_direction_group_count> count{};
+  std::array<double, k_bone_count> bone_sum{};
   proxy_pose p;
   std::array<glm::quat, k_bone_count> world;
   for (;;) {
@@ -233,6 +234,7 @@ status measure_pose_jitter(const std::string& path, pose_jitter& out) {
                            (0.5 * (dt0 + dt1));
       const double deg = glm::length(a) * k_rad_to_deg;
       sum[static_cast<int>(g)] += deg * deg;
+      bone_sum[b] += deg * deg;
       ++count[static_cast<int>(g)];
     }
   }
@@ -246,6 +248,8 @@ status measure_pose_jitter(const std::string& path, pose_jitter& out) {
     n += count[g];
   }
   out.rms = n > 0 ? std::sqrt(all / static_cast<double>(n)) : 0.0;
+  for (int b = 0; b < k_bone_count; ++b)
+    out.bones[b] = std::sqrt(bone_sum[b] / static_cast<double>(out.frames - 2));
   return {};
 }
 

@@ -51,6 +51,18 @@ constexpr double k_reference_noise[2] = {0.22, 0.93};
 constexpr double k_reference_fps = 30.0;
 constexpr double k_noise_seconds = 4.0;
 constexpr double k_min_noise_factor = 0.25, k_max_noise_factor = 1.0;
+// Low-confidence observations (0 < confidence < observed_above) of a group -- the body without
+// the hands; the hands and fingers -- are smoothed (low_confidence_sigma_seconds) while their
+// measured noise (the same second differences, over the bones low in three frames running) is
+// at most k_low_noise_ratio x the confident bones' (the body's; the fingers') and below
+// k_low_noise_saturation radians per sample, where a bone's turn from frame to frame is mostly
+// noise (a finger's 2-4 cm bone under 30 mm of noise measures ~2.0, under 10 mm ~1.65); else
+// they are filled as gaps from the observed frames around them. Until measured: the body's
+// are smoothed, the hands' filled.
+constexpr double k_low_noise_ratio = 5.0;
+constexpr double k_low_noise_saturation = 1.8;
+// Shortest hand detection believed (drop_flicker): 0.25 s is 6 frames at 25 fps.
+constexpr double k_min_detection_seconds = 0.25;
 // Longest hold, ease or gap accepted (a window of minutes would be a mistake, not a choice).
 constexpr float k_max_gap_option_seconds = 60.f;
 constexpr int k_min_capacity = 8;
@@ -171,6 +183,10 @@ void offline_smoother::reset() noexcept {
   sigma_floor_ = 0.0;
   sigma_widest_ = 0.0;
   noise_.fill(0.0);
+  low_noise_.fill(0.0);
+  low_noise_weight_.fill(0.0);
+  low_informative_ = {true, false};
+  flicker_bits_ = 0;
   noise_dt_ = 0.0;
   noise_weight_ = 0.0;
   last_good_.fill(identity_quat());
@@ -237,14 +253,76 @@ bool offline_smoother::push(const proxy_pose& in) noexcept {
     lane[k_row_y * k_lanes] = q.y;
     lane[k_row_z * k_lanes] = q.z;
     lane[k_row_w * k_lanes] = q.w;
-    lane[k_row_weight * k_lanes] = w;
     const bool observed = real && w >= options_.observed_above;
+    lane[k_row_weight * k_lanes] = w;
     lane[k_row_observed * k_lanes] = observed ? w : 0.f;
     if (observed) s.observed_bits |= std::uint64_t{1} << b;
     if (real && w == 1.f) s.ones |= std::uint64_t{1} << b;
   }
-  if (options_.adapt_to_noise) observe_noise();
+  observe_noise();
+  drop_flicker();
   return true;
+}
+
+// A hand seen for less than k_min_detection_seconds between frames where it was not detected
+// at all (confidence 0; or the start of the take) is taken for a false detection: the hand
+// landmark model also answers on a crop that holds no hand, or a hand turned the wrong way,
+// and such answers rarely last. Its frames become gaps (filled from the frames around them)
+// as long as none of them has been emitted. Checked when the hand is missed again, per bone.
+void offline_smoother::drop_flicker() noexcept {
+  if (count_ < 2) return;
+  slot& s = at(count_ - 1);
+  // A hand dropped before, still unseen: the input's hold of the false detection is replaced.
+  for (std::uint64_t todo = flicker_bits_; todo != 0; todo &= todo - 1) {
+    const int b = lowest_bit(todo);
+    if (s.weight[b] > 0.f || s.segment != at(count_ - 2).segment) {
+      flicker_bits_ &= ~(std::uint64_t{1} << b);
+      continue;
+    }
+    s.pose.rotations[b] = flicker_fill_[b];
+    float* lane = lanes_of(s, b / k_lanes) + b % k_lanes;
+    lane[k_row_x * k_lanes] = flicker_fill_[b].x;
+    lane[k_row_y * k_lanes] = flicker_fill_[b].y;
+    lane[k_row_z * k_lanes] = flicker_fill_[b].z;
+    lane[k_row_w * k_lanes] = flicker_fill_[b].w;
+  }
+  const slot& prev = at(count_ - 2);
+  if (prev.segment != s.segment) return;
+  std::uint64_t absent = 0;
+  for (int b = 0; b < k_bone_count; ++b)
+    if (hand_or_finger(b) && !(s.weight[b] > 0.f)) absent |= std::uint64_t{1} << b;
+  for (std::uint64_t todo = absent & prev.observed_bits; todo != 0; todo &= todo - 1) {
+    const int b = lowest_bit(todo);
+    const std::uint64_t bit = std::uint64_t{1} << b;
+    int first = count_ - 2;
+    while (first > 0 && at(first - 1).segment == s.segment && (at(first - 1).observed_bits & bit))
+      --first;
+    if (first < centre_) continue;  // part of it already written out
+    const bool bounded =
+        first > 0 && (at(first - 1).segment != s.segment || !(at(first - 1).weight[b] > 0.f));
+    if (!bounded || !(s.pose.t - at(first).pose.t < k_min_detection_seconds)) continue;
+    // What the input showed before the detection stands for it (rest, or a hold), here and
+    // in the frames after it while the hand stays unseen (the input holds the false detection).
+    const slot& ahead = at(first - 1);
+    const glm::quat before = ahead.segment == s.segment ? ahead.pose.rotations[b] : identity_quat();
+    flicker_fill_[b] = before;
+    flicker_bits_ |= bit;
+    for (int i = first; i < count_; ++i) {
+      slot& f = at(i);
+      f.pose.rotations[b] = before;
+      f.pose.confidence[b] = 0.f;
+      f.weight[b] = 0.f;
+      f.observed_bits &= ~bit;
+      f.ones &= ~bit;
+      float* lane = lanes_of(f, b / k_lanes) + b % k_lanes;
+      lane[k_row_x * k_lanes] = before.x;
+      lane[k_row_y * k_lanes] = before.y;
+      lane[k_row_z * k_lanes] = before.z;
+      lane[k_row_w * k_lanes] = before.w;
+      lane[k_row_weight * k_lanes] = 0.f;
+      lane[k_row_observed * k_lanes] = 0.f;
+    }
+  }
 }
 
 // The newest three poses of one segment give, per bone observed in all three, the second
@@ -290,9 +368,14 @@ void offline_smoother::observe_noise() noexcept {
       size[block * k_lanes + l] = std::sqrt(vx * vx + vy * vy + vz * vz);
     }
   }
-  double sum[2] = {0.0, 0.0};
-  int n[2] = {0, 0};
+  double sum[2] = {0.0, 0.0}, low_sum[2] = {0.0, 0.0};
+  int n[2] = {0, 0}, low_n[2] = {0, 0};
+  auto low = [&](float w) { return w > 0.f && w < threshold; };
   for (int i = 0; i < k_bone_count; ++i) {
+    if (low(a.weight[i]) && low(b.weight[i]) && low(c.weight[i]) && size[i] > 1e-6f) {
+      low_sum[hand_or_finger(i) ? 1 : 0] += size[i];
+      ++low_n[hand_or_finger(i) ? 1 : 0];
+    }
     if (!(a.weight[i] >= threshold && b.weight[i] >= threshold && c.weight[i] >= threshold))
       continue;
     // Bones that do not change at all (set by a prior: toes, clavicles) tell nothing.
@@ -301,6 +384,18 @@ void offline_smoother::observe_noise() noexcept {
     sum[group_of(i)] += len;
     ++n[group_of(i)];
   }
+  // Running means as below, per group.
+  for (int g = 0; g < 2; ++g) {
+    if (low_n[g] == 0) continue;
+    const double w = std::min(mean_dt, k_noise_seconds);
+    const double total = std::min(low_noise_weight_[g] + w, k_noise_seconds);
+    low_noise_[g] += w / std::max(total, w) * (low_sum[g] / low_n[g] - low_noise_[g]);
+    low_noise_weight_[g] = total;
+  }
+  for (int g = 0; g < 2; ++g)
+    if (low_noise_weight_[g] > 0.0 && noise_weight_ > 0.0)
+      low_informative_[g] =
+          low_noise_[g] <= std::min(k_low_noise_ratio * noise_[g], k_low_noise_saturation);
   if (n[0] + n[1] == 0) return;
   // A running mean over about k_noise_seconds: plain while less than that has been seen.
   const double w = std::min(mean_dt, k_noise_seconds);
@@ -688,7 +783,7 @@ void offline_smoother::emit(proxy_pose& out) noexcept {
     // confidence (observed neighbours dominate near the gap's ends).
     const float own = c.pose.confidence[b];
     if (options_.low_confidence_sigma_seconds > 0.f && own > 0.f && own == c.weight[b] &&
-        !hand_or_finger(b)) {
+        low_informative_[hand_or_finger(b) ? 1 : 0]) {
       how_low[b] = weighting::confidence;
       low_used = true;
       continue;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "avatarmap/core/rotation.hpp"
 #include "avatarmap/io/landmark_file.hpp"
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/solve/frame_solver.hpp"
@@ -86,6 +87,7 @@ std::vector<proxy_pose> reference_offline_poses(const std::string& path, solver_
                                                 const offline_smoother_options& smooth = {}) {
   options.confidence.lost_below = 0.f;
   options.confidence.found_above = 0.f;
+  options.confidence.regain_seconds = 0.f;
   landmark_reader reader;
   EXPECT_TRUE(reader.open(path).ok());
   frame_solver solver(options);
@@ -456,6 +458,67 @@ TEST_F(solve_file, offline_strength_and_none_are_honoured) {
   off.enabled = false;
   expect_same_poses(solve_with(pose_filter_mode::none, 1.f),
                     reference_poses(input, synth_camera(), off), 0.f);
+}
+
+TEST(solve_file_offline, a_hand_found_again_is_its_measurement_at_once) {
+  // The left hand is lost for half a second and found again curled further. With the offline filter
+  // the smoother decides what was observed, so the solver's gate is open (thresholds 0) and a
+  // bone found again is its measurement at once: no blend in from the rotation held through
+  // the gap (the causal gate's regain blend is for live streams). Strength 0: gaps filled,
+  // nothing smoothed, so the frames after the gap are the solver's own output.
+  test::temp_dir dir{"solve_file_regain"};
+  const std::string path = dir.file("in.landmarks.jsonl");
+  synth_options o;
+  o.seed = 7;
+  landmark_synth synth(o);
+  landmark_writer writer;
+  landmark_file_header h;
+  h.present = true;
+  h.image_width = o.image_width;
+  h.image_height = o.image_height;
+  h.fps = k_fps;
+  ASSERT_TRUE(writer.open(path, h).ok());
+  landmark_frame frame;
+  for (int i = 0; i < 60; ++i) {
+    const double t = 5.0 + i / k_fps;  // the left hand's finger curls (5-9 s)
+    synth.generate(demo_motion_pose(t, synth.skeleton()), frame);
+    frame.t = t;
+    if (i >= 30 && i < 45) {
+      frame.set(frame_part::left_hand, false);
+      frame.set(frame_part::left_hand_world, false);
+    }
+    ASSERT_TRUE(writer.write(frame).ok());
+  }
+  ASSERT_TRUE(writer.commit().ok());
+
+  solve_file_job job;
+  job.input = path;
+  job.filter_mode = pose_filter_mode::offline;
+  job.offline.strength = 0.f;
+  std::vector<proxy_pose> got;
+  job.sink = [&got](const proxy_pose& p) {
+    got.push_back(p);
+    return status{};
+  };
+  solve_file_summary summary;
+  ASSERT_TRUE(job.run(summary).ok());
+  offline_smoother_options fill_only;
+  fill_only.strength = 0.f;
+  expect_same_poses(got, reference_offline_poses(path, synth_camera(), fill_only), 0.f);
+  // With the regain blend the hand after the gap would start from the held rotation.
+  solver_options blended = synth_camera();
+  blended.confidence.lost_below = 0.f;
+  blended.confidence.found_above = 0.f;
+  frame_solver solver(blended);
+  landmark_reader reader;
+  ASSERT_TRUE(reader.open(path).ok());
+  proxy_pose p;
+  // A finger: the hand bone itself is still placed by the body's hand points in the gap.
+  const int finger = idx(bone::left_index_intermediate);
+  for (int i = 0; reader.next(frame) == read_result::frame; ++i) {
+    solver.solve(frame, p);
+    if (i == 45) EXPECT_GT(angle_between(p.rotations[finger], got[45].rotations[finger]), 0.05f);
+  }
 }
 
 TEST_F(solve_file, resampling_runs_after_the_offline_filter) {

@@ -252,6 +252,11 @@ TEST(PoseJitter, ConstantTurnGivesTheCentripetalAcceleration) {
               deg * 1e-3);
   EXPECT_NEAR(j.groups[static_cast<int>(accuracy_group::legs)], 0.0, 1e-6);
   EXPECT_NEAR(j.groups[static_cast<int>(accuracy_group::torso)], 0.0, 1e-6);
+  // Per bone: each moving bone of the left arm has the whole w^2; the rest 0.
+  for (bone b : {bone::left_upper_arm, bone::left_lower_arm, bone::left_hand})
+    EXPECT_NEAR(j.bones[idx(b)], deg, deg * 1e-3) << bone_name(b);
+  for (bone b : {bone::right_upper_arm, bone::left_shoulder, bone::hips, bone::left_upper_leg})
+    EXPECT_NEAR(j.bones[idx(b)], 0.0, 1e-6) << bone_name(b);
 }
 
 TEST(PoseJitter, RefusesShortFilesAndTimesGoingBack) {

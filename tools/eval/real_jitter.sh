@@ -10,8 +10,10 @@
 # (`capture --hands --face`, default models), imports tfjs-models' reference landmarks of the
 # same video (body for the squats, the right hand for asl_hand), solves both with the same
 # options (the defaults unless given) and prints `eval-pose --jitter` per group (deg/s^2,
-# smaller is steadier). asl_hand is compared over the hand alone (`--parts hands` for both): the
-# reference has no body, and the video shows no legs.
+# smaller is steadier). Each video is compared over the parts the reference has, the same for
+# both: the squats over the body (`--parts body,root`; the reference has no hands or face, which
+# in ours drive the wrists, neck and head -- the all-parts row is printed too), asl_hand over
+# the hand alone (`--parts hands`; the reference has no body, and the video shows no legs).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
 exe=${AVATARMAP:-$here/build/avatarmap}
@@ -56,7 +58,8 @@ w, h = json.load(sys.stdin)["image_size"]; print("%dx%d" % (w, h))')
   --fps 25 --hand right -o "$work/asl_ref.landmarks.jsonl" 2>/dev/null
 
 printf '%-28s %9s %9s %9s %9s\n' recording torso arms legs fingers
-jitter "squats, ours" "$work/squats.landmarks.jsonl" "$@"
-jitter "squats, Google's" "$work/squats_ref.landmarks.jsonl" "$@"
+jitter "squats, ours, all parts" "$work/squats.landmarks.jsonl" "$@"
+jitter "squats body, ours" "$work/squats.landmarks.jsonl" --parts body,root "$@"
+jitter "squats body, Google's" "$work/squats_ref.landmarks.jsonl" --parts body,root "$@"
 jitter "asl_hand hand, ours" "$work/asl.landmarks.jsonl" --parts hands "$@"
 jitter "asl_hand hand, Google's" "$work/asl_ref.landmarks.jsonl" --parts hands "$@"

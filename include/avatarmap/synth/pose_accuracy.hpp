@@ -96,6 +96,7 @@ struct pose_jitter {
   long frames = 0;                                       // frames read
   double rms = 0.0;                                      // every measured bone, deg/s^2
   std::array<double, k_direction_group_count> groups{};  // torso, arms, legs, fingers
+  std::array<double, k_bone_count> bones{};  // per measured bone (0 for the head's bones)
 };
 /// Fails (naming the file and line) on a read error, times that do not increase, or fewer than
 /// three frames.

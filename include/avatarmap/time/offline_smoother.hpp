@@ -18,7 +18,13 @@
 //   same width would flatten, so the kernels can be wider for the same lag error.
 // - seen with a low confidence of its own (0 < confidence < observed_above, e.g. an occluded
 //   limb the estimator still places): smoothed over low_confidence_sigma_seconds with every
-//   frame weighted by its confidence; the measurement still says where the bone went.
+//   frame weighted by its confidence while such frames' measured noise says they still carry
+//   the motion (at most 5 x the confident bones' noise and below 1.8 rad per sample, per group:
+//   the body; the hands and fingers; until measured the body's are, the hands' are not); else
+//   filled as a gap.
+// - a hand or finger seen for less than 0.25 s between frames where it was not detected at all
+//   (confidence 0) is a false detection: its frames become gaps (confidence written 0), and the
+//   input's hold of it afterwards is replaced by what the input showed before it.
 // - not observed (a gap: confidence 0, or a hand capped by its arm): filled from both sides.
 //   When the last observed pose before and the next one after are at most max_gap_seconds
 //   apart, the bone is the slerp between their smoothed rotations at the centre's time
@@ -27,8 +33,8 @@
 //   hold_and_ease), from each side symmetrically; with both sides, the two are slerped by time
 //   fraction so nothing snaps. A bone observed nowhere within reach keeps the input's rotations
 //   (e.g. unobservable bones the solver sets from priors), smoothed.
-// - confidence is copied unchanged (a filled bone stays marked as not observed); `t` is the
-//   centre's.
+// - confidence is copied unchanged (a filled bone stays marked as not observed; a false
+//   detection is written 0); `t` is the centre's.
 // The hips position and the expression weights are Gaussian-smoothed (unweighted by
 // confidence: the solver already holds and eases them).
 //
@@ -71,7 +77,7 @@ struct offline_smoother_options {
   /// Noise-adaptive widths: the sigmas above are for the noise of the synthetic "noisy"
   /// scenario at 30 fps (10 mm body, 5 mm hand points); each group's (body, fingers) sigma is
   /// scaled by (noise density / that reference)^(1/7), the rate at which a local quadratic's
-  /// best width grows with its noise, clamped to [1/4, 3/2] (wider would flatten fast motion). The
+  /// best width grows with its noise, clamped to [1/4, 1] (wider would flatten fast motion). The
   /// noise is measured on the input as it streams (second differences of the observed bones'
   /// rotations, a running mean over ~4 s) and its density is per-sample noise^2 / frame rate, so
   /// exact landmarks are barely smoothed and noisier capture is smoothed more. false = the sigmas
@@ -87,8 +93,8 @@ struct offline_smoother_options {
   /// arm as barely visible the hand's points are unreliable even when the hand model is sure.
   bool hands_follow_arms = false;
   /// Bones seen with a low confidence of their own (0 < confidence < observed_above):
-  /// smoothed with this sigma, every frame weighted by its confidence, instead of filled.
-  /// 0 = fill them as gaps.
+  /// smoothed with this sigma, every frame weighted by its confidence, instead of filled (when
+  /// their measured noise allows; see above). 0 = always fill them as gaps.
   float low_confidence_sigma_seconds = 0.3f;
   /// Gaps up to this long (from the last observed frame to the next) are interpolated.
   float max_gap_seconds = 1.5f;
@@ -170,9 +176,20 @@ class offline_smoother {
   double sigma_floor_ = 0.0;   // min_sigma_frames x the last centre's frame interval (capped)
   double sigma_widest_ = 0.0;  // widest adapted sigma used at the last centre
   void observe_noise() noexcept;
+  void drop_flicker() noexcept;
   // Running mean of the second differences' size per group (body, fingers), radians per
   // sample, and of the frame interval; weights (seconds of evidence, capped).
   std::array<double, 2> noise_{};
+  // The same over low-confidence observations (0 < weight < observed_above), per group
+  // (body without the hands; hands and fingers) and its running weight.
+  std::array<double, 2> low_noise_{};
+  std::array<double, 2> low_noise_weight_{};
+  // Whether low-confidence observations of each group still carry the motion (smoothed with
+  // low_confidence_sigma_seconds) or not (filled as gaps); see observe_noise().
+  std::array<bool, 2> low_informative_{};
+  // drop_flicker(): bones whose false detection is being replaced, and by what.
+  std::uint64_t flicker_bits_ = 0;
+  std::array<glm::quat, k_bone_count> flicker_fill_{};
   double noise_dt_ = 0.0;
   double noise_weight_ = 0.0;
   int capacity_ = 0;
