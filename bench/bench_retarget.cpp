@@ -7,8 +7,8 @@
 
 #include "avatarmap/core/rotation.hpp"
 #include "avatarmap/rig/retarget.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/synth/random_pose.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
 
 namespace {
 
@@ -17,7 +17,7 @@ using namespace avatarmap;
 // A rig with a joint per proxy bone at the synthetic skeleton's T-pose positions and random
 // rest rotations.
 rig make_rig(bone_binding& binding) {
-  const synth_skeleton sk = make_synth_skeleton(1.7f);
+  const proxy_skeleton sk = make_proxy_skeleton(1.7f);
   proxy_pose rest;
   rest.hips_position = glm::vec3(0.f, standing_hips_height(sk), 0.f);
   std::array<glm::vec3, k_bone_count> joints;

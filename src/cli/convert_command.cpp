@@ -14,7 +14,7 @@
 #include "avatarmap/jobs/solve_file.hpp"
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "avatarmap/rig/retarget.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/time/resample_clip.hpp"
 #include "avatarmap/time/seconds_text.hpp"
 #include "cli/cli_args.hpp"
@@ -116,7 +116,7 @@ void append_position(std::string& s, const std::string& name, glm::dvec3 p, bool
 // Diagnostic (--dump-positions, used by tools/interop/check_blender.sh): every joint's world
 // position (metres, the output's world axes) per written frame, as JSON
 // {"unit":"m","fps":F,"frames":[{"name":[x,y,z],...},...]}. Rig output: every rig joint, rig
-// FK of the retargeted poses; otherwise the proxy bones on the synthetic skeleton written to
+// FK of the retargeted poses; otherwise the proxy bones on the proxy skeleton written to
 // BVH. Joint names must need no JSON escaping (interop files only).
 status dump_positions(const std::string& path, double fps, const std::vector<proxy_pose>& sampled,
                       const rig* r, const std::vector<rig_pose>& poses) {
@@ -140,7 +140,7 @@ status dump_positions(const std::string& path, double fps, const std::vector<pro
       s += "}";
     }
   } else {
-    const synth_skeleton sk = make_synth_skeleton();
+    const proxy_skeleton sk = make_proxy_skeleton();
     std::array<glm::vec3, k_bone_count> joints;
     for (size_t f = 0; f < sampled.size(); ++f) {
       s += f ? ",{" : "{";

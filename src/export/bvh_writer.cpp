@@ -23,7 +23,7 @@ bool has_children(int b) {
   return false;
 }
 
-void write_joint(std::string& s, const synth_skeleton& sk, int b, int depth, double scale) {
+void write_joint(std::string& s, const proxy_skeleton& sk, int b, int depth, double scale) {
   std::string indent(static_cast<std::size_t>(depth), '\t');
   bool root = bone_parent(b) == k_no_parent;
   s += indent + (root ? "ROOT " : "JOINT ") + std::string(bone_name(static_cast<bone>(b))) + "\n" +
@@ -83,7 +83,7 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
   else if (frames.size() > 1)
     frame_time = (frames.back().t - frames.front().t) / static_cast<double>(frames.size() - 1);
   const double scale = options.units == bvh_units::centimetres ? 100.0 : 1.0;
-  const synth_skeleton sk = make_synth_skeleton(options.height);
+  const proxy_skeleton sk = make_proxy_skeleton(options.height);
 
   io_detail::text_output out;
   if (status s = out.open(path); !s) return s;

@@ -80,7 +80,7 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
     return s;
   const std::size_t n = keys.size();
 
-  const synth_skeleton skeleton = make_synth_skeleton(options.height);
+  const proxy_skeleton skeleton = make_proxy_skeleton(options.height);
   std::array<int, k_bone_count> node_of_bone;
   node_of_bone.fill(-1);
   json nodes = json::array();

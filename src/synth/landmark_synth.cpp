@@ -268,13 +268,13 @@ int synth_limb_of(bone b) {
 }
 
 landmark_synth::landmark_synth(const synth_options& options)
-    : skeleton_(make_synth_skeleton(options.validate().ok() ? options.person_height
-                                                            : k_synth_reference_height)),
+    : skeleton_(make_proxy_skeleton(options.validate().ok() ? options.person_height
+                                                            : k_proxy_reference_height)),
       options_(options) {
   init();
 }
 
-landmark_synth::landmark_synth(const synth_skeleton& skeleton, const synth_options& options)
+landmark_synth::landmark_synth(const proxy_skeleton& skeleton, const synth_options& options)
     : skeleton_(skeleton), options_(options) {
   init();
 }
@@ -466,7 +466,7 @@ void landmark_synth::generate(const proxy_pose& pose, landmark_frame& out) {
     p = &mirrored_;
     camera.x = -camera.x;
   }
-  compute_synth_fk(skeleton_, *p, fk_);
+  compute_proxy_fk(skeleton_, *p, fk_);
   update_bursts(pose.t);
   // Bursts are the person's limbs; mirrored output swaps the labels of the points they hit.
   auto burst_on_output_side = [&](bool arm, int output_side) {

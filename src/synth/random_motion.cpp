@@ -64,7 +64,7 @@ motion_channel motion_channel_of(bone b) {
                                                  : motion_channel::right_fingers;
 }
 
-random_motion::random_motion(const synth_skeleton& skeleton, std::uint32_t seed,
+random_motion::random_motion(const proxy_skeleton& skeleton, std::uint32_t seed,
                              const random_motion_options& options)
     : skeleton_(skeleton), seed_(seed), options_(options) {
   restart();

@@ -185,7 +185,7 @@ float pulse(float centre, float half_width, float x) {
 }
 }  // namespace
 
-proxy_pose demo_motion_pose(double t_seconds, const synth_skeleton& skeleton) {
+proxy_pose demo_motion_pose(double t_seconds, const proxy_skeleton& skeleton) {
   proxy_pose p;
   p.t = t_seconds;
   p.confidence.fill(1.f);
@@ -260,7 +260,7 @@ proxy_pose demo_motion_pose(double t_seconds, const synth_skeleton& skeleton) {
 }
 
 proxy_pose demo_motion_pose(double t) {
-  static const synth_skeleton k_default = make_synth_skeleton();
+  static const proxy_skeleton k_default = make_proxy_skeleton();
   return demo_motion_pose(t, k_default);
 }
 

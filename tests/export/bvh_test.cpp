@@ -64,7 +64,7 @@ TEST(bvh, write_read_round_trip) {
     EXPECT_NEAR(clip.frame_time, 1.0 / 60.0, 1e-9);
     EXPECT_EQ(clip.channel_count, 6 + 3 * (k_bone_count - 1));
     const float scale = units == bvh_units::centimetres ? 100.f : 1.f;
-    synth_skeleton sk = make_synth_skeleton();
+    proxy_skeleton sk = make_proxy_skeleton();
     double worst = 0.0;
     for (int b = 0; b < k_bone_count; ++b) {
       int j = joint_index(clip, std::string(bone_name(static_cast<bone>(b))));

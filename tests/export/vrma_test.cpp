@@ -223,7 +223,7 @@ TEST(vrma_write, random_poses_round_trip) {
   EXPECT_LT(worst, 0.01);
   std::printf("[ synthetic ] max rotation error %.3g degrees\n", worst);
   EXPECT_EQ(clip.expression_names.size(), 12u);
-  EXPECT_NEAR(clip.rest_hips_height, standing_hips_height(make_synth_skeleton()), 1e-5f);
+  EXPECT_NEAR(clip.rest_hips_height, standing_hips_height(make_proxy_skeleton()), 1e-5f);
 }
 
 TEST(vrma_write, file_structure_follows_the_spec) {

@@ -11,8 +11,8 @@
 
 #include "avatarmap/core/euler.hpp"
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/synth/random_pose.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
 #include "support/rig_fk.hpp"
 
 namespace avatarmap {
@@ -102,7 +102,7 @@ struct test_rig {
 test_rig make_mixamo_like(bool a_pose, bool skip_chest, uint32_t seed) {
   test_rig t;
   t.binding.fill(-1);
-  const synth_skeleton sk = make_synth_skeleton(1.70f);
+  const proxy_skeleton sk = make_proxy_skeleton(1.70f);
   proxy_pose rest;
   rest.hips_position = glm::vec3(0.f, standing_hips_height(sk), 0.f);
   if (a_pose) {

@@ -281,7 +281,7 @@ TEST(SynthScenario, BurstsSwapWithTheLabelsWhenMirrored) {
 }
 
 TEST(RandomMotion, IsAPureFunctionOfTime) {
-  const synth_skeleton sk = make_synth_skeleton(1.8f);
+  const proxy_skeleton sk = make_proxy_skeleton(1.8f);
   random_motion a(sk, 11), b(sk, 11), c(sk, 12);
   proxy_pose pa, pb, pc;
   for (int i = 0; i < 300; ++i) a.pose_at(i * 0.05, pa);  // a walked there, b jumps
@@ -301,7 +301,7 @@ TEST(RandomMotion, IsAPureFunctionOfTime) {
 // The hands' world angular speed reaches ~6 rad/s (fast motion) but not much more; finger
 // intermediate and distal joints bend sideways (non-hinge) within the +-10 degree range.
 TEST(RandomMotion, WristsAreFastAndFingersAreNotHinges) {
-  const synth_skeleton sk = make_synth_skeleton();
+  const proxy_skeleton sk = make_proxy_skeleton();
   random_motion m(sk, 3);
   const double dt = 0.005;
   std::array<glm::quat, k_bone_count> prev{}, cur{};

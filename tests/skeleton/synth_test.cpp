@@ -7,9 +7,9 @@
 #include <random>
 
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
 
 using namespace avatarmap;
 
@@ -57,7 +57,7 @@ synth_options all_parts() {
 
 TEST(SynthSkeleton, PrimaryChildrenLieAlongRestDirections) {
   for (float height : {1.70f, 1.55f, 1.92f}) {
-    synth_skeleton s = make_synth_skeleton(height);
+    proxy_skeleton s = make_proxy_skeleton(height);
     EXPECT_FLOAT_EQ(s.scale, height / 1.70f);
     for (int b = 0; b < k_bone_count; ++b) {
       EXPECT_GT(s.lengths[b], 0.f) << bone_name(static_cast<bone>(b));
@@ -80,22 +80,22 @@ TEST(SynthSkeleton, PrimaryChildrenLieAlongRestDirections) {
 }
 
 TEST(SynthSkeleton, StandingHeightAndGrounding) {
-  synth_skeleton s = make_synth_skeleton(1.70f);
+  proxy_skeleton s = make_proxy_skeleton(1.70f);
   float h = standing_hips_height(s);
   EXPECT_NEAR(h, 0.89f, 0.01f);
   proxy_pose rest;
   rest.hips_position = glm::vec3(0.3f, 5.f, -1.f);
   ground_pose(s, rest);
   EXPECT_NEAR(rest.hips_position.y, h, 1e-5f);
-  synth_fk fk;
-  compute_synth_fk(s, rest, fk);
+  proxy_fk fk;
+  compute_proxy_fk(s, rest, fk);
   // The top of the head is the person's height.
   EXPECT_NEAR(fk.tips[idx(bone::head)].y, 1.70f, 0.005f);
-  EXPECT_NEAR(standing_hips_height(make_synth_skeleton(1.9f)), h * 1.9f / 1.7f, 1e-4f);
+  EXPECT_NEAR(standing_hips_height(make_proxy_skeleton(1.9f)), h * 1.9f / 1.7f, 1e-4f);
 }
 
 TEST(SynthFk, MatchesIndependentEigenFk) {
-  synth_skeleton s = make_synth_skeleton(1.76f);
+  proxy_skeleton s = make_proxy_skeleton(1.76f);
   std::mt19937 rng(7);
   for (int n = 0; n < 50; ++n) {
     proxy_pose p = random_pose(rng);
@@ -116,8 +116,8 @@ TEST(SynthFk, MatchesIndependentEigenFk) {
     }
     std::array<glm::vec3, k_bone_count> mine;
     joint_world_positions(s, p, mine);
-    synth_fk fk;
-    compute_synth_fk(s, p, fk);
+    proxy_fk fk;
+    compute_proxy_fk(s, p, fk);
     for (int b = 0; b < k_bone_count; ++b) {
       for (int k = 0; k < 3; ++k) {
         EXPECT_NEAR(mine[b][k], joints[b][k], 1e-5f);
@@ -461,7 +461,7 @@ TEST(Synth, ExpressionsDriveTheFace) {
 }
 
 TEST(RandomPose, FingersFlexTowardThePalmOnBothHands) {
-  synth_skeleton s = make_synth_skeleton();
+  proxy_skeleton s = make_proxy_skeleton();
   std::mt19937 rng(5);
   random_pose_limits lim;
   for (int n = 0; n < 100; ++n) {
@@ -475,8 +475,8 @@ TEST(RandomPose, FingersFlexTowardThePalmOnBothHands) {
         continue;
       hands.rotations[b] = p.rotations[b];
     }
-    synth_fk fk;
-    compute_synth_fk(s, hands, fk);
+    proxy_fk fk;
+    compute_proxy_fk(s, hands, fk);
     // Flexion in [0, 110] degrees: each intermediate joint lies at or below its knuckle.
     for (bone prox : {bone::left_index_proximal, bone::right_ring_proximal,
                       bone::left_little_proximal, bone::right_middle_proximal})
@@ -486,8 +486,8 @@ TEST(RandomPose, FingersFlexTowardThePalmOnBothHands) {
   proxy_pose p;
   p[bone::left_index_proximal] = axis_angle(glm::vec3(0.f, 0.f, -1.f), 1.f);
   p[bone::right_index_proximal] = mirror_x(p[bone::left_index_proximal]);
-  synth_fk fk;
-  compute_synth_fk(s, p, fk);
+  proxy_fk fk;
+  compute_proxy_fk(s, p, fk);
   glm::vec3 l = fk.tips[idx(bone::left_index_distal)], r = fk.tips[idx(bone::right_index_distal)];
   EXPECT_LT(l.y, fk.joints[idx(bone::left_hand)].y - 0.03f);
   EXPECT_NEAR(l.y, r.y, 1e-5f);
@@ -495,14 +495,14 @@ TEST(RandomPose, FingersFlexTowardThePalmOnBothHands) {
 }
 
 TEST(DemoMotion, FeetOnTheFloorHipsLowerAndLoops) {
-  synth_skeleton s = make_synth_skeleton();
+  proxy_skeleton s = make_proxy_skeleton();
   float standing = standing_hips_height(s);
   proxy_pose a = demo_motion_pose(0.0), squat = demo_motion_pose(1.0), b = demo_motion_pose(10.0);
   EXPECT_NEAR(a.hips_position.y, standing, 1e-3f);
   EXPECT_LT(squat.hips_position.y, standing - 0.15f);
   EXPECT_NEAR(lowest_foot_point(s, squat), 0.f, 1e-5f);
-  synth_fk sq;
-  compute_synth_fk(s, squat, sq);  // feet stay flat: heel and toe tip on the floor
+  proxy_fk sq;
+  compute_proxy_fk(s, squat, sq);  // feet stay flat: heel and toe tip on the floor
   EXPECT_NEAR(sq.heels[0].y, 0.f, 1e-3f);
   EXPECT_NEAR(sq.tips[idx(bone::right_toes)].y, 0.f, 1e-3f);
   EXPECT_GT(sq.joints[idx(bone::left_lower_leg)].z,
@@ -519,8 +519,8 @@ TEST(DemoMotion, FeetOnTheFloorHipsLowerAndLoops) {
     for (float e : p.expressions) EXPECT_TRUE(e >= 0.f && e <= 1.f);
   }
   // Waving: right wrist above the right elbow, both above the shoulder.
-  synth_fk fk;
-  compute_synth_fk(s, demo_motion_pose(6.0), fk);
+  proxy_fk fk;
+  compute_proxy_fk(s, demo_motion_pose(6.0), fk);
   EXPECT_GT(fk.joints[idx(bone::right_hand)].y, fk.joints[idx(bone::right_upper_arm)].y);
 }
 

@@ -8,10 +8,10 @@
 #include <random>
 
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
 
 namespace avatarmap {
 namespace {

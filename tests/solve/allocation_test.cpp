@@ -11,10 +11,10 @@
 #include "avatarmap/rig/formula.hpp"
 #include "avatarmap/rig/mapping.hpp"
 #include "avatarmap/rig/retarget.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
 #include "support/counting_new.hpp"
@@ -64,7 +64,7 @@ TEST(Allocation, SolveFilterAndResampleAllocateNothingPerFrame) {
 // Retargeting onto a rig (rest-aware path and table formulas) allocates nothing per frame
 // once the output is prepared.
 TEST(Allocation, RetargetAllocatesNothingPerFrame) {
-  const synth_skeleton sk = make_synth_skeleton(1.7f);
+  const proxy_skeleton sk = make_proxy_skeleton(1.7f);
   proxy_pose rest;
   rest.hips_position = glm::vec3(0.f, standing_hips_height(sk), 0.f);
   std::array<glm::vec3, k_bone_count> joints;

@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
 #include "support/test_data.hpp"
 
 namespace avatarmap {

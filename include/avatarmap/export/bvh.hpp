@@ -1,4 +1,4 @@
-// Biovision Hierarchy (.bvh): writing proxy poses on the synthetic skeleton or retargeted poses
+// Biovision Hierarchy (.bvh): writing proxy poses on the proxy skeleton or retargeted poses
 // on an avatar's own rig, and a minimal
 // reader (hierarchy + motion values) for round trips and for checking third-party clips.
 // Conventions: docs/export.md.
@@ -14,7 +14,7 @@
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/rig/rig.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 
 namespace avatarmap {
 
@@ -29,9 +29,9 @@ struct bvh_write_options {
   /// Length unit of OFFSETs and root positions. Centimetres by default, like most BVH tools
   /// (Blender, MotionBuilder, the CMU clips).
   bvh_units units = bvh_units::centimetres;
-  /// Height (metres) of the synthetic skeleton (make_synth_skeleton) whose T-pose offsets
+  /// Height (metres) of the proxy skeleton (make_proxy_skeleton) whose T-pose offsets
   /// become the joints' OFFSETs.
-  float height = k_synth_reference_height;
+  float height = k_proxy_reference_height;
 };
 
 /// Writes `frames` (held in memory by the caller) as a BVH file at `path`.
@@ -39,7 +39,7 @@ struct bvh_write_options {
 /// HIERARCHY: all 55 proxy bones, VRM names, in proxy order (parents first, depth-first);
 /// ROOT hips with OFFSET 0 0 0 and channels Xposition Yposition Zposition Zrotation
 /// Xrotation Yrotation; every other joint has Zrotation Xrotation Yrotation. OFFSETs are the
-/// synthetic skeleton's T-pose offsets (VRM axes: Y up, facing +Z, avatar's left +X); leaf
+/// proxy skeleton's T-pose offsets (VRM axes: Y up, facing +Z, avatar's left +X); leaf
 /// bones get an End Site at their tip (length * rest direction). MOTION: root position =
 /// hips_position (world, in `units`; rest pose T-pose, so no rest rotation is needed), angles
 /// in degrees such that the joint's local rotation is Rz(z) * Rx(x) * Ry(y) (column vectors;

@@ -14,7 +14,7 @@
 #include "avatarmap/skeleton/bone.hpp"
 #include "avatarmap/skeleton/expression.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 
 namespace avatarmap {
 
@@ -87,9 +87,9 @@ struct vrma_write_options {
   /// 0: one key per frame at the frames' own times. > 0: keys at k / fps seconds, the frames
   /// resampled (slerp on the shortest arc for rotations, linear for hips and expressions).
   double fps = 0.0;
-  /// Height (metres) of the synthetic skeleton (make_synth_skeleton) whose T-pose offsets
+  /// Height (metres) of the proxy skeleton (make_proxy_skeleton) whose T-pose offsets
   /// become the nodes' rest translations; the hips node rests at standing_hips_height().
-  float height = k_synth_reference_height;
+  float height = k_proxy_reference_height;
   /// Subtract the first frame's t so that the animation starts at 0 (glTF times must not be
   /// negative). When false every frame's t must be >= 0.
   bool start_at_zero = true;
@@ -102,7 +102,7 @@ struct vrma_write_options {
 
 /// Writes `frames` (held in memory by the caller; each ~1.2 kB) as a .vrma at `path`:
 /// a node per bone for which is_vrma_bone() holds (names = VRM names, rest rotation
-/// identity, rest translation from the synthetic skeleton), a node per written expression
+/// identity, rest translation from the proxy skeleton), a node per written expression
 /// (a root node named after it), and one animation "avatarmap" with a LINEAR rotation channel
 /// per bone, a LINEAR translation channel for hips (hips_position, metres, as given) and a
 /// LINEAR translation channel per expression (x = weight clamped to [0, 1]). Quaternions are

@@ -1,7 +1,7 @@
 // Synthetic ground truth: the landmark_frame that MediaPipe would ideally output for a known
 // proxy_pose. The reference of every solver accuracy test, and the CLI's demo recording.
 //
-// Geometry (VRM space, metres; skeleton and FK in synth_skeleton.hpp):
+// Geometry (VRM space, metres; skeleton and FK in proxy_skeleton.hpp):
 // - Pose: 11/12 upper-arm joints, 13/14 lower-arm joints, 15/16 hand joints, 17/18 little-
 //   proximal joints, 19/20 index-proximal joints, 21/22 thumb-proximal joints, 23/24 upper-leg
 //   joints, 25/26 lower-leg joints, 27/28 foot joints, 29/30 heels (foot joint + foot world *
@@ -45,7 +45,7 @@
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 
 namespace avatarmap {
 
@@ -88,7 +88,7 @@ struct synth_options {
   /// left_hand...). frame_solver with options.mirror = true undoes it.
   bool mirror = false;
   /// Person height in metres; used only by the constructor that builds the skeleton itself.
-  float person_height = k_synth_reference_height;
+  float person_height = k_proxy_reference_height;
   /// Standard deviation (metres, >= 0) of isotropic Gaussian noise added to every 3-D point
   /// (VRM space) before projection and output, per part.
   float body_noise_sigma = 0.f;
@@ -155,7 +155,7 @@ class landmark_synth {
   /// invalid options are replaced by defaults in release builds).
   explicit landmark_synth(const synth_options& options = {});
   /// Uses `skeleton` (options.person_height is ignored).
-  landmark_synth(const synth_skeleton& skeleton, const synth_options& options);
+  landmark_synth(const proxy_skeleton& skeleton, const synth_options& options);
 
   /// Writes the frame for `pose` into `out` (out.t = pose.t; parts per options; every other
   /// part cleared). Non-unit rotations give distorted bones: pass unit quaternions.
@@ -185,12 +185,12 @@ class landmark_synth {
     return l >= 0 && in_burst_[l];
   }
 
-  const synth_skeleton& skeleton() const { return skeleton_; }
+  const proxy_skeleton& skeleton() const { return skeleton_; }
   const synth_options& options() const { return options_; }
   /// 3-D points of the last generate() call.
   const synth_points& points() const { return points_; }
   /// FK of the last generate() call (of the mirrored pose when options.mirror is set).
-  const synth_fk& fk() const { return fk_; }
+  const proxy_fk& fk() const { return fk_; }
 
  private:
   void init();
@@ -200,7 +200,7 @@ class landmark_synth {
   void update_bursts(double t);
   float draw_visibility();
 
-  synth_skeleton skeleton_;
+  proxy_skeleton skeleton_;
   synth_options options_;
   glm::vec3 camera_{0.f};
   float focal_ = 1.f;
@@ -216,7 +216,7 @@ class landmark_synth {
   std::array<double, k_synth_limb_count> burst_end_{};
   std::array<bool, k_synth_limb_count> in_burst_{};
   proxy_pose mirrored_;
-  synth_fk fk_;
+  proxy_fk fk_;
   synth_points points_;
 };
 

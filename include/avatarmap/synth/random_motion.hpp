@@ -19,8 +19,8 @@
 #include <random>
 
 #include "avatarmap/skeleton/proxy_pose.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/synth/random_pose.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
 
 namespace avatarmap {
 
@@ -71,13 +71,13 @@ motion_channel motion_channel_of(bone b);
 /// Not thread-safe (one object per thread).
 class random_motion {
  public:
-  random_motion(const synth_skeleton& skeleton, std::uint32_t seed,
+  random_motion(const proxy_skeleton& skeleton, std::uint32_t seed,
                 const random_motion_options& options = {});
 
   /// The pose at time t seconds (t = out.t; confidence 1 for every bone).
   void pose_at(double t, proxy_pose& out);
 
-  const synth_skeleton& skeleton() const { return skeleton_; }
+  const proxy_skeleton& skeleton() const { return skeleton_; }
 
  private:
   struct channel_state {
@@ -89,7 +89,7 @@ class random_motion {
   void advance(int channel);
   float segment_seconds(int channel, const proxy_pose& a, const proxy_pose& b);
 
-  synth_skeleton skeleton_;
+  proxy_skeleton skeleton_;
   std::uint32_t seed_;
   random_motion_options options_;
   std::array<channel_state, k_motion_channel_count> channels_;

@@ -15,7 +15,7 @@
 #include <random>
 
 #include "avatarmap/skeleton/proxy_pose.hpp"
-#include "avatarmap/synth/synth_skeleton.hpp"
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 
 namespace avatarmap {
 
@@ -87,7 +87,7 @@ proxy_pose random_pose(std::mt19937& rng, const random_pose_limits& limits = {})
 /// (0-4 s, feet kept flat on the floor), waving with the right hand (4-8 s), left-hand finger
 /// curls (5-9 s), talking (6-9.5 s), blinks, a slow head turn and gaze. hips_position puts
 /// the soles on Y = 0 for `skeleton`. Allocation-free.
-proxy_pose demo_motion_pose(double t, const synth_skeleton& skeleton);
+proxy_pose demo_motion_pose(double t, const proxy_skeleton& skeleton);
 /// Same for the default 1.70 m skeleton.
 proxy_pose demo_motion_pose(double t);
 

@@ -1,6 +1,6 @@
-// Rest skeleton table (1.70 m person, scaled) and forward kinematics of the synthetic ground
-// truth. See include/avatarmap/synth/synth_skeleton.hpp.
-#include "avatarmap/synth/synth_skeleton.hpp"
+// Rest skeleton table (1.70 m person, scaled) and forward kinematics of the proxy skeleton. See
+// include/avatarmap/skeleton/proxy_skeleton.hpp.
+#include "avatarmap/skeleton/proxy_skeleton.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -49,17 +49,17 @@ const finger_row k_fingers[4] = {
 };
 
 // Sets bone b's length and its primary child's offset along the rest direction.
-void chain(synth_skeleton& s, bone b, bone child, float length) {
+void chain(proxy_skeleton& s, bone b, bone child, float length) {
   s.lengths[idx(b)] = length;
   s.offsets[idx(child)] = length * bone_rest_direction(b);
 }
 
 }  // namespace
 
-synth_skeleton make_synth_skeleton(float height) {
+proxy_skeleton make_proxy_skeleton(float height) {
   assert(height > 0.f && std::isfinite(height));
-  if (!(height > 0.f) || !std::isfinite(height)) height = k_synth_reference_height;
-  synth_skeleton s;
+  if (!(height > 0.f) || !std::isfinite(height)) height = k_proxy_reference_height;
+  proxy_skeleton s;
   s.height = height;
   s.offsets.fill(glm::vec3(0.f));
   s.lengths.fill(0.f);
@@ -109,7 +109,7 @@ synth_skeleton make_synth_skeleton(float height) {
     s.lengths[m] = s.lengths[b];
   }
 
-  s.scale = height / k_synth_reference_height;
+  s.scale = height / k_proxy_reference_height;
   for (int b = 0; b < k_bone_count; ++b) {
     s.offsets[b] *= s.scale;
     s.lengths[b] *= s.scale;
@@ -118,7 +118,7 @@ synth_skeleton make_synth_skeleton(float height) {
   return s;
 }
 
-void compute_synth_fk(const synth_skeleton& skeleton, const proxy_pose& pose, synth_fk& out) {
+void compute_proxy_fk(const proxy_skeleton& skeleton, const proxy_pose& pose, proxy_fk& out) {
   compute_world_rotations(pose, out.world);
   for (int b = 0; b < k_bone_count; ++b) {
     int p = bone_parent(b);
@@ -135,7 +135,7 @@ void compute_synth_fk(const synth_skeleton& skeleton, const proxy_pose& pose, sy
       out.joints[idx(bone::right_foot)] + out.world[idx(bone::right_foot)] * skeleton.heel_offset;
 }
 
-void joint_world_positions(const synth_skeleton& skeleton, const proxy_pose& pose,
+void joint_world_positions(const proxy_skeleton& skeleton, const proxy_pose& pose,
                            std::array<glm::vec3, k_bone_count>& out_joints) {
   std::array<glm::quat, k_bone_count> world;
   compute_world_rotations(pose, world);
@@ -146,20 +146,20 @@ void joint_world_positions(const synth_skeleton& skeleton, const proxy_pose& pos
   }
 }
 
-float lowest_foot_point(const synth_skeleton& skeleton, const proxy_pose& pose) {
-  synth_fk fk;
-  compute_synth_fk(skeleton, pose, fk);
+float lowest_foot_point(const proxy_skeleton& skeleton, const proxy_pose& pose) {
+  proxy_fk fk;
+  compute_proxy_fk(skeleton, pose, fk);
   return std::min({fk.heels[0].y, fk.heels[1].y, fk.tips[idx(bone::left_toes)].y,
                    fk.tips[idx(bone::right_toes)].y});
 }
 
-float standing_hips_height(const synth_skeleton& skeleton) {
+float standing_hips_height(const proxy_skeleton& skeleton) {
   proxy_pose rest;
   rest.hips_position = glm::vec3(0.f);
   return -lowest_foot_point(skeleton, rest);
 }
 
-void ground_pose(const synth_skeleton& skeleton, proxy_pose& pose) {
+void ground_pose(const proxy_skeleton& skeleton, proxy_pose& pose) {
   pose.hips_position.y -= lowest_foot_point(skeleton, pose);
 }
 

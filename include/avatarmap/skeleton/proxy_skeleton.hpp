@@ -1,7 +1,8 @@
-// The synthetic ground truth's rest skeleton and its forward kinematics. The skeleton is the
-// independent reference of every solver accuracy test: a proxy_pose (local rotations in VRM
-// normalised space + hips_position) is turned into joint positions here, then into landmarks
-// by landmark_synth (landmark_synth.hpp).
+// The proxy skeleton's proportions (a 1.70 m person, scalable) and its forward kinematics: the
+// rest offsets of the VRM 1.0 humanoid bones that the proxy pose's rotations act on. Exports
+// that write proxy poses without an avatar (.vrma, proxy .bvh) take their rest translations
+// from it; the synthetic ground truth (synth/) turns a proxy_pose (local rotations in VRM
+// normalised space + hips_position) into joint positions here, then into landmarks.
 //
 // Space: VRM (metres, Y up, the avatar faces +Z, avatar's left = +X); rest = VRM T-pose.
 // For every bone, offsets[primary child] == lengths[bone] * bone_rest_direction(bone), so a
@@ -19,13 +20,13 @@
 namespace avatarmap {
 
 /// Height of the reference person the proportion table is written for (metres).
-inline constexpr float k_synth_reference_height = 1.70f;
+inline constexpr float k_proxy_reference_height = 1.70f;
 
-/// Rest skeleton of a synthetic person. Build with make_synth_skeleton(); the fields are
+/// Rest skeleton of a synthetic person. Build with make_proxy_skeleton(); the fields are
 /// plain data so that tests can inspect (or deliberately break) them.
-struct synth_skeleton {
-  float height = k_synth_reference_height;  // metres, top of the head above the soles
-  float scale = 1.f;                        // height / k_synth_reference_height
+struct proxy_skeleton {
+  float height = k_proxy_reference_height;  // metres, top of the head above the soles
+  float scale = 1.f;                        // height / k_proxy_reference_height
   /// Rest offset of each bone's joint from its parent's joint (VRM, metres). hips: zero.
   std::array<glm::vec3, k_bone_count> offsets{};
   /// Length of each bone along bone_rest_direction(): to its primary child's joint, or to its
@@ -37,12 +38,12 @@ struct synth_skeleton {
 
 /// Rest skeleton of a person `height` metres tall (every length of the 1.70 m table scaled
 /// by height / 1.70). `height` must be positive and finite (asserted); 1.70 by default.
-synth_skeleton make_synth_skeleton(float height = k_synth_reference_height);
+proxy_skeleton make_proxy_skeleton(float height = k_proxy_reference_height);
 
 /// Forward kinematics of one pose: world rotations, joint positions and bone tips (VRM space,
 /// metres). joints[hips] = pose.hips_position; joints[b] = joints[parent] +
 /// world[parent] * offsets[b]; tips[b] = joints[b] + world[b] * (lengths[b] * rest_dir(b)).
-struct synth_fk {
+struct proxy_fk {
   std::array<glm::quat, k_bone_count> world{};
   std::array<glm::vec3, k_bone_count> joints{};
   std::array<glm::vec3, k_bone_count> tips{};
@@ -51,20 +52,20 @@ struct synth_fk {
 
 /// Fills `out` for `pose` (rotations need not be normalised: they are used as given, so pass
 /// unit quaternions).
-void compute_synth_fk(const synth_skeleton& skeleton, const proxy_pose& pose, synth_fk& out);
+void compute_proxy_fk(const proxy_skeleton& skeleton, const proxy_pose& pose, proxy_fk& out);
 
-/// Joint positions only (VRM, metres), as in synth_fk::joints.
-void joint_world_positions(const synth_skeleton& skeleton, const proxy_pose& pose,
+/// Joint positions only (VRM, metres), as in proxy_fk::joints.
+void joint_world_positions(const proxy_skeleton& skeleton, const proxy_pose& pose,
                            std::array<glm::vec3, k_bone_count>& out_joints);
 
 /// Height of the hips joint above the soles in the rest pose (metres); the sole is the lowest
 /// of the heel and toe-tip points.
-float standing_hips_height(const synth_skeleton& skeleton);
+float standing_hips_height(const proxy_skeleton& skeleton);
 
 /// Y (VRM, metres) of the lowest heel or toe-tip point of `pose`.
-float lowest_foot_point(const synth_skeleton& skeleton, const proxy_pose& pose);
+float lowest_foot_point(const proxy_skeleton& skeleton, const proxy_pose& pose);
 
 /// Moves pose.hips_position.y so that the lowest heel or toe-tip point lies at Y = 0.
-void ground_pose(const synth_skeleton& skeleton, proxy_pose& pose);
+void ground_pose(const proxy_skeleton& skeleton, proxy_pose& pose);
 
 }  // namespace avatarmap
