@@ -1,0 +1,178 @@
+// The C API's clip handle (avm_clip_*): poses collected in memory, then written as a file by
+// the library's clip-output job (the CLI's `convert` runs it too).
+#include <cmath>
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "avatarmap/avatarmap.h"
+#include "avatarmap/core/rotation.hpp"
+#include "avatarmap/jobs/clip_output.hpp"
+#include "avatarmap/rig/rig.hpp"
+#include "avatarmap/rig/rig_binding.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+#include "c_avatar.hpp"
+#include "c_guard.hpp"
+
+namespace am = avatarmap;
+using namespace avatarmap::c_api;
+
+struct avm_clip : avatarmap::c_api::error_slot {
+  std::vector<am::proxy_pose> frames;
+};
+
+namespace {
+
+float clamp01(float v) { return v < 0.f ? 0.f : (v > 1.f ? 1.f : v); }
+
+// The C pose as a proxy pose, non-finite values taken as missing (see avm_clip_add).
+void sanitized_pose(const avm_pose& in, const am::proxy_pose* prev, am::proxy_pose& out) {
+  out.set_rest();
+  out.t = in.t;
+  for (int i = 0; i < 3; ++i) {
+    const float v = in.hips_position[i];
+    out.hips_position[i] =
+        std::isfinite(v) ? v : (prev != nullptr ? prev->hips_position[i] : out.hips_position[i]);
+  }
+  for (int b = 0; b < am::k_bone_count; ++b) {
+    const auto bi = static_cast<std::size_t>(b);
+    const glm::quat q = am::load_xyzw(in.rotations[b]);
+    const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+    const bool good = std::isfinite(n2) && n2 > 1e-12f;
+    if (good) {
+      out.rotations[bi] = q * (1.f / std::sqrt(n2));
+      const float c = in.confidence[b];
+      out.confidence[bi] = std::isfinite(c) ? clamp01(c) : 0.f;
+    } else {
+      out.rotations[bi] = prev != nullptr ? prev->rotations[bi] : am::identity_quat();
+      out.confidence[bi] = 0.f;
+    }
+  }
+  for (int e = 0; e < am::k_expression_count; ++e) {
+    const auto ei = static_cast<std::size_t>(e);
+    const float w = in.expressions[e];
+    out.expressions[ei] =
+        std::isfinite(w) ? clamp01(w) : (prev != nullptr ? prev->expressions[ei] : 0.f);
+  }
+}
+
+// Writes `frames` to `path` with the library's clip-output job (the CLI's `convert` runs it
+// too): the job's checks first, then the avatar (loaded and bound only when the format uses
+// it), then the write. On failure returns the status and sets `msg`.
+avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::string& path,
+                      double fps, const char* avatar_path, const char* mapping, std::string& msg) {
+  am::clip_output_job job;
+  job.path = path;
+  job.frames = &frames;
+  job.fps = fps;
+  job.avatar_path = avatar_path != nullptr ? avatar_path : "";
+  if (am::status st = job.validate(); !st.ok()) {
+    msg = st.message();
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  // An avatar with its binding (large: kept on the heap).
+  struct bound_avatar {
+    am::rig rig;
+    am::rig_binding_choice choice;
+  };
+  std::unique_ptr<bound_avatar> avatar;
+  if (avatar_path != nullptr && am::find_clip_format(path)->uses_avatar) {
+    avatar = std::make_unique<bound_avatar>();
+    const avm_status code =
+        load_bound_avatar(avatar_path, mapping, avatar->rig, avatar->choice, msg);
+    if (code != AVM_OK) return code;
+    job.avatar_rig = &avatar->rig;
+    job.avatar_binding = avatar->choice.binding;
+    job.avatar_table = avatar->choice.table_or_null();
+  }
+  am::clip_output_summary summary;
+  if (am::status st = job.run(summary); !st.ok()) {
+    msg = st.message();
+    return code_for(st, job_code(summary.failure));
+  }
+  return AVM_OK;
+}
+
+}  // namespace
+
+extern "C" {
+
+AVATARMAP_C_API avm_status avm_clip_create(avm_clip** out) {
+  set_create_error("");
+  if (out == nullptr) {
+    set_create_error("avm_clip_create: out is NULL");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  *out = nullptr;
+  return guard("avm_clip_create", to_create_error, [&]() -> avm_status {
+    *out = new avm_clip();
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API void avm_clip_destroy(avm_clip* clip) {
+  guard_value(0, [&] {
+    delete clip;
+    return 0;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_clip_add(avm_clip* clip, const avm_pose* pose) {
+  if (clip == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  clip->last_error.clear();
+  if (pose == nullptr) {
+    set_error(clip, "avm_clip_add: pose is NULL");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  if (!std::isfinite(pose->t)) {
+    set_error(clip, "avm_clip_add: pose->t must be finite");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  return guard("avm_clip_add", to_handle(clip), [&]() -> avm_status {
+    const am::proxy_pose* prev = clip->frames.empty() ? nullptr : &clip->frames.back();
+    if (prev != nullptr && !(pose->t > prev->t)) {
+      const std::string msg = "avm_clip_add: pose->t (" + std::to_string(pose->t) +
+                              ") must be after the previous frame's (" + std::to_string(prev->t) +
+                              ")";
+      set_error(clip, msg.c_str());
+      return AVM_ERROR_INVALID_ARGUMENT;
+    }
+    am::proxy_pose p;
+    sanitized_pose(*pose, prev, p);
+    clip->frames.push_back(p);  // may reallocate: `prev` is not used after this
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API int avm_clip_frame_count(const avm_clip* clip) {
+  return guard_value(0,
+                     [&] { return clip == nullptr ? 0 : static_cast<int>(clip->frames.size()); });
+}
+
+AVATARMAP_C_API avm_status avm_clip_write(avm_clip* clip, const char* path, double fps,
+                                          const char* avatar_path, const char* mapping, char* err,
+                                          size_t err_size) {
+  copy_message(err, err_size, "");
+  if (clip != nullptr) clip->last_error.clear();
+  auto report = [&](avm_status code, const char* msg) {
+    copy_message(err, err_size, msg);
+    set_error(clip, msg);
+    return code;
+  };
+  if (clip == nullptr || path == nullptr)
+    return report(AVM_ERROR_INVALID_ARGUMENT, "avm_clip_write: clip and path must not be NULL");
+  return guard("avm_clip_write", report, [&]() -> avm_status {
+    std::string msg;
+    const avm_status code = write_clip(clip->frames, path, fps, avatar_path, mapping, msg);
+    if (code != AVM_OK) return report(code, msg.c_str());
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API const char* avm_clip_last_error(const avm_clip* clip) {
+  return guard_value<const char*>("",
+                                  [&] { return clip == nullptr ? "" : clip->last_error.c_str(); });
+}
+
+}  // extern "C"

@@ -1,0 +1,65 @@
+// Conversions between the C API's frames and poses and the library's (c_frames.hpp).
+#include "c_frames.hpp"
+
+#include <cmath>
+
+#include "avatarmap/core/rotation.hpp"
+
+namespace avatarmap::c_api {
+
+namespace am = avatarmap;
+
+namespace {
+void copy_part(am::landmark_frame& dst, am::frame_part part, const avm_landmark* src, int n,
+               am::landmark* out) {
+  dst.set(part, src != nullptr);
+  if (src == nullptr) return;
+  for (int i = 0; i < n; ++i) {
+    out[i].x = src[i].x;
+    out[i].y = src[i].y;
+    out[i].z = src[i].z;
+    out[i].visibility = src[i].visibility;
+    out[i].presence = src[i].presence;
+  }
+}
+
+}  // namespace
+
+// Checks a C frame; on failure returns a static message.
+const char* check_frame(const avm_frame& f) noexcept {
+  if (!std::isfinite(f.t)) return "avm_frame.t must be finite";
+  if (f.face != nullptr && f.face_count != AVM_FACE_LANDMARK_COUNT &&
+      f.face_count != AVM_FACE_IRIS_LANDMARK_COUNT)
+    return "avm_frame.face_count must be 468 or 478 when face is not NULL";
+  return nullptr;
+}
+
+void convert_frame(const avm_frame& f, am::landmark_frame& out) noexcept {
+  out.clear();
+  out.t = f.t;
+  using fp = am::frame_part;
+  copy_part(out, fp::pose, f.pose, AVM_POSE_LANDMARK_COUNT, out.pose.data());
+  copy_part(out, fp::pose_world, f.pose_world, AVM_POSE_LANDMARK_COUNT, out.pose_world.data());
+  copy_part(out, fp::left_hand, f.left_hand, AVM_HAND_LANDMARK_COUNT, out.left_hand.data());
+  copy_part(out, fp::left_hand_world, f.left_hand_world, AVM_HAND_LANDMARK_COUNT,
+            out.left_hand_world.data());
+  copy_part(out, fp::right_hand, f.right_hand, AVM_HAND_LANDMARK_COUNT, out.right_hand.data());
+  copy_part(out, fp::right_hand_world, f.right_hand_world, AVM_HAND_LANDMARK_COUNT,
+            out.right_hand_world.data());
+  copy_part(out, fp::face, f.face, f.face != nullptr ? f.face_count : 0, out.face.data());
+  out.face_count = f.face != nullptr ? f.face_count : 0;
+}
+
+void to_c_pose(const am::proxy_pose& p, avm_pose& out) noexcept {
+  out.t = p.t;
+  out.hips_position[0] = p.hips_position.x;
+  out.hips_position[1] = p.hips_position.y;
+  out.hips_position[2] = p.hips_position.z;
+  for (int b = 0; b < AVM_BONE_COUNT; ++b) {
+    am::store_xyzw(p.rotations[b], out.rotations[b]);
+    out.confidence[b] = p.confidence[b];
+  }
+  for (int e = 0; e < AVM_EXPRESSION_COUNT; ++e) out.expressions[e] = p.expressions[e];
+}
+
+}  // namespace avatarmap::c_api

@@ -1,0 +1,124 @@
+// The C API's library-wide functions: version, status strings, bone and expression names,
+// the create error (bindings/c/include/avatarmap/avatarmap.h).
+#include <cstring>
+#include <string_view>
+
+#include "avatarmap/avatarmap.h"
+#include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/skeleton/bone.hpp"
+#include "avatarmap/skeleton/expression.hpp"
+#include "avatarmap/version.hpp"
+#include "c_guard.hpp"
+
+namespace am = avatarmap;
+using namespace avatarmap::c_api;
+
+static_assert(AVM_VERSION_MAJOR == AVATARMAP_VERSION_MAJOR &&
+                  AVM_VERSION_MINOR == AVATARMAP_VERSION_MINOR &&
+                  AVM_VERSION_PATCH == AVATARMAP_VERSION_PATCH,
+              "avatarmap.h and avatarmap/version.hpp disagree on the version");
+static_assert(AVM_BONE_COUNT == am::k_bone_count, "bone count");
+static_assert(AVM_EXPRESSION_COUNT == am::k_expression_count, "expression count");
+static_assert(AVM_POSE_LANDMARK_COUNT == am::k_pose_landmark_count, "pose landmark count");
+static_assert(AVM_HAND_LANDMARK_COUNT == am::k_hand_landmark_count, "hand landmark count");
+static_assert(AVM_FACE_LANDMARK_COUNT == am::k_face_mesh_count, "face landmark count");
+static_assert(AVM_FACE_IRIS_LANDMARK_COUNT == am::k_face_mesh_iris_count, "face+iris count");
+static_assert(AVM_BONE_RIGHT_LITTLE_DISTAL == am::idx(am::bone::right_little_distal) &&
+                  AVM_BONE_LEFT_HAND == am::idx(am::bone::left_hand) &&
+                  AVM_BONE_RIGHT_TOES == am::idx(am::bone::right_toes) &&
+                  AVM_BONE_JAW == am::idx(am::bone::jaw),
+              "avm_bone must follow avatarmap::bone");
+static_assert(AVM_EXPRESSION_BROW_DOWN_RIGHT == am::idx(am::expression::brow_down_right) &&
+                  AVM_EXPRESSION_LOOK_UP == am::idx(am::expression::look_up),
+              "avm_expression must follow avatarmap::expression");
+
+namespace {
+const char* status_text(avm_status status) noexcept {
+  // A C caller may pass any int: read it as one (an out-of-range value is not an avm_status in
+  // C++, and switching on it would be undefined).
+  int value = 0;
+  static_assert(sizeof value == sizeof status, "avm_status is an int");
+  std::memcpy(&value, &status, sizeof value);
+  switch (value) {
+    case AVM_OK:
+      return "ok";
+    case AVM_ERROR_INVALID_ARGUMENT:
+      return "invalid argument";
+    case AVM_ERROR_IO:
+      return "input/output error";
+    case AVM_ERROR_PARSE:
+      return "parse error";
+    case AVM_ERROR_END_OF_FILE:
+      return "end of file";
+    case AVM_ERROR_UNSUPPORTED:
+      return "unsupported";
+    case AVM_ERROR_OUT_OF_MEMORY:
+      return "out of memory";
+    case AVM_ERROR_INTERNAL:
+      return "internal error";
+  }
+  return "unknown status";
+}
+
+}  // namespace
+
+extern "C" {
+
+AVATARMAP_C_API void avm_version(int* out_major, int* out_minor, int* out_patch) {
+  guard_value(0, [&] {
+    if (out_major != nullptr) *out_major = AVATARMAP_VERSION_MAJOR;
+    if (out_minor != nullptr) *out_minor = AVATARMAP_VERSION_MINOR;
+    if (out_patch != nullptr) *out_patch = AVATARMAP_VERSION_PATCH;
+    return 0;
+  });
+}
+
+AVATARMAP_C_API const char* avm_version_string(void) {
+  return guard_value<const char*>("", [] { return AVATARMAP_VERSION_STRING; });
+}
+
+AVATARMAP_C_API const char* avm_status_string(avm_status status) {
+  return guard_value<const char*>("unknown status", [&] { return status_text(status); });
+}
+
+AVATARMAP_C_API const char* avm_last_create_error(void) {
+  return guard_value<const char*>("", [] { return create_error(); });
+}
+
+AVATARMAP_C_API const char* avm_bone_name(int bone) {
+  return guard_value<const char*>(nullptr, [&]() -> const char* {
+    if (bone < 0 || bone >= AVM_BONE_COUNT) return nullptr;
+    // The names are string_views over string literals: NUL-terminated.
+    return am::bone_name(static_cast<am::bone>(bone)).data();
+  });
+}
+
+AVATARMAP_C_API int avm_bone_parent(int bone) {
+  return guard_value(
+      -1, [&] { return bone < 0 || bone >= AVM_BONE_COUNT ? -1 : am::bone_parent(bone); });
+}
+
+AVATARMAP_C_API int avm_bone_from_name(const char* name) {
+  return guard_value(-1, [&] {
+    if (name == nullptr) return -1;
+    auto b = am::bone_from_name(std::string_view(name));
+    return b ? am::idx(*b) : -1;
+  });
+}
+
+AVATARMAP_C_API const char* avm_expression_name(int expression) {
+  return guard_value<const char*>(nullptr, [&]() -> const char* {
+    if (expression < 0 || expression >= AVM_EXPRESSION_COUNT) return nullptr;
+    return am::expression_name(static_cast<am::expression>(expression)).data();
+  });
+}
+
+AVATARMAP_C_API int avm_expression_from_name(const char* name) {
+  return guard_value(-1, [&] {
+    if (name == nullptr) return -1;
+    auto e = am::expression_from_name(std::string_view(name));
+    return e ? am::idx(*e) : -1;
+  });
+}
+
+}  // extern "C"

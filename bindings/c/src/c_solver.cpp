@@ -1,0 +1,185 @@
+// The C API's solver handle and file solve (avm_solver_*, avm_solve_file): options read and
+// checked, landmarks -> proxy pose -> live filter -> resampler per frame, and the library's
+// solve-file job for files.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <string>
+
+#include "avatarmap/avatarmap.h"
+#include "avatarmap/jobs/solve_file.hpp"
+#include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+#include "avatarmap/solve/frame_solver.hpp"
+#include "avatarmap/solve/solver_options.hpp"
+#include "avatarmap/time/offline_smoother.hpp"
+#include "avatarmap/time/pose_filter.hpp"
+#include "avatarmap/time/pose_resampler.hpp"
+#include "c_frames.hpp"
+#include "c_guard.hpp"
+#include "c_solver_options.hpp"
+
+namespace am = avatarmap;
+using namespace avatarmap::c_api;
+
+// The handle. Everything a frame needs is preallocated here.
+struct avm_solver : avatarmap::c_api::error_slot {
+  am::frame_solver solver;
+  am::pose_filter filter;
+  am::pose_resampler resampler;
+  am::pose_filter_channels channels;
+  am::landmark_frame frame;  // scratch: the C frame converted
+  am::proxy_pose raw;        // scratch: solved, before filtering
+  am::proxy_pose latest;     // solved and filtered
+  am::proxy_pose sampled;    // scratch for sample()
+
+  avm_solver(const am::solver_options& s, const am::pose_filter_options& f,
+             const am::pose_resampler_options& r)
+      : solver(s), filter(f), resampler(r) {}
+};
+
+extern "C" {
+
+AVATARMAP_C_API avm_status avm_solver_options_init(avm_solver_options* options) {
+  if (options == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  return guard("avm_solver_options_init", silently, [&]() -> avm_status {
+    *options = default_options();
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_solver_create(const avm_solver_options* options,
+                                             avm_solver** out_solver) {
+  set_create_error("");
+  if (out_solver == nullptr) {
+    set_create_error("avm_solver_create: out_solver is NULL");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  *out_solver = nullptr;
+  return guard("avm_solver_create", to_create_error, [&]() -> avm_status {
+    core_options o;
+    std::string msg;
+    if (!read_options(options, o, msg)) {
+      set_create_error(msg.c_str());
+      return AVM_ERROR_INVALID_ARGUMENT;
+    }
+    auto* s = new avm_solver(o.solver, o.filter, o.resampler);
+    s->channels = o.channels;
+    s->latest.set_rest();
+    s->last_error.reserve(128);  // push's messages fit without allocating
+    *out_solver = s;
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API void avm_solver_destroy(avm_solver* solver) {
+  guard_value(0, [&] {
+    delete solver;
+    return 0;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_solver_reset(avm_solver* solver) {
+  if (solver == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  solver->last_error.clear();
+  return guard("avm_solver_reset", to_handle(solver), [&]() -> avm_status {
+    solver->solver.reset();
+    solver->filter.reset();
+    solver->resampler.reset();
+    solver->latest.set_rest();
+    solver->latest.t = 0.0;
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_solver_push(avm_solver* solver, const avm_frame* frame) {
+  if (solver == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  solver->last_error.clear();
+  if (frame == nullptr)
+    return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_push: frame is NULL");
+  if (const char* bad = check_frame(*frame)) return fail(solver, AVM_ERROR_INVALID_ARGUMENT, bad);
+  return guard("avm_solver_push", to_handle(solver), [&]() -> avm_status {
+    convert_frame(*frame, solver->frame);
+    solver->solver.solve(solver->frame, solver->raw);
+    am::filter_pose_channels(solver->filter, solver->channels, solver->raw, solver->latest);
+    solver->latest.t = frame->t;
+    if (!solver->resampler.push(solver->latest))
+      return fail(solver, AVM_ERROR_INTERNAL, "avm_solver_push: the resampler refused the pose");
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_solver_get_pose(const avm_solver* solver, avm_pose* out_pose) {
+  if (solver == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  solver->last_error.clear();
+  if (out_pose == nullptr)
+    return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_get_pose: out_pose is NULL");
+  return guard("avm_solver_get_pose", to_handle(solver), [&]() -> avm_status {
+    to_c_pose(solver->latest, *out_pose);
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_solver_sample(avm_solver* solver, double t, avm_pose* out_pose) {
+  if (solver == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  solver->last_error.clear();
+  if (out_pose == nullptr)
+    return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_sample: out_pose is NULL");
+  if (!std::isfinite(t))
+    return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_sample: t must be finite");
+  return guard("avm_solver_sample", to_handle(solver), [&]() -> avm_status {
+    if (!solver->resampler.sample(t, solver->sampled)) {
+      solver->sampled.set_rest();  // nothing pushed yet
+      solver->sampled.t = t;
+    }
+    to_c_pose(solver->sampled, *out_pose);
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API const char* avm_solver_last_error(const avm_solver* solver) {
+  return guard_value<const char*>(
+      "", [&] { return solver == nullptr ? "" : solver->last_error.c_str(); });
+}
+
+AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* out_pose,
+                                          const avm_solver_options* options, char* err,
+                                          size_t err_size) {
+  copy_message(err, err_size, "");
+  set_create_error("");
+  auto report = [&](avm_status code, const char* msg) {
+    copy_message(err, err_size, msg);
+    return code;
+  };
+  if (in_landmarks == nullptr || out_pose == nullptr)
+    return report(AVM_ERROR_INVALID_ARGUMENT, "avm_solve_file: a path is NULL");
+  return guard("avm_solve_file", report, [&]() -> avm_status {
+    core_options o;
+    std::string msg;
+    if (!read_options(options, o, msg)) {
+      set_create_error(msg.c_str());
+      return report(AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
+    }
+    // The library's solve-file job (the CLI's `solve` runs it too), on this thread.
+    am::solve_file_job job;
+    job.input = in_landmarks;
+    job.output = out_pose;
+    job.options = o.solver;
+    // Non-zero options.image_width/height win over the file's header (0 = the header's).
+    job.image_width = o.solver.image_width;
+    job.image_height = o.solver.image_height;
+    job.filter_mode = o.file_filter;
+    job.offline.strength = o.file_smoothing;
+    job.filter = o.filter;
+    job.filter_channels = o.channels;
+    job.threads = 1;
+    am::solve_file_summary summary;
+    const am::status st = job.run(summary);
+    if (!st) return report(code_for(st, job_code(summary.failure)), st.message().c_str());
+    return AVM_OK;
+  });
+}
+
+}  // extern "C"
