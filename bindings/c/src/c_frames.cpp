@@ -62,4 +62,31 @@ void to_c_pose(const am::proxy_pose& p, avm_pose& out) noexcept {
   for (int e = 0; e < AVM_EXPRESSION_COUNT; ++e) out.expressions[e] = p.expressions[e];
 }
 
+void to_c_frame(const am::landmark_frame& in, frame_storage& storage, avm_frame& out) noexcept {
+  auto part = [&](am::frame_part p, const am::landmark* src, int n,
+                  avm_landmark* dst) -> const avm_landmark* {
+    if (!in.has(p)) return nullptr;
+    for (int i = 0; i < n; ++i)
+      dst[i] = {src[i].x, src[i].y, src[i].z, src[i].visibility, src[i].presence};
+    return dst;
+  };
+  using fp = am::frame_part;
+  out.t = in.t;
+  out.pose = part(fp::pose, in.pose.data(), AVM_POSE_LANDMARK_COUNT, storage.pose.data());
+  out.pose_world = part(fp::pose_world, in.pose_world.data(), AVM_POSE_LANDMARK_COUNT,
+                        storage.pose_world.data());
+  out.left_hand =
+      part(fp::left_hand, in.left_hand.data(), AVM_HAND_LANDMARK_COUNT, storage.left_hand.data());
+  out.left_hand_world = part(fp::left_hand_world, in.left_hand_world.data(),
+                             AVM_HAND_LANDMARK_COUNT, storage.left_hand_world.data());
+  out.right_hand = part(fp::right_hand, in.right_hand.data(), AVM_HAND_LANDMARK_COUNT,
+                        storage.right_hand.data());
+  out.right_hand_world = part(fp::right_hand_world, in.right_hand_world.data(),
+                              AVM_HAND_LANDMARK_COUNT, storage.right_hand_world.data());
+  const bool face = in.has(fp::face) && (in.face_count == AVM_FACE_LANDMARK_COUNT ||
+                                         in.face_count == AVM_FACE_IRIS_LANDMARK_COUNT);
+  out.face = face ? part(fp::face, in.face.data(), in.face_count, storage.face.data()) : nullptr;
+  out.face_count = face ? in.face_count : 0;
+}
+
 }  // namespace avatarmap::c_api

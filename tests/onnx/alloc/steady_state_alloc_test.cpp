@@ -11,6 +11,7 @@
 #include <string>
 
 #include "../onnx_support.hpp"
+#include "avatarmap/capture/capture_pipeline.hpp"
 #include "avatarmap/capture/estimator.hpp"
 #include "capture/onnx/ort_model.hpp"
 #include "support/test_data.hpp"
@@ -60,6 +61,35 @@ TEST(steady_state, no_allocation_outside_onnx_runtime) {
   EXPECT_TRUE(f.has(frame_part::face));
   std::printf("[figures] parts seen: 0x%x; allocations outside ONNX Runtime in 30 frames: %ld\n",
               parts, g_outside.load());
+  EXPECT_EQ(g_outside.load(), 0);
+}
+
+// The same through capture_pipeline (what the C API's estimator and live handles run): the
+// estimator, the solver and the live filter together allocate nothing per frame either.
+TEST(steady_state, capture_pipeline_allocates_nothing_outside_onnx_runtime) {
+  const std::string models = test::models_dir();
+  if (models.empty()) GTEST_SKIP() << "AVATARMAP_MODELS is not set (folder of converted models)";
+  if (test::test_data_dir().empty()) GTEST_SKIP() << test::k_no_test_data;
+  test::loaded_image img;
+  ASSERT_TRUE(test::load_image(test::test_data_path("motion/tfjs-models/pose.jpg"), img));
+  capture_pipeline_options o;
+  o.estimator.source = models;
+  o.estimator.threads = 1;
+  o.estimator.hands = o.estimator.face = true;
+  std::unique_ptr<capture_pipeline> p;
+  const status s = capture_pipeline::create(o, p);
+  ASSERT_TRUE(s.ok()) << s.message();
+  landmark_frame f;
+  proxy_pose pose;
+  g_outside = 0;
+  for (int i = 0; i < 40; ++i) {
+    if (i == 10) g_counting = true;
+    ASSERT_TRUE(p->process(img.view(), i / 30.0, f, pose).ok());
+  }
+  g_counting = false;
+  EXPECT_TRUE(f.has(frame_part::pose));
+  std::printf("[figures] capture_pipeline: allocations outside ONNX Runtime in 30 frames: %ld\n",
+              g_outside.load());
   EXPECT_EQ(g_outside.load(), 0);
 }
 

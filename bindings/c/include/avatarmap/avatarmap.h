@@ -540,6 +540,145 @@ AVATARMAP_C_API avm_status avm_clip_write(avm_clip* clip, const char* path, doub
  * NULL). Owned by the clip, valid until the next call on it or its destruction. */
 AVATARMAP_C_API const char* avm_clip_last_error(const avm_clip* clip);
 
+/* ---- capture: images -> landmarks -> poses ------------------------------------------- */
+
+/* Pixel layouts of avm_image: 8 bits per channel, rows top to bottom. */
+typedef enum avm_pixel_format {
+  AVM_PIXEL_RGB8 = 0,
+  AVM_PIXEL_BGR8 = 1,
+  AVM_PIXEL_RGBA8 = 2,
+  AVM_PIXEL_BGRA8 = 3
+} avm_pixel_format;
+
+/* An image owned by the caller, only read during the call that receives it. */
+typedef struct avm_image {
+  const uint8_t* data;  /* the first row's first pixel */
+  int32_t width;        /* pixels, 1 .. 16384 */
+  int32_t height;       /* pixels, 1 .. 16384 */
+  int32_t stride_bytes; /* bytes from one row to the next, >= width x bytes per pixel */
+  int32_t format;       /* an avm_pixel_format */
+} avm_image;
+
+/* Options of the estimator (MediaPipe's models on ONNX Runtime, CPU). Initialise with
+ * avm_estimator_options_init(), then change fields (struct_size as for avm_solver_options).
+ * Booleans are int32_t, 0 or non-zero. */
+typedef struct avm_estimator_options {
+  uint32_t struct_size;          /* sizeof(avm_estimator_options) as the caller knows it */
+  const char* models_dir;        /* the converted models (scripts/prepare_capture.sh makes them);
+                                    NULL or "": $AVATARMAP_MODELS/onnx. Read during create only. */
+  int32_t model_complexity;      /* body landmark model: 0 lite, 1 full (default), 2 heavy */
+  int32_t hands;                 /* estimate both hands (default 1) */
+  int32_t face;                  /* estimate the face mesh (default 1) */
+  int32_t hand_model_complexity; /* hand landmark model: 0 lite, 1 full (default) */
+  int32_t threads;               /* ONNX Runtime threads, 1 .. 64 (default 2) */
+  int32_t mirrored;              /* the images are mirrored (a selfie preview); default 0 */
+  int32_t static_images;         /* detect on every image (unrelated stills); default 0 */
+} avm_estimator_options;
+
+/* Fills *options with the defaults above. AVM_ERROR_INVALID_ARGUMENT when options is NULL. */
+AVATARMAP_C_API avm_status avm_estimator_options_init(avm_estimator_options* options);
+
+/* An estimator: images in capture order -> landmarks -> solved, live-filtered poses (the
+ * same steps as `avatarmap live`). Opaque; created by avm_estimator_create(). */
+typedef struct avm_estimator avm_estimator;
+
+/* Creates an estimator: loads the models (a few hundred milliseconds). `options` NULL = the
+ * defaults; `solver_options` NULL = the solver's defaults (its image size 0 = each image's;
+ * its filter fields set the live filter; file_* fields are not used). Both are only read
+ * during the call. On success *out is a new handle owned by the caller (free it with
+ * avm_estimator_destroy()).
+ * Failures (*out is set to NULL whenever out is not NULL):
+ *   AVM_ERROR_INVALID_ARGUMENT: out NULL, a field out of range, no models folder given and
+ *     $AVATARMAP_MODELS unset;
+ *   AVM_ERROR_IO: the models are missing or unreadable (the message names the folder);
+ *   AVM_ERROR_UNSUPPORTED: this library was built without the ONNX Runtime backend;
+ *   AVM_ERROR_OUT_OF_MEMORY; AVM_ERROR_INTERNAL. avm_last_create_error() says which.
+ * Thread-safe. */
+AVATARMAP_C_API avm_status avm_estimator_create(const avm_estimator_options* options,
+                                                const avm_solver_options* solver_options,
+                                                avm_estimator** out);
+
+/* Frees an estimator. NULL does nothing. The handle must not be in use by another thread. */
+AVATARMAP_C_API void avm_estimator_destroy(avm_estimator* estimator);
+
+/* Estimates the landmarks of one image (capture time t, seconds, increasing) and solves and
+ * filters them. Either output may be NULL. *out_frame's pointers then point into the
+ * estimator's own storage (NULL for parts not seen), valid until the next call on it or its
+ * destruction; *out_pose is copied. A frame with no person is not an error (its parts are
+ * NULL; the pose holds and eases what was lost). Allocates nothing outside ONNX Runtime.
+ * One thread at a time per estimator.
+ * Failures (outputs unchanged): AVM_ERROR_INVALID_ARGUMENT: estimator or image NULL, no
+ *   pixels, a size outside 1 .. 16384, an unknown format, a stride below width x bytes per
+ *   pixel, t not finite; AVM_ERROR_INTERNAL (the estimator failed). avm_estimator_last_error()
+ *   says which. */
+AVATARMAP_C_API avm_status avm_estimator_process(avm_estimator* estimator, const avm_image* image,
+                                                 double t, avm_frame* out_frame,
+                                                 avm_pose* out_pose);
+
+/* Message of the last failed call on `estimator` ("" after a success or for NULL); owned by
+ * the estimator, valid until the next call on it or its destruction. */
+AVATARMAP_C_API const char* avm_estimator_last_error(const avm_estimator* estimator);
+
+/* ---- live: a camera thread pushes, a render thread polls ------------------------------ */
+
+/* A live capture: the caller's camera thread pushes images (copied, never waiting for
+ * processing); a worker thread of the handle processes the newest one as avm_estimator does
+ * (one pushed while it is busy replaces the waiting one: dropped and counted, so latency
+ * stays one frame's processing time); any thread asks for the pose at any time. Opaque. */
+typedef struct avm_live avm_live;
+
+/* Counters and latency of a live handle. */
+typedef struct avm_live_stats {
+  int64_t pushed;        /* images pushed */
+  int64_t processed;     /* images processed */
+  int64_t dropped;       /* images replaced before the worker took them */
+  int64_t failed;        /* images the estimator failed on (avm_live_last_error) */
+  double latency_p50_ms; /* push -> pose ready, over the last 4096 processed images */
+  double latency_p95_ms;
+  double latency_max_ms;
+  double newest_t; /* capture time of the newest processed pose; 0 before the first */
+} avm_live_stats;
+
+/* Creates a live handle and starts its worker thread; options as avm_estimator_create() (the
+ * solver options' max_extrapolation_seconds bounds avm_live_sample()'s extrapolation).
+ * Failures and messages as avm_estimator_create(). Thread-safe. */
+AVATARMAP_C_API avm_status avm_live_create(const avm_estimator_options* options,
+                                           const avm_solver_options* solver_options,
+                                           avm_live** out);
+
+/* Stops the worker (waits for the image in process, if any) and frees the handle. NULL does
+ * nothing. No other call on the handle may be in flight or follow. */
+AVATARMAP_C_API void avm_live_destroy(avm_live* live);
+
+/* Camera thread: copies `image` (capture time t, seconds, increasing) for the worker and
+ * returns at once. Allocates only when an image larger than any before arrives. One thread at
+ * a time may push; it may run concurrently with the calls below.
+ * Failures (nothing queued): AVM_ERROR_INVALID_ARGUMENT for the image checks of
+ * avm_estimator_process() or t not finite. */
+AVATARMAP_C_API avm_status avm_live_push(avm_live* live, const avm_image* image, double t);
+
+/* Any thread, any time: the pose at capture time t (slerp between processed frames, a short
+ * extrapolation past the newest, then held) into *out_pose (out_pose->t = t). To follow a
+ * camera, pass the newest capture time you pushed (or that minus a frame for pure
+ * interpolation). Before the first processed image: AVM_ERROR_END_OF_FILE and the rest pose.
+ * Allocates nothing.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT when live or out_pose is NULL or t is not finite. */
+AVATARMAP_C_API avm_status avm_live_sample(const avm_live* live, double t, avm_pose* out_pose);
+
+/* Any thread, any time: the newest processed pose. Before the first: AVM_ERROR_END_OF_FILE
+ * and the rest pose. Failures: AVM_ERROR_INVALID_ARGUMENT when live or out_pose is NULL. */
+AVATARMAP_C_API avm_status avm_live_latest(const avm_live* live, avm_pose* out_pose);
+
+/* Any thread: the counters and latency so far. AVM_ERROR_INVALID_ARGUMENT when an argument
+ * is NULL. */
+AVATARMAP_C_API avm_status avm_live_get_stats(const avm_live* live, avm_live_stats* out_stats);
+
+/* Any thread: the message of the last image the worker failed on, else of the last failed
+ * call on the handle ("" when none, or for NULL). Copied into `buffer` (truncated, always
+ * NUL-terminated); returns `buffer`. */
+AVATARMAP_C_API const char* avm_live_last_error(const avm_live* live, char* buffer,
+                                                size_t buffer_size);
+
 #ifdef __cplusplus
 } /* extern "C" */
 #endif

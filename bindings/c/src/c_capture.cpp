@@ -1,0 +1,94 @@
+// The C API's estimator handle (avm_estimator_*): images -> landmarks -> solved, live-filtered
+// poses, the library's capture_pipeline on the caller's thread.
+#include <array>
+#include <memory>
+#include <string>
+
+#include "avatarmap/avatarmap.h"
+#include "avatarmap/capture/capture_pipeline.hpp"
+#include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+#include "c_capture_options.hpp"
+#include "c_frames.hpp"
+#include "c_guard.hpp"
+
+namespace am = avatarmap;
+using namespace avatarmap::c_api;
+
+struct avm_estimator : avatarmap::c_api::error_slot {
+  std::unique_ptr<am::capture_pipeline> pipeline;
+  am::landmark_frame frame;  // the last image's landmarks
+  am::proxy_pose pose;       // and its pose
+  frame_storage storage;     // what avm_frame's pointers point into
+};
+
+extern "C" {
+
+AVATARMAP_C_API avm_status avm_estimator_options_init(avm_estimator_options* options) {
+  if (options == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  return guard("avm_estimator_options_init", silently, [&]() -> avm_status {
+    *options = default_estimator_options();
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_estimator_create(const avm_estimator_options* options,
+                                                const avm_solver_options* solver_options,
+                                                avm_estimator** out) {
+  set_create_error("");
+  if (out == nullptr) {
+    set_create_error("avm_estimator_create: out is NULL");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  *out = nullptr;
+  return guard("avm_estimator_create", to_create_error, [&]() -> avm_status {
+    am::capture_pipeline_options po;
+    double extrapolation = 0.0;
+    std::string msg;
+    const avm_status code = read_capture_options(options, solver_options, po, extrapolation, msg);
+    if (code != AVM_OK) return to_create_error(code, msg.c_str());
+    std::unique_ptr<avm_estimator> e(new avm_estimator());
+    const am::status st = am::capture_pipeline::create(po, e->pipeline);
+    if (!st.ok()) return to_create_error(capture_create_code(st), st.message().c_str());
+    e->pose.set_rest();
+    e->last_error.reserve(256);  // the image checks' messages fit without allocating
+    *out = e.release();
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API void avm_estimator_destroy(avm_estimator* estimator) {
+  guard_value(0, [&] {
+    delete estimator;
+    return 0;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_estimator_process(avm_estimator* estimator, const avm_image* image,
+                                                 double t, avm_frame* out_frame,
+                                                 avm_pose* out_pose) {
+  if (estimator == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  estimator->last_error.clear();
+  return guard("avm_estimator_process", to_handle(estimator), [&]() -> avm_status {
+    if (image == nullptr)
+      return fail(estimator, AVM_ERROR_INVALID_ARGUMENT, "avm_estimator_process: image is NULL");
+    if (!std::isfinite(t))
+      return fail(estimator, AVM_ERROR_INVALID_ARGUMENT, "avm_estimator_process: t must be finite");
+    am::image_view view;
+    char buffer[k_error_capacity];
+    if (const char* bad = to_image_view(*image, view, buffer, sizeof buffer))
+      return fail(estimator, AVM_ERROR_INVALID_ARGUMENT, bad);
+    const am::status st = estimator->pipeline->process(view, t, estimator->frame, estimator->pose);
+    if (!st.ok()) return fail(estimator, code_for(st, AVM_ERROR_INTERNAL), st.message().c_str());
+    if (out_frame != nullptr) to_c_frame(estimator->frame, estimator->storage, *out_frame);
+    if (out_pose != nullptr) to_c_pose(estimator->pose, *out_pose);
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API const char* avm_estimator_last_error(const avm_estimator* estimator) {
+  return guard_value<const char*>(
+      "", [&] { return estimator == nullptr ? "" : estimator->last_error.c_str(); });
+}
+
+}  // extern "C"

@@ -1,0 +1,149 @@
+// The C API's live handle (avm_live_*): the library's live_session — the caller's camera thread
+// pushes images, the session's worker processes the newest, any thread samples the pose.
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "avatarmap/avatarmap.h"
+#include "avatarmap/capture/live_session.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+#include "c_capture_options.hpp"
+#include "c_frames.hpp"
+#include "c_guard.hpp"
+
+namespace am = avatarmap;
+using namespace avatarmap::c_api;
+
+// The error slot of a live handle is written by push (one thread) and read by any: a mutex
+// guards it, and avm_live_last_error copies it out.
+struct avm_live {
+  std::unique_ptr<am::live_session> session;
+  mutable std::mutex error_m;
+  char push_error[k_error_capacity] = "";
+  // Scratch for the pushing thread (never shared).
+  char buffer[k_error_capacity] = "";
+
+  avm_status push_failed(avm_status code, const char* msg) noexcept {
+    std::lock_guard<std::mutex> lock(error_m);
+    copy_message(push_error, sizeof push_error, msg);
+    return code;
+  }
+};
+
+namespace {
+avm_status rest_pose(double t, avm_pose* out) noexcept {
+  am::proxy_pose rest;
+  rest.set_rest();
+  rest.t = t;
+  to_c_pose(rest, *out);
+  return AVM_ERROR_END_OF_FILE;
+}
+}  // namespace
+
+extern "C" {
+
+AVATARMAP_C_API avm_status avm_live_create(const avm_estimator_options* options,
+                                           const avm_solver_options* solver_options,
+                                           avm_live** out) {
+  set_create_error("");
+  if (out == nullptr) {
+    set_create_error("avm_live_create: out is NULL");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  *out = nullptr;
+  return guard("avm_live_create", to_create_error, [&]() -> avm_status {
+    am::live_session_options lo;
+    double extrapolation = 0.0;
+    std::string msg;
+    const avm_status code =
+        read_capture_options(options, solver_options, lo.pipeline, extrapolation, msg);
+    if (code != AVM_OK) return to_create_error(code, msg.c_str());
+    lo.resampler.max_extrapolation_seconds = extrapolation;
+    std::unique_ptr<avm_live> l(new avm_live());
+    const am::status st = am::live_session::create(lo, l->session);
+    if (!st.ok()) return to_create_error(capture_create_code(st), st.message().c_str());
+    *out = l.release();
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API void avm_live_destroy(avm_live* live) {
+  guard_value(0, [&] {
+    delete live;
+    return 0;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_live_push(avm_live* live, const avm_image* image, double t) {
+  if (live == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  auto report = [live](avm_status code, const char* msg) noexcept {
+    return live->push_failed(code, msg);
+  };
+  return guard("avm_live_push", report, [&]() -> avm_status {
+    if (image == nullptr) return report(AVM_ERROR_INVALID_ARGUMENT, "avm_live_push: image is NULL");
+    if (!std::isfinite(t))
+      return report(AVM_ERROR_INVALID_ARGUMENT, "avm_live_push: t must be finite");
+    am::image_view view;
+    if (const char* bad = to_image_view(*image, view, live->buffer, sizeof live->buffer))
+      return report(AVM_ERROR_INVALID_ARGUMENT, bad);
+    const am::status st = live->session->push(view, t);
+    if (!st.ok()) return report(code_for(st, AVM_ERROR_INVALID_ARGUMENT), st.message().c_str());
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_live_sample(const avm_live* live, double t, avm_pose* out_pose) {
+  if (live == nullptr || out_pose == nullptr || !std::isfinite(t))
+    return AVM_ERROR_INVALID_ARGUMENT;
+  return guard("avm_live_sample", silently, [&]() -> avm_status {
+    am::proxy_pose p;
+    if (!live->session->sample(t, p)) return rest_pose(t, out_pose);
+    to_c_pose(p, *out_pose);
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_live_latest(const avm_live* live, avm_pose* out_pose) {
+  if (live == nullptr || out_pose == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  return guard("avm_live_latest", silently, [&]() -> avm_status {
+    am::proxy_pose p;
+    if (!live->session->latest(p)) return rest_pose(0.0, out_pose);
+    to_c_pose(p, *out_pose);
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_live_get_stats(const avm_live* live, avm_live_stats* out_stats) {
+  if (live == nullptr || out_stats == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  return guard("avm_live_get_stats", silently, [&]() -> avm_status {
+    const am::live_session_stats s = live->session->stats();
+    out_stats->pushed = s.pushed;
+    out_stats->processed = s.processed;
+    out_stats->dropped = s.dropped;
+    out_stats->failed = s.failed;
+    out_stats->latency_p50_ms = s.latency_p50_ms;
+    out_stats->latency_p95_ms = s.latency_p95_ms;
+    out_stats->latency_max_ms = s.latency_max_ms;
+    out_stats->newest_t = s.newest_t;
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API const char* avm_live_last_error(const avm_live* live, char* buffer,
+                                                size_t buffer_size) {
+  return guard_value<const char*>(buffer, [&]() -> const char* {
+    copy_message(buffer, buffer_size, "");
+    if (live == nullptr) return buffer;
+    const am::status worker = live->session->last_error();
+    if (!worker.ok()) {
+      copy_message(buffer, buffer_size, worker.message().c_str());
+      return buffer;
+    }
+    std::lock_guard<std::mutex> lock(live->error_m);
+    copy_message(buffer, buffer_size, live->push_error);
+    return buffer;
+  });
+}
+
+}  // extern "C"

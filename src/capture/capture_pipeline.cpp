@@ -1,0 +1,107 @@
+#include "avatarmap/capture/capture_pipeline.hpp"
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+namespace avatarmap {
+
+int image_bytes_per_pixel(pixel_format format) {
+  switch (format) {
+    case pixel_format::rgb8:
+    case pixel_format::bgr8:
+      return 3;
+    case pixel_format::rgba8:
+    case pixel_format::bgra8:
+      return 4;
+    case pixel_format::gray8:
+      return 1;
+  }
+  return 0;
+}
+
+status check_image(const image_view& image) {
+  if (image.data == nullptr) return status::error("image: no pixels (data is NULL)");
+  if (image.width < 1 || image.height < 1 || image.width > k_max_image_side ||
+      image.height > k_max_image_side)
+    return status::error("image: width and height must be in [1, " +
+                         std::to_string(k_max_image_side) + "], got " +
+                         std::to_string(image.width) + "x" + std::to_string(image.height));
+  const int bpp = image_bytes_per_pixel(image.format);
+  if (bpp == 0) return status::error("image: unknown pixel format");
+  if (static_cast<long long>(image.stride_bytes) < static_cast<long long>(image.width) * bpp)
+    return status::error("image: stride_bytes (" + std::to_string(image.stride_bytes) +
+                         ") must be at least width x " + std::to_string(bpp) + " = " +
+                         std::to_string(static_cast<long long>(image.width) * bpp));
+  return {};
+}
+
+status capture_pipeline_options::validate() const {
+  if (status st = solver.validate(); !st.ok()) return st;
+  const estimator_backend_list list = estimator_backends();
+  std::string names;
+  for (int i = 0; i < list.count; ++i) {
+    if (list.items[i].name == backend) return {};
+    names += (i > 0 ? ", " : "") + std::string(list.items[i].name);
+  }
+  return status::error("capture_pipeline_options.backend '" + backend +
+                       "' is not built in (this build has: " + names + ")");
+}
+
+status capture_pipeline::create(const capture_pipeline_options& options,
+                                std::unique_ptr<capture_pipeline>& out) {
+  out.reset();
+  if (status st = options.validate(); !st.ok()) return st;
+  std::unique_ptr<capture_pipeline> p(new capture_pipeline());
+  p->options_ = options;
+  if (status st = create_estimator(options.backend, options.estimator, p->estimator_); !st.ok())
+    return st;
+  p->solver_ = frame_solver(options.solver);
+  p->filter_ = pose_filter(options.filter);
+  p->args_.body = true;
+  p->args_.hands = options.estimator.hands;
+  p->args_.face = options.estimator.face;
+  out = std::move(p);
+  return {};
+}
+
+capture_pipeline::~capture_pipeline() = default;
+
+status capture_pipeline::process(const image_view& image, double t, landmark_frame& frame,
+                                 proxy_pose& pose) {
+  if (!std::isfinite(t)) return status::error("capture time must be finite");
+  // The replay backend needs no pixels; every other one does.
+  if (options_.backend != "replay")
+    if (status st = check_image(image); !st.ok()) return st;
+  // The solver scales image points by the image's size: made for it when the options leave it
+  // open, remade (fresh state) when the size changes.
+  if (!(options_.solver.image_width > 0.f) &&
+      (image.width != solver_width_ || image.height != solver_height_) && image.width > 0) {
+    solver_options so = options_.solver;
+    so.image_width = static_cast<float>(image.width);
+    so.image_height = static_cast<float>(image.height);
+    solver_ = frame_solver(so);
+    filter_.reset();
+    solver_width_ = image.width;
+    solver_height_ = image.height;
+  }
+  args_.image = image;
+  args_.t = t;
+  if (status st = estimator_->estimate(args_, frame); !st.ok()) return st;
+  frame.t = t;
+  solver_.solve(frame, pose);
+  filter_.apply(pose, pose);
+  pose.t = t;
+  return {};
+}
+
+const estimator_timings* capture_pipeline::last_timings() const {
+  return estimator_->last_timings();
+}
+
+void capture_pipeline::reset() {
+  solver_.reset();
+  filter_.reset();
+}
+
+}  // namespace avatarmap
