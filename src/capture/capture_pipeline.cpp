@@ -6,20 +6,6 @@
 
 namespace avatarmap {
 
-int image_bytes_per_pixel(pixel_format format) {
-  switch (format) {
-    case pixel_format::rgb8:
-    case pixel_format::bgr8:
-      return 3;
-    case pixel_format::rgba8:
-    case pixel_format::bgra8:
-      return 4;
-    case pixel_format::gray8:
-      return 1;
-  }
-  return 0;
-}
-
 status check_image(const image_view& image) {
   if (image.data == nullptr) return status::error("image: no pixels (data is NULL)");
   if (image.width < 1 || image.height < 1 || image.width > k_max_image_side ||

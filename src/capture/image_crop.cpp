@@ -20,20 +20,6 @@ constexpr int k_weight_round = 1 << (k_weight_bits - 1);
 // sample position * 32 within int range without a per-pixel clamp.
 constexpr double k_coord_limit = static_cast<double>(1 << 24);
 
-int bytes_per_pixel(pixel_format f) {
-  switch (f) {
-    case pixel_format::rgb8:
-    case pixel_format::bgr8:
-      return 3;
-    case pixel_format::rgba8:
-    case pixel_format::bgra8:
-      return 4;
-    case pixel_format::gray8:
-      return 1;
-  }
-  return 0;
-}
-
 bool finite(float v) { return std::isfinite(v); }
 
 // Per-call constants of the warp, shared by every row.
@@ -260,7 +246,7 @@ crop_point project_to_tensor(const crop_transform& t, crop_point p) {
 }
 
 bool image_crop_job::validate() const {
-  const int bpp = bytes_per_pixel(image.format);
+  const int bpp = image_bytes_per_pixel(image.format);
   if (image.data == nullptr || image.width <= 0 || image.height <= 0 || bpp == 0) return false;
   if (image.stride_bytes < image.width * bpp) return false;
   if (options.output_width <= 0 || options.output_height <= 0) return false;

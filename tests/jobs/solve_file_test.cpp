@@ -121,6 +121,19 @@ void expect_same_poses(const std::vector<proxy_pose>& got, const std::vector<pro
   }
 }
 
+// Runs `job` with a sink that collects every pose; the run must succeed.
+std::vector<proxy_pose> run_collecting(solve_file_job& job) {
+  std::vector<proxy_pose> got;
+  job.sink = [&got](const proxy_pose& p) {
+    got.push_back(p);
+    return status{};
+  };
+  solve_file_summary s;
+  const status st = job.run(s);
+  EXPECT_TRUE(st.ok()) << st.message();
+  return got;
+}
+
 class solve_file : public ::testing::Test {
  protected:
   test::temp_dir dir{"solve_file"};
@@ -441,14 +454,7 @@ TEST_F(solve_file, offline_strength_and_none_are_honoured) {
     job.input = input;
     job.filter_mode = mode;
     job.offline.strength = strength;
-    std::vector<proxy_pose> got;
-    job.sink = [&got](const proxy_pose& p) {
-      got.push_back(p);
-      return status{};
-    };
-    solve_file_summary s;
-    EXPECT_TRUE(job.run(s).ok());
-    return got;
+    return run_collecting(job);
   };
   offline_smoother_options twice;
   twice.strength = 2.f;
@@ -495,13 +501,8 @@ TEST(solve_file_offline, a_hand_found_again_is_its_measurement_at_once) {
   job.input = path;
   job.filter_mode = pose_filter_mode::offline;
   job.offline.strength = 0.f;
-  std::vector<proxy_pose> got;
-  job.sink = [&got](const proxy_pose& p) {
-    got.push_back(p);
-    return status{};
-  };
-  solve_file_summary summary;
-  ASSERT_TRUE(job.run(summary).ok());
+  const std::vector<proxy_pose> got = run_collecting(job);
+  ASSERT_EQ(got.size(), 60u);
   offline_smoother_options fill_only;
   fill_only.strength = 0.f;
   expect_same_poses(got, reference_offline_poses(path, synth_camera(), fill_only), 0.f);

@@ -31,9 +31,6 @@ inline constexpr int k_max_image_side = 16384;
 /// and what it must be.
 status check_image(const image_view& image);
 
-/// Bytes per pixel of `format` (0 for an unknown value).
-int image_bytes_per_pixel(pixel_format format);
-
 struct capture_pipeline_options {
   std::string backend = "onnx";  // estimator_backends(): "onnx", "replay"
   /// The backend's options; estimator.source is the models folder for "onnx". estimator.hands
