@@ -7,7 +7,8 @@ packages=(build-essential cmake ninja-build pkg-config
           libglm-dev libeigen3-dev nlohmann-json3-dev libtinygltf-dev
           libgtest-dev libgmock-dev libbenchmark-dev libstb-dev python3
           libavformat-dev libavcodec-dev libavutil-dev libswscale-dev
-          python3-onnx python3-numpy)  # python3-onnx: the tflite -> ONNX converter (tools/convert)
+          python3-onnx python3-numpy  # python3-onnx: the tflite -> ONNX converter (tools/convert)
+          liblo-tools)  # oscdump, oscsend: the independent OSC receiver of the VMC tests
 # The fuzz run and the sanitizer run (scripts/test.sh, scripts/sanitize.sh) need clang with its
 # sanitizer runtime.
 if [ "${AVATARMAP_SKIP_FUZZ:-0}" != 1 ] || [ "${AVATARMAP_SKIP_SANITIZE:-0}" != 1 ]; then

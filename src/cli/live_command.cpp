@@ -2,11 +2,14 @@
 // a file paced to its time stamps as a camera would deliver it; frames the estimator cannot
 // keep up with are dropped. Each processed frame is solved, filtered by the live filter
 // (pose_filter, unless --filter none) and pushed to the pose resampler; an output thread
-// samples it at --fps (a higher rate than capture) into OUT.pose.jsonl.
+// samples it at --fps (a higher rate than capture) into OUT.pose.jsonl and, with --vmc, to a
+// VMC protocol receiver (cli/live_vmc.hpp).
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <mutex>
 #include <string>
@@ -20,6 +23,7 @@
 #include "avatarmap/time/pose_resampler.hpp"
 #include "cli/capture_setup.hpp"
 #include "cli/commands.hpp"
+#include "cli/live_vmc.hpp"
 
 namespace avatarmap::cli {
 namespace {
@@ -55,6 +59,8 @@ int run_live_command(int argc, char** argv) {
   if (a.flag("--help") || a.flag("-h")) {
     std::fputs(k_live_help, stdout);
     std::fputs(k_estimator_options_help, stdout);
+    std::fputs("\nVMC protocol output (docs/vmc.md):\n", stdout);
+    std::fputs(k_live_vmc_help, stdout);
     return 0;
   }
   std::string out_path, error;
@@ -67,6 +73,8 @@ int run_live_command(int argc, char** argv) {
   const bool unpaced = a.flag("--unpaced");
   const bool quiet = a.flag("--quiet");
   const bool progress = !quiet && isatty(STDERR_FILENO);
+  live_vmc vmc;
+  if (const int rc = vmc.read_options(a)) return rc;
   estimator_options ec;
   if (!parse_estimator_options(a, false, ec, error)) {
     std::fprintf(stderr, "avatarmap live: %s\n", error.c_str());
@@ -86,6 +94,7 @@ int run_live_command(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap live: --fps must be in (0, 1000], --seconds >= 0\n");
     return 2;
   }
+  if (const int rc = vmc.open()) return rc;
   video_source source;
   video_source_quiet_log(true);
   status st = source.open(a.rest()[0]);
@@ -134,17 +143,24 @@ int run_live_command(int argc, char** argv) {
     const auto period = std::chrono::duration_cast<clock_type::duration>(
         std::chrono::duration<double>(1.0 / out_fps));
     auto next = clock_type::now();
+    double last_t = -INFINITY;  // output times always increase (processing time varies)
     while (!done.load()) {
       next += period;
       std::this_thread::sleep_until(next);
-      std::lock_guard<std::mutex> lock(m);
-      if (!have_pose) continue;
-      const double t =
-          stream_t + std::chrono::duration<double>(clock_type::now() - stream_wall).count();
-      if (!resampler.sample(t, p)) continue;
-      p.t = t;
-      if (writing && write_status.ok()) write_status = writer.write(p);
-      ++written;
+      {
+        std::lock_guard<std::mutex> lock(m);
+        if (!have_pose) continue;
+        const double t = std::max(
+            last_t + 1e-6,
+            stream_t + std::chrono::duration<double>(clock_type::now() - stream_wall).count());
+        if (!resampler.sample(t, p)) continue;
+        last_t = t;
+        p.t = t;
+        if (writing && write_status.ok()) write_status = writer.write(p);
+        ++written;
+        vmc.pose_sampled();
+      }
+      vmc.send(p);  // outside the lock: never blocks, but need not hold up the capture side
     }
   });
 
@@ -163,6 +179,9 @@ int run_live_command(int argc, char** argv) {
   status est_status;
   st = run_live([&](image_view& v, double& t) { return source.next(v, t); },
                 [&](const image_view& img, const live_frame_info& info_) {
+                  const auto arrived = clock_type::now() -
+                                       std::chrono::duration_cast<clock_type::duration>(
+                                           std::chrono::duration<double, std::milli>(info_.age_ms));
                   ea.image = img;
                   ea.t = info_.t;
                   est_status = est->estimate(ea, frame);
@@ -178,6 +197,7 @@ int run_live_command(int argc, char** argv) {
                     have_pose = true;
                     stream_t = pose.t;
                     stream_wall = clock_type::now();
+                    vmc.frame_pushed(arrived);
                   }
                   if (progress) {
                     const auto now = clock_type::now();
@@ -216,6 +236,7 @@ int run_live_command(int argc, char** argv) {
   timings.print(stderr);
   std::fprintf(stderr, "output: %ld poses at %.0f fps%s%s\n", written, out_fps,
                out_path.empty() ? "" : " -> ", out_path.c_str());
+  vmc.print_summary(stderr);
   return 0;
 }
 

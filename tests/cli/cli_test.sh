@@ -314,6 +314,104 @@ open('black.png','wb').write(b'\\x89PNG\\r\\n\\x1a\\n'+chunk(b'IHDR',struct.pack
       fi
     fi
     ;;
+  live_vmc)
+    # Destinations that are not one, and --avatar without --vmc: usage errors (exit 2) before
+    # any input is opened; a name that does not resolve or an avatar that cannot be read: 1.
+    for bad in "host:0" "host:65536" "host:" ":39539" "[::1" "[::1]x" "127.0.0.1:39539:1" ""; do
+      run 2 live in.mp4 --vmc "$bad"
+      expect_in err.txt "HOST:PORT"
+    done
+    run 2 live in.mp4 --avatar me.vrm
+    expect_in err.txt "use it with --vmc"
+    run 2 live in.mp4 --vmc 127.0.0.1 --avatar ""
+    run 1 live in.mp4 --vmc no-such-host.invalid
+    expect_in err.txt "cannot resolve host 'no-such-host.invalid'"
+    run 1 live in.mp4 --vmc 127.0.0.1 --avatar missing.vrm
+    expect_in err.txt "missing.vrm"
+    run 0 live --help
+    expect_in out.txt "--vmc HOST[:PORT]"
+    if [ -n "${AVATARMAP_TEST_DATA:-}" ]; then
+      run 1 live in.mp4 --vmc 127.0.0.1 --avatar "$AVATARMAP_TEST_DATA/avatars/gltf_rigged_simple.glb"
+      expect_in err.txt "For --vmc, --avatar takes a VRM model"
+    fi
+    models="${AVATARMAP_MODELS:-}/onnx"
+    if [ -n "${AVATARMAP_TEST_DATA:-}" ] && [ -f "$models/pose_detection.onnx" ] && has_onnx; then
+      input="$AVATARMAP_TEST_DATA/motion/tfjs-models/asl_hand.25fps.mp4"
+      free_port() {
+        python3 -c 'import socket; s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'
+      }
+      # A receiver that is not running: the loop runs as it does without --vmc (1 s at 60 fps:
+      # 30..61 poses) and the refusals are counted.
+      closed=$(free_port)
+      run 0 live "$input" --seconds 1 --models "$models" -o closed.pose.jsonl --vmc "127.0.0.1:$closed"
+      n=$(($(lines closed.pose.jsonl) - 1))
+      if [ "$n" -lt 30 ] || [ "$n" -gt 61 ]; then fail "1 s at 60 fps with no receiver wrote $n poses"; fi
+      refused=$(sed -n 's/.* dropped, \([0-9]*\) refused.*/\1/p' err.txt)
+      [ "${refused:-0}" -gt 0 ] || fail "no refusal counted: $(grep vmc err.txt)"
+      if command -v oscdump >/dev/null && command -v oscsend >/dev/null; then
+        # oscdump (liblo-tools) as the independent receiver: every output frame must arrive
+        # as one bundle with every bone, the blend values, Apply, OK and T.
+        for avatar in "" "$AVATARMAP_TEST_DATA/avatars/vrm1_spec_53bones.vrm"; do
+          port=$(free_port)
+          oscdump -L "$port" >dump.txt 2>/dev/null &
+          dump_pid=$!
+          wait_dump() {
+            for _ in $(seq 200); do
+              oscsend 127.0.0.1 "$port" "$1" 2>/dev/null
+              sleep 0.05
+              grep -q "$1" dump.txt && return 0
+            done
+            return 1
+          }
+          wait_dump /ready || fail "oscdump did not start"
+          if [ -n "$avatar" ]; then
+            run 0 live "$input" --seconds 2 --models "$models" -o vmc.pose.jsonl --vmc "127.0.0.1:$port" --avatar "$avatar"
+            bones=53
+          else
+            run 0 live "$input" --seconds 2 --models "$models" -o vmc.pose.jsonl --vmc "127.0.0.1:$port"
+            bones=55
+          fi
+          wait_dump /done || fail "oscdump stopped receiving"
+          kill "$dump_pid" 2>/dev/null
+          wait "$dump_pid" 2>/dev/null
+          poses=$(($(lines vmc.pose.jsonl) - 1))
+          sent=$(sed -n 's/^vmc: \([0-9]*\) bundles sent.*/\1/p' err.txt)
+          expect_in err.txt "vmc latency (frame delivered -> first packet with its pose"
+          [ "$sent" = "$poses" ] || fail "vmc sent ${sent:-?} bundles for $poses output poses"
+          python3 - "$poses" "$bones" dump.txt <<'PY' || fail "oscdump's bundles (see above)"
+import sys
+want, bones, path = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
+groups, last = [], None
+for line in open(path):
+    f = line.split()
+    if len(f) < 2 or f[1] in ("/ready", "/done"):
+        continue
+    if f[0] != last:
+        groups.append([])
+    last = f[0]
+    groups[-1].append(f)
+bad = []
+times = []
+for g in groups:
+    addr = [f[1] for f in g]
+    names = {f[3].strip('"') for f in g if f[1] == "/VMC/Ext/Bone/Pos"}
+    if (addr.count("/VMC/Ext/Bone/Pos") != bones or len(names) != bones
+            or addr.count("/VMC/Ext/Root/Pos") != 1 or addr.count("/VMC/Ext/Blend/Val") != 12
+            or addr.count("/VMC/Ext/Blend/Apply") != 1 or addr[-1] != "/VMC/Ext/T"
+            or ["/VMC/Ext/OK", "i", "1"] != next(f[1:] for f in g if f[1] == "/VMC/Ext/OK")):
+        bad.append(addr[:3])
+    times.append(float(g[-1][3]))  # T parses as a number
+if len(groups) != want or bad or "Hips" not in names:
+    print("bundles at oscdump: %d (want %d), malformed: %d %s" % (len(groups), want, len(bad), bad[:2]))
+    sys.exit(1)
+print("oscdump: %d bundles of %d bones" % (len(groups), bones))
+PY
+        done
+      else
+        echo "oscdump/oscsend not found (Debian liblo-tools): the live VMC receiver check is skipped"
+      fi
+    fi
+    ;;
   solve_stdio)
     synth_input in.landmarks.jsonl 1 || exit 1
     "$exe" solve - -o - <in.landmarks.jsonl >out.pose.jsonl 2>err.txt ||

@@ -1,0 +1,59 @@
+// A VMC protocol stream (docs/vmc.md): each send() turns a proxy pose into one VMC bundle
+// (stream/vmc_bundle.hpp) in a buffer the stream owns and hands it to a non-blocking UDP sender
+// (stream/udp_sender.hpp). Receivers (VSeeFace, VMagicMirror, Warudo, EVMC4U) listen on UDP
+// port 39539 unless told otherwise. send() never blocks and never allocates.
+// Thread-safety: one thread sends; stats() is read by it or after it stopped.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "avatarmap/core/status.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+#include "avatarmap/stream/host_port.hpp"
+#include "avatarmap/stream/osc_writer.hpp"
+#include "avatarmap/stream/udp_sender.hpp"
+#include "avatarmap/stream/vmc_bundle.hpp"
+#include "avatarmap/stream/vmc_skeleton.hpp"
+
+namespace avatarmap {
+
+/// The port VMC receivers listen on by default.
+inline constexpr int k_vmc_default_port = 39539;
+
+class vmc_stream {
+ public:
+  vmc_stream() : writer_(buffer_.data(), buffer_.size()) {}
+  vmc_stream(const vmc_stream&) = delete;
+  vmc_stream& operator=(const vmc_stream&) = delete;
+
+  /// Resolves `to` and keeps `skeleton` (copied). Fails as udp_sender::open does.
+  status open(const host_port& to, const vmc_skeleton& skeleton);
+  void close() { sender_.close(); }
+  bool is_open() const { return sender_.is_open(); }
+
+  /// Sends `pose` as one bundle stamped `time` (seconds). True when the kernel took it; a
+  /// dropped or refused packet is counted (stats()) and the call returns at once.
+  bool send(const proxy_pose& pose, float time);
+
+  const udp_send_stats& stats() const { return sender_.stats(); }
+  /// Bundles that did not fit the buffer (never expected: counted, not sent).
+  long encode_failures() const { return encode_failures_; }
+  const std::string& address() const { return sender_.address(); }
+  const std::string& warning() const { return sender_.warning(); }
+  /// /VMC/Ext/Bone/Pos and /VMC/Ext/Blend/Val messages in each bundle.
+  int bone_messages() const { return skeleton_.sent_count; }
+  int blend_messages() const { return vmc_blend_count(); }
+  /// Size in bytes of the last bundle built.
+  std::size_t last_bundle_bytes() const { return writer_.size(); }
+
+ private:
+  std::array<std::uint8_t, k_vmc_bundle_capacity> buffer_{};
+  osc_writer writer_;
+  udp_sender sender_;
+  vmc_skeleton skeleton_{};
+  long encode_failures_ = 0;
+};
+
+}  // namespace avatarmap
