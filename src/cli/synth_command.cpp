@@ -6,10 +6,14 @@
 #include <filesystem>
 #include <string>
 
+#include "avatarmap/avatar/builtin_avatar.hpp"
 #include "avatarmap/export/vrma.hpp"
 #include "avatarmap/io/landmark_file.hpp"
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/io/tfjs_import.hpp"
+#include "avatarmap/jobs/clip_output.hpp"
+#include "avatarmap/rig/avatar_loader.hpp"
+#include "avatarmap/rig/rig_binding.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
 #include "avatarmap/synth/synth_recording.hpp"
@@ -232,6 +236,30 @@ bool parse_synth(args& a, synth_settings& s, std::string& err) {
   return err.empty();
 }
 
+// Writes the built-in avatar (1.70 m, the demo's person) to `avatar_path`, then `poses` on it as
+// an animated .glb at `glb_path` through the library's clip writer; `out_frames` is the count
+// written.
+status write_on_builtin_avatar(const std::vector<proxy_pose>& poses, const std::string& avatar_path,
+                               const std::string& glb_path, std::size_t& out_frames) {
+  if (status st = write_builtin_avatar(avatar_path); !st) return st;
+  raw_rig raw;
+  rig r;
+  rig_binding_choice binding;
+  if (status st = load_avatar(avatar_path, raw); !st) return st;
+  if (status st = build_rig(raw, r); !st) return st;
+  if (status st = select_binding(r, "auto", "", binding); !st) return st;
+  clip_output_job out;
+  out.path = glb_path;
+  out.frames = &poses;
+  out.avatar_path = avatar_path;
+  out.avatar_rig = &r;
+  out.avatar_binding = binding.binding;
+  clip_output_summary summary;
+  if (status st = out.run(summary); !st) return st;
+  out_frames = summary.frames_written;
+  return {};
+}
+
 }  // namespace
 
 int run_synth(int argc, char** argv) {
@@ -268,21 +296,34 @@ int run_demo(int argc, char** argv) {
   args a(argc, argv, 2);
   if (a.flag("--help") || a.flag("-h")) {
     std::fputs(
-        "Usage: avatarmap demo [--keep DIR]\n"
+        "Usage: avatarmap demo [--out DIR] [--keep DIR]\n"
         "\n"
         "Synthesises a 10 s recording (avatarmap synth, 2 mm noise), solves it (avatarmap solve)\n"
-        "and prints the summary, then writes the motion as demo.vrma. --keep DIR keeps\n"
-        "demo.landmarks.jsonl, demo.pose.jsonl and demo.vrma there\n"
-        "(DIR is created if needed); otherwise they go to a temporary folder that is removed.\n",
+        "and prints the summary, then puts the motion on the built-in avatar (avatarmap avatar):\n"
+        "DIR/avatar.vrm (the avatar), DIR/demo.glb (the avatar moving: open it in a glTF\n"
+        "viewer) and DIR/demo.vrma (the motion as VRM Animation), where DIR is --out, else\n"
+        "--keep's folder, else ./avatarmap-demo (created if needed). --keep DIR also keeps\n"
+        "demo.landmarks.jsonl and demo.pose.jsonl there; otherwise they go to a temporary\n"
+        "folder that is removed.\n",
         stdout);
     return 0;
   }
-  std::string keep;
+  std::string keep, out_dir;
   a.value("--keep", keep);
+  a.value("--out", out_dir);
   if (!a.error().empty() || !a.check_no_options() || !a.rest().empty()) {
     std::fprintf(stderr, "avatarmap demo: %s\n",
                  a.error().empty() ? "unexpected argument (see --help)" : a.error().c_str());
     return 2;
+  }
+  // The results' folder first, so that a bad one fails before any work.
+  if (out_dir.empty()) out_dir = keep.empty() ? "avatarmap-demo" : keep;
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) {
+    std::fprintf(stderr, "avatarmap demo: cannot create %s: %s\n", out_dir.c_str(),
+                 ec.message().c_str());
+    return 1;
   }
   std::string dir = keep;
   if (dir.empty()) {
@@ -294,7 +335,6 @@ int run_demo(int argc, char** argv) {
     }
     dir = pattern;
   } else {
-    std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec) {
       std::fprintf(stderr, "avatarmap demo: cannot create %s: %s\n", dir.c_str(),
@@ -333,19 +373,33 @@ int run_demo(int argc, char** argv) {
     proxy_pose p;
     while (st.ok() && reader.next(p) == read_result::frame) poses.push_back(p);
   }
-  const std::string vrma = dir + "/demo.vrma";
+  if (keep.empty()) {
+    std::remove(s.output.c_str());
+    std::remove(job.output.c_str());
+    rmdir(dir.c_str());
+  }
+  const std::string vrma = out_dir + "/demo.vrma";
   if (st.ok()) st = write_vrma(vrma, poses);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap demo: %s\n", st.message().c_str());
     return 1;
   }
   std::printf("wrote %zu frames of VRM Animation to %s\n", poses.size(), vrma.c_str());
-  if (keep.empty()) {
-    std::remove(s.output.c_str());
-    std::remove(job.output.c_str());
-    std::remove(vrma.c_str());
-    rmdir(dir.c_str());
+  // The motion on the built-in avatar, the way `avatarmap convert --avatar` would write it.
+  const std::string avatar = out_dir + "/avatar.vrm", glb = out_dir + "/demo.glb";
+  std::size_t written = 0;
+  st = write_on_builtin_avatar(poses, avatar, glb, written);
+  if (!st.ok()) {
+    std::fprintf(stderr, "avatarmap demo: %s\n", st.message().c_str());
+    return 1;
   }
+  std::printf("wrote the built-in avatar to %s and the motion on it to %s (%zu frames)\n",
+              avatar.c_str(), glb.c_str(), written);
+  const std::filesystem::path shown = std::filesystem::absolute(glb, ec);
+  std::printf(
+      "watch it: open %s in a glTF viewer: Blender (File > Import > glTF 2.0, then play), or\n"
+      "  drag it into a browser viewer (the three.js editor, the Babylon.js sandbox)\n",
+      ec ? glb.c_str() : shown.c_str());
   return 0;
 }
 

@@ -1,20 +1,19 @@
 // The animated .glb writer: the avatar's own JSON (opened and checked by gltf_detail) with every
 // buffer and image gathered into one BIN chunk, the animation appended, and the GLB container
-// written here (no glTF library re-encodes anything: textures pass through byte for byte,
-// whatever their format). Written atomically (io_detail::write_file_atomically).
+// made by export_detail::make_glb (no glTF library re-encodes anything: textures pass through
+// byte for byte, whatever their format). Written atomically (io_detail::write_file_atomically).
 #include "avatarmap/export/animated_glb.hpp"
 
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <exception>
-#include <limits>
 #include <new>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "avatarmap/core/rotation.hpp"
+#include "export/glb_builder.hpp"
 #include "io/atomic_file.hpp"
 #include "rig/gltf_document.hpp"
 
@@ -23,79 +22,12 @@ namespace {
 
 using json = nlohmann::json;
 
-constexpr int k_component_float = 5126;  // glTF componentType FLOAT
-constexpr std::uint32_t k_chunk_json = 0x4E4F534A;
-constexpr std::uint32_t k_chunk_bin = 0x004E4942;
-
-void pad_to_4(std::string& s, char fill) {
-  while (s.size() % 4) s += fill;
-}
-
-void append_u32(std::string& s, std::uint32_t v) {
-  for (int k = 0; k < 4; ++k) s += static_cast<char>((v >> (8 * k)) & 0xFF);
-}
-
-// The BIN chunk being built and the JSON arrays that index into it.
-class bin_builder {
- public:
-  explicit bin_builder(json& doc) : doc_(doc) {
-    if (!doc_.contains("bufferViews") || !doc_["bufferViews"].is_array())
-      doc_["bufferViews"] = json::array();
-    if (!doc_.contains("accessors") || !doc_["accessors"].is_array())
-      doc_["accessors"] = json::array();
-  }
-
-  /// Appends `bytes` 4-byte aligned; returns its offset in the BIN chunk.
-  std::size_t append(const std::string& bytes) {
-    pad_to_4(bin_, '\0');
-    const std::size_t offset = bin_.size();
-    bin_ += bytes;
-    return offset;
-  }
-
-  /// A new bufferView over `bytes`; returns its index.
-  std::size_t add_view(const std::string& bytes) {
-    const std::size_t offset = append(bytes);
-    json view = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes.size()}};
-    doc_["bufferViews"].push_back(std::move(view));
-    return doc_["bufferViews"].size() - 1;
-  }
-
-  /// A FLOAT accessor of `components` per element (type "SCALAR", "VEC3" or "VEC4").
-  std::size_t add_floats(const std::vector<float>& values, const char* type, int components,
-                         bool with_bounds) {
-    std::string bytes(values.size() * sizeof(float), '\0');
-    if (!values.empty()) std::memcpy(&bytes[0], values.data(), bytes.size());
-    json acc = {{"bufferView", add_view(bytes)},
-                {"componentType", k_component_float},
-                {"count", values.size() / static_cast<std::size_t>(components)},
-                {"type", type}};
-    if (with_bounds && !values.empty()) {
-      std::vector<double> lo(static_cast<std::size_t>(components), 1e300);
-      std::vector<double> hi(static_cast<std::size_t>(components), -1e300);
-      for (std::size_t i = 0; i < values.size(); ++i) {
-        const std::size_t c = i % static_cast<std::size_t>(components);
-        lo[c] = std::min(lo[c], double(values[i]));
-        hi[c] = std::max(hi[c], double(values[i]));
-      }
-      acc["min"] = lo;
-      acc["max"] = hi;
-    }
-    doc_["accessors"].push_back(std::move(acc));
-    return doc_["accessors"].size() - 1;
-  }
-
-  std::string& bytes() { return bin_; }
-
- private:
-  json& doc_;
-  std::string bin_;
-};
+using export_detail::glb_builder;
 
 // Moves every buffer of the avatar into the BIN chunk (buffer 0 of the output): the GLB's own
 // BIN chunk, data: URIs and external files alike, and rewrites the bufferViews (and extension
 // bufferViews such as EXT_meshopt_compression's) to point into it.
-status gather_buffers(const gltf_detail::gltf_document& doc, json& j, bin_builder& bin,
+status gather_buffers(const gltf_detail::gltf_document& doc, json& j, glb_builder& bin,
                       std::uint64_t& total_read) {
   const std::string& p = doc.path;
   std::vector<std::size_t> offset;
@@ -170,7 +102,7 @@ status gather_buffers(const gltf_detail::gltf_document& doc, json& j, bin_builde
 // unchanged, with its media type. An image file that does not exist (but that our rules would
 // read) is left named as the avatar names it: the avatar already lacked it, and a viewer
 // then misses the same texture; nothing is read.
-status gather_images(const gltf_detail::gltf_document& doc, json& j, bin_builder& bin,
+status gather_images(const gltf_detail::gltf_document& doc, json& j, glb_builder& bin,
                      std::uint64_t& total_read) {
   if (!j.contains("images")) return {};
   json& images = j["images"];
@@ -207,7 +139,7 @@ status gather_images(const gltf_detail::gltf_document& doc, json& j, bin_builder
 // translation). Refuses non-finite values: no writer emits nan.
 status add_animation(const rig& r, const std::vector<rig_pose>& frames,
                      const animated_glb_options& options, const std::string& out_path, json& j,
-                     bin_builder& bin) {
+                     glb_builder& bin) {
   const std::size_t n = frames.size();
   for (std::size_t f = 0; f < n; ++f) {
     const rig_pose& pose = frames[f];
@@ -283,37 +215,16 @@ status write_impl(const std::string& avatar_path, const rig& r, const std::vecto
       return status::error(avatar_path + ": the rig does not belong to this file (joint '" +
                            r.names[k] + "')");
 
-  bin_builder bin(j);
+  glb_builder bin(j);
   std::uint64_t total_read = 0;
   if (status s = gather_buffers(doc, j, bin, total_read); !s) return s;
   if (status s = gather_images(doc, j, bin, total_read); !s) return s;
   if (status s = add_animation(r, frames, options, out_path, j, bin); !s) return s;
-  std::string& payload = bin.bytes();
-  pad_to_4(payload, '\0');
-  j["buffers"] = json::array({json{{"byteLength", payload.size()}}});
   if (!j.contains("asset") || !j["asset"].is_object()) j["asset"] = {{"version", "2.0"}};
   j["asset"]["generator"] = "avatarmap";
-
-  // The avatar's strings were valid UTF-8 when parsed; `replace` only guards the dump itself.
-  std::string text = j.dump(-1, ' ', false, json::error_handler_t::replace);
-  pad_to_4(text, ' ');
-  const std::uint64_t total = 12 + 8 + text.size() + (payload.empty() ? 0 : 8 + payload.size());
-  if (total > std::numeric_limits<std::uint32_t>::max())
-    return status::error(out_path + ": the animated avatar would be " + std::to_string(total) +
-                         " bytes, more than a GLB can hold (4 GiB); use a shorter clip");
   std::string glb;
-  glb.reserve(static_cast<std::size_t>(total));
-  glb += "glTF";
-  append_u32(glb, 2);
-  append_u32(glb, static_cast<std::uint32_t>(total));
-  append_u32(glb, static_cast<std::uint32_t>(text.size()));
-  append_u32(glb, k_chunk_json);
-  glb += text;
-  if (!payload.empty()) {
-    append_u32(glb, static_cast<std::uint32_t>(payload.size()));
-    append_u32(glb, k_chunk_bin);
-    glb += payload;
-  }
+  if (status s = export_detail::make_glb(j, bin.bytes(), out_path, glb); !s)
+    return status::error(s.message() + "; use a shorter clip");
   return io_detail::write_file_atomically(out_path, glb);
 }
 

@@ -1,6 +1,7 @@
-// .vrma writer: the GLB is assembled by hand (JSON chunk via nlohmann::json, BIN chunk of
-// little-endian floats) so that the extension object and every number are exactly as written
-// here; the output goes through io_detail::text_output for the atomic rename.
+// .vrma writer: the GLB is assembled by hand (export_detail::glb_builder: JSON chunk via
+// nlohmann::json, BIN chunk of little-endian floats) so that the extension object and every
+// number are exactly as written here; the output goes through io_detail::text_output for the
+// atomic rename.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -13,6 +14,7 @@
 
 #include "avatarmap/export/vrma.hpp"
 #include "export/export_common.hpp"
+#include "export/glb_builder.hpp"
 #include "io/text_output.hpp"
 
 namespace avatarmap {
@@ -24,45 +26,6 @@ constexpr bool is_custom_expression(expression e) {
   return e == expression::brow_up_left || e == expression::brow_up_right ||
          e == expression::brow_down_left || e == expression::brow_down_right;
 }
-
-void put_u32(std::string& s, std::uint32_t v) {
-  for (int i = 0; i < 4; ++i) s.push_back(static_cast<char>((v >> (8 * i)) & 0xffu));
-}
-
-// Growing BIN chunk plus the JSON objects that describe it.
-struct bin_builder {
-  std::string bin;
-  json views = json::array();
-  json accessors = json::array();
-
-  // Appends `values` (count * comps floats) as a new bufferView + accessor; returns its index.
-  int add(const std::vector<float>& values, int comps, bool with_min_max) {
-    std::size_t offset = bin.size();
-    for (float f : values) {
-      std::uint32_t u;
-      std::memcpy(&u, &f, 4);
-      put_u32(bin, u);
-    }
-    views.push_back(
-        {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", values.size() * sizeof(float)}});
-    static const char* k_types[] = {"", "SCALAR", "VEC2", "VEC3", "VEC4"};
-    json acc = {{"bufferView", views.size() - 1},
-                {"componentType", 5126},
-                {"count", values.size() / comps},
-                {"type", k_types[comps]}};
-    if (with_min_max && !values.empty()) {
-      std::vector<float> lo(values.begin(), values.begin() + comps), hi = lo;
-      for (std::size_t i = 0; i < values.size(); ++i) {
-        lo[i % comps] = std::min(lo[i % comps], values[i]);
-        hi[i % comps] = std::max(hi[i % comps], values[i]);
-      }
-      acc["min"] = lo;
-      acc["max"] = hi;
-    }
-    accessors.push_back(std::move(acc));
-    return static_cast<int>(accessors.size() - 1);
-  }
-};
 
 status write_impl(const std::string& path, const std::vector<proxy_pose>& frames,
                   const vrma_write_options& options) {
@@ -106,15 +69,16 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
     if (used) written_expressions.push_back(e);
   }
 
-  bin_builder bin;
+  json doc = json::object();
+  export_detail::glb_builder bin(doc);
   std::vector<float> values;
   values.reserve(n * 4);
   for (const proxy_pose& p : keys) values.push_back(static_cast<float>(p.t));
-  const int time_accessor = bin.add(values, 1, true);
+  const std::size_t time_accessor = bin.add_floats(values, "SCALAR", 1, true);
 
   json samplers = json::array();
   json channels = json::array();
-  auto add_channel = [&](int node, const char* target, int output) {
+  auto add_channel = [&](int node, const char* target, std::size_t output) {
     samplers.push_back({{"input", time_accessor}, {"output", output}, {"interpolation", "LINEAR"}});
     channels.push_back(
         {{"sampler", samplers.size() - 1}, {"target", {{"node", node}, {"path", target}}}});
@@ -124,7 +88,8 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
   values.clear();
   for (const proxy_pose& p : keys)
     values.insert(values.end(), {p.hips_position.x, p.hips_position.y, p.hips_position.z});
-  add_channel(node_of_bone[idx(bone::hips)], "translation", bin.add(values, 3, false));
+  add_channel(node_of_bone[idx(bone::hips)], "translation",
+              bin.add_floats(values, "VEC3", 3, false));
   for (int b = 0; b < k_bone_count; ++b) {
     if (node_of_bone[b] < 0) continue;
     values.clear();
@@ -135,7 +100,7 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
       prev = q;
       values.insert(values.end(), {q.x, q.y, q.z, q.w});  // glTF order {x, y, z, w}
     }
-    add_channel(node_of_bone[b], "rotation", bin.add(values, 4, false));
+    add_channel(node_of_bone[b], "rotation", bin.add_floats(values, "VEC4", 4, false));
   }
 
   json preset = json::object(), custom = json::object();
@@ -148,7 +113,7 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
     (is_custom_expression(static_cast<expression>(e)) ? custom : preset)[name] = {{"node", node}};
     values.clear();
     for (const proxy_pose& p : keys) values.insert(values.end(), {p.expressions[e], 0.f, 0.f});
-    add_channel(node, "translation", bin.add(values, 3, false));
+    add_channel(node, "translation", bin.add_floats(values, "VEC3", 3, false));
   }
 
   json humanoid_bones = json::object();
@@ -163,33 +128,15 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
     ext["expressions"] = exprs;
   }
 
-  json doc = {
-      {"asset", {{"version", "2.0"}, {"generator", options.generator}}},
-      {"extensionsUsed", {"VRMC_vrm_animation"}},
-      {"extensions", {{"VRMC_vrm_animation", ext}}},
-      {"scene", 0},
-      {"scenes", {{{"nodes", scene_nodes}}}},
-      {"nodes", nodes},
-      {"animations", {{{"name", "avatarmap"}, {"samplers", samplers}, {"channels", channels}}}},
-      {"buffers", {{{"byteLength", bin.bin.size()}}}},
-      {"bufferViews", bin.views},
-      {"accessors", bin.accessors},
-  };
-
-  std::string text = doc.dump();
-  while (text.size() % 4) text.push_back(' ');
-  while (bin.bin.size() % 4) bin.bin.push_back('\0');
+  doc["asset"] = {{"version", "2.0"}, {"generator", options.generator}};
+  doc["extensionsUsed"] = json::array({"VRMC_vrm_animation"});
+  doc["extensions"] = {{"VRMC_vrm_animation", ext}};
+  doc["scene"] = 0;
+  doc["scenes"] = {{{"nodes", scene_nodes}}};
+  doc["nodes"] = nodes;
+  doc["animations"] = {{{"name", "avatarmap"}, {"samplers", samplers}, {"channels", channels}}};
   std::string glb;
-  glb.reserve(28 + text.size() + bin.bin.size());
-  put_u32(glb, 0x46546C67u);  // "glTF"
-  put_u32(glb, 2u);
-  put_u32(glb, static_cast<std::uint32_t>(12 + 8 + text.size() + 8 + bin.bin.size()));
-  put_u32(glb, static_cast<std::uint32_t>(text.size()));
-  put_u32(glb, 0x4E4F534Au);  // "JSON"
-  glb += text;
-  put_u32(glb, static_cast<std::uint32_t>(bin.bin.size()));
-  put_u32(glb, 0x004E4942u);  // "BIN\0"
-  glb += bin.bin;
+  if (status s = export_detail::make_glb(doc, bin.bytes(), path, glb); !s) return s;
 
   io_detail::text_output out;
   if (status s = out.open(path); !s) return s;

@@ -66,7 +66,7 @@ case $case_name in
     expect_in out.txt "avatarmap solve"
     run 0 -h
     expect_in out.txt "Usage:"
-    for cmd in solve synth demo import-tfjs backends; do
+    for cmd in solve synth demo import-tfjs backends avatar; do
       run 0 "$cmd" --help
       expect_in out.txt "Usage: avatarmap $cmd"
     done
@@ -498,10 +498,51 @@ PY
     [ -z "$(ls -A tmp)" ] || fail "demo left files in TMPDIR: $(ls -A tmp)"
     expect_in out.txt "solved 300 frames"
     expect_in out.txt "wrote 300 poses"
+    # The motion on the built-in avatar, in ./avatarmap-demo by default.
+    for f in avatar.vrm demo.glb demo.vrma; do
+      [ "$(head -c 4 "avatarmap-demo/$f" 2>/dev/null)" = glTF ] || fail "demo did not write avatarmap-demo/$f"
+    done
+    expect_in out.txt "the motion on it to avatarmap-demo/demo.glb (300 frames)"
+    expect_in out.txt "watch it: open $dir/avatarmap-demo/demo.glb"
+    run 0 inspect avatarmap-demo/demo.glb
+    expect_in out.txt "declared: 55 of 55 bones"
     run 0 demo --keep "$dir/kept/new"
     expect_in out.txt "solved 300 frames"
     [ -s "$dir/kept/new/demo.landmarks.jsonl" ] || fail "demo --keep did not keep the landmarks"
     [ -s "$dir/kept/new/demo.pose.jsonl" ] || fail "demo --keep did not keep the poses"
+    [ -s "$dir/kept/new/demo.glb" ] || fail "demo --keep did not put demo.glb there"
+    run 0 demo --out "$dir/elsewhere"
+    [ -s "$dir/elsewhere/demo.glb" ] && [ -s "$dir/elsewhere/avatar.vrm" ] ||
+      fail "demo --out did not write there"
+    : >blocker
+    run 1 demo --out blocker/x
+    expect_in err.txt "blocker/x"
+    ;;
+  avatar)
+    run 0 avatar -o me.vrm
+    expect_in err.txt "wrote the built-in avatar (1.70 m, VRM 1.0) to me.vrm"
+    [ "$(head -c 4 me.vrm)" = glTF ] || fail "avatar did not write a binary glTF"
+    run 0 inspect me.vrm
+    expect_in out.txt "format: VRM 1.0"
+    expect_in out.txt "declared: 55 of 55 bones"
+    expect_in out.txt "missing required: none"
+    run 0 avatar -o tall.vrm --height 1.9
+    cmp -s me.vrm tall.vrm && fail "--height 1.9 wrote the 1.70 m avatar"
+    # The avatar drives like any other: a synthetic motion onto it as an animated .glb.
+    synth_input in.landmarks.jsonl 1 || exit 1
+    run 0 convert in.landmarks.jsonl -o moving.glb --avatar me.vrm
+    [ "$(head -c 4 moving.glb)" = glTF ] || fail "convert onto the built-in avatar wrote no .glb"
+    run 2 avatar
+    expect_in err.txt "-o OUT.vrm"
+    run 2 avatar -o x.vrm --height 9
+    expect_in err.txt "--height must be in [0.50, 3.00] metres"
+    run 2 avatar -o x.vrm --height tall
+    expect_in err.txt "--height needs a number"
+    run 2 avatar -o x.vrm --frobnicate
+    expect_in err.txt "unknown option --frobnicate"
+    [ -e x.vrm ] && fail "an avatar usage error wrote the output file"
+    run 1 avatar -o no-such-dir/x.vrm
+    expect_in err.txt "no-such-dir/x.vrm"
     ;;
   backends)
     run 0 backends

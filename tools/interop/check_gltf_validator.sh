@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Every .vrma and .glb avatarmap writes passes the Khronos glTF validator with 0 errors.
+# Every .vrma and .glb avatarmap writes, and the built-in avatar, pass the Khronos glTF validator
+# with 0 errors.
 #   check_gltf_validator.sh AVATARMAP_EXE WORK_DIR
 # The validator comes from the npm registry (package gltf-validator), installed once into
 # $AVATARMAP_NPM_CACHE (default: WORK_DIR/npm). Exit 77 (skipped) without node/npm or when
@@ -20,6 +21,10 @@ fi
 "$exe" synth -o motion.landmarks.jsonl --seconds 2 --noise 2 >/dev/null 2>&1 || { echo "synth failed"; exit 1; }
 "$exe" convert motion.landmarks.jsonl -o motion.vrma --quiet || exit 1
 files=(motion.vrma)
+# The built-in avatar, and the motion on it (no test data needed).
+"$exe" avatar -o builtin.vrm 2>/dev/null || exit 1
+"$exe" convert motion.landmarks.jsonl -o builtin_moving.glb --quiet --avatar builtin.vrm || exit 1
+files+=(builtin.vrm builtin_moving.glb)
 if [ -n "${AVATARMAP_TEST_DATA:-}" ]; then
   for avatar in vrm1_debug_robot.vrm vrm1_spec_53bones.vrm vrm1_spec_expressions.vrm; do
     "$exe" convert motion.landmarks.jsonl -o "${avatar%.vrm}.glb" --quiet \
