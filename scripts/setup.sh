@@ -9,6 +9,8 @@ packages=(build-essential cmake ninja-build pkg-config
           libavformat-dev libavcodec-dev libavutil-dev libswscale-dev
           python3-onnx python3-numpy  # python3-onnx: the tflite -> ONNX converter (tools/convert)
           liblo-tools)  # oscdump, oscsend: the independent OSC receiver of the VMC tests
+# The browser viewer (docs/viewer.md): its server library, and headless Chromium for its tests.
+packages+=(libwebsockets-dev chromium python3-pil)
 # The fuzz run and the sanitizer run (scripts/test.sh, scripts/sanitize.sh) need clang with its
 # sanitizer runtime.
 if [ "${AVATARMAP_SKIP_FUZZ:-0}" != 1 ] || [ "${AVATARMAP_SKIP_SANITIZE:-0}" != 1 ]; then
@@ -29,3 +31,8 @@ if [ ${#missing[@]} -gt 0 ]; then
   $sudo_cmd apt-get update -qq
   $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
+
+# The viewer's JavaScript modules (three.js, three-vrm) from npm into the cache; without the
+# registry the viewer's tests skip and `avatarmap view` says what to run.
+"$(dirname "${BASH_SOURCE[0]}")/fetch_viewer_modules.sh" ||
+  echo "setup: warning: the viewer's modules could not be fetched (scripts/fetch_viewer_modules.sh)" >&2

@@ -16,5 +16,6 @@ int run_backends(int argc, char** argv);
 int run_inspect(int argc, char** argv);
 int run_eval_pose(int argc, char** argv);
 int run_avatar(int argc, char** argv);
+int run_view(int argc, char** argv);
 
 }  // namespace avatarmap::cli

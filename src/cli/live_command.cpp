@@ -19,11 +19,13 @@
 #include "avatarmap/capture/video_source.hpp"
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/solve/frame_solver.hpp"
+#include "avatarmap/stream/pose_server.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
 #include "cli/capture_setup.hpp"
 #include "cli/commands.hpp"
 #include "cli/live_vmc.hpp"
+#include "cli/viewer_setup.hpp"
 
 namespace avatarmap::cli {
 namespace {
@@ -48,6 +50,8 @@ const char* k_live_help =
     "                        none: the solver's poses as they are\n"
     "  --seconds S           stop after S seconds (default: when the input ends)\n"
     "  --unpaced             deliver file frames as fast as they decode (stress test)\n"
+    "  --serve [HOST:]PORT   serve the browser viewer and stream the output poses to it\n"
+    "                        (docs/viewer.md; host default 127.0.0.1, port 0 picks one)\n"
     "  --quiet               no progress line and no summary\n"
     "\n"
     "Estimator options (hands and face off unless asked):\n";
@@ -71,6 +75,8 @@ int run_live_command(int argc, char** argv) {
   std::string filter_name = "live";
   a.value("--filter", filter_name);
   const bool unpaced = a.flag("--unpaced");
+  std::string serve;
+  a.value("--serve", serve);
   const bool quiet = a.flag("--quiet");
   const bool progress = !quiet && isatty(STDERR_FILENO);
   live_vmc vmc;
@@ -93,6 +99,23 @@ int run_live_command(int argc, char** argv) {
   if (!(out_fps > 0 && out_fps <= 1000) || !(seconds >= 0)) {
     std::fprintf(stderr, "avatarmap live: --fps must be in (0, 1000], --seconds >= 0\n");
     return 2;
+  }
+  pose_server_options serve_options = default_viewer_options("live");
+  if (!serve.empty() && !parse_host_port(serve, serve_options.host, serve_options.port, error)) {
+    std::fprintf(stderr, "avatarmap live: --serve: %s\n", error.c_str());
+    return 2;
+  }
+  // The viewer's server first: a port in use is reported before the models load.
+  pose_server server;  // its own thread; publish() never waits for a page
+  if (!serve.empty()) {
+    if (quiet) serve_options.on_event = nullptr;
+    const status serve_status = server.start(serve_options);
+    if (!serve_status.ok()) {
+      std::fprintf(stderr, "avatarmap live: %s\n", serve_status.message().c_str());
+      return 1;
+    }
+    std::fprintf(stderr, "live: viewer at %s (poses on %s)\n", server.url().c_str(),
+                 k_pose_socket_path);
   }
   if (const int rc = vmc.open()) return rc;
   video_source source;
@@ -158,6 +181,7 @@ int run_live_command(int argc, char** argv) {
         p.t = t;
         if (writing && write_status.ok()) write_status = writer.write(p);
         ++written;
+        if (!serve.empty()) server.publish(p);
         vmc.pose_sampled();
       }
       vmc.send(p);  // outside the lock: never blocks, but need not hold up the capture side

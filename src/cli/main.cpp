@@ -26,8 +26,10 @@ const char* k_usage =
     "      Video, image or image sequence -> landmarks (MediaPipe's models on ONNX Runtime).\n"
     "  avatarmap animate VIDEO -o OUT.vrma|OUT.glb|OUT.bvh [--avatar AVATAR]\n"
     "      capture + convert in one command: video in, avatar animation out.\n"
-    "  avatarmap live INPUT [-o OUT.pose.jsonl] [--fps 60] [--hands] [--face]\n"
+    "  avatarmap live INPUT [-o OUT.pose.jsonl] [--fps 60] [--hands] [--face] [--serve PORT]\n"
     "      Latest-frame live loop (camera, or a file paced as one) with latency figures.\n"
+    "  avatarmap view [FILE.pose.jsonl|FILE.vrma] --avatar AVATAR.vrm [--port 8080]\n"
+    "      Browser viewer: the avatar posed live (live --serve) or playing FILE.\n"
     "  avatarmap convert IN -o OUT [--avatar AVATAR] [--rig auto|NAME|FILE.json] [--fps N]\n"
     "      Landmarks, poses or .vrma in; .vrma, .glb (animated avatar), .bvh or poses out.\n"
     "  avatarmap synth -o OUT.landmarks.jsonl [--truth OUT.pose.jsonl] [--scenario clean|noisy]\n"
@@ -60,6 +62,7 @@ int dispatch(const std::string& cmd, int argc, char** argv) {
   if (cmd == "inspect") return avatarmap::cli::run_inspect(argc, argv);
   if (cmd == "eval-pose") return avatarmap::cli::run_eval_pose(argc, argv);
   if (cmd == "avatar") return avatarmap::cli::run_avatar(argc, argv);
+  if (cmd == "view") return avatarmap::cli::run_view(argc, argv);
   return -1;
 }
 

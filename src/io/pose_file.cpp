@@ -8,6 +8,7 @@
 #include "avatarmap/core/rotation.hpp"
 #include "io/json_scan.hpp"
 #include "io/jsonl_reader_core.hpp"
+#include "io/pose_text.hpp"
 #include "io/text_output.hpp"
 
 namespace avatarmap {
@@ -320,62 +321,7 @@ status pose_writer::open(const std::string& path, const pose_file_header& header
 status pose_writer::write(const proxy_pose& pose) {
   auto& o = impl_->out;
   if (!o.is_open()) return status::error(o.path() + ": write() on a writer that is not open");
-  // One bone entry: name (<= 24) + 4 numbers (<= 16 each) + punctuation.
-  if (!o.reserve(128)) return status::error(o.error());
-  o.put("{\"t\":");
-  o.put_number(pose.t);
-  o.put(",\"hips_position\":[");
-  o.put_number(pose.hips_position.x);
-  o.put(',');
-  o.put_number(pose.hips_position.y);
-  o.put(',');
-  o.put_number(pose.hips_position.z);
-  o.put("],\"bones\":{");
-  bool first = true;
-  for (int b = 0; b < k_bone_count; ++b) {
-    const glm::quat& q = pose.rotations[b];
-    if (impl_->options.skip_identity && q.w == 1.f && q.x == 0.f && q.y == 0.f && q.z == 0.f)
-      continue;
-    if (!o.reserve(128)) return status::error(o.error());
-    if (!first) o.put(',');
-    first = false;
-    o.put('"');
-    o.put(bone_name(static_cast<bone>(b)));
-    o.put("\":[");
-    float v[4];
-    store_xyzw(q, v);
-    for (int i = 0; i < 4; ++i) {
-      if (i) o.put(',');
-      o.put_number(v[i]);
-    }
-    o.put(']');
-  }
-  if (!o.reserve(32)) return status::error(o.error());
-  o.put("},\"expressions\":{");
-  for (int e = 0; e < k_expression_count; ++e) {
-    if (!o.reserve(64)) return status::error(o.error());
-    if (e) o.put(',');
-    o.put('"');
-    o.put(expression_name(static_cast<expression>(e)));
-    o.put("\":");
-    o.put_number(pose.expressions[e]);
-  }
-  o.put('}');
-  if (impl_->options.write_confidence) {
-    if (!o.reserve(32)) return status::error(o.error());
-    o.put(",\"confidence\":{");
-    for (int b = 0; b < k_bone_count; ++b) {
-      if (!o.reserve(64)) return status::error(o.error());
-      if (b) o.put(',');
-      o.put('"');
-      o.put(bone_name(static_cast<bone>(b)));
-      o.put("\":");
-      o.put_number(pose.confidence[b]);
-    }
-    o.put('}');
-  }
-  if (!o.reserve(2)) return status::error(o.error());
-  o.put("}\n");
+  if (!io_detail::put_pose_line(o, pose, impl_->options)) return status::error(o.error());
   return {};
 }
 

@@ -1,8 +1,8 @@
 // A counting global operator new for the allocation tests: every form of new and delete
 // goes through malloc/free, and g_allocations counts the news. It replaces the allocator of
 // the whole test executable, so include this header in exactly ONE source file of an
-// executable (the area's allocation test); the other files of that executable see the count
-// through it only.
+// executable (the area's allocation test); other files of that executable that read the count
+// define AVATARMAP_COUNTING_NEW_COUNTER_ONLY before including it (the counter alone).
 #pragma once
 
 #include <atomic>
@@ -10,6 +10,8 @@
 #include <new>
 
 inline std::atomic<long> g_allocations{0};
+
+#ifndef AVATARMAP_COUNTING_NEW_COUNTER_ONLY
 
 void* operator new(std::size_t n) {
   g_allocations.fetch_add(1, std::memory_order_relaxed);
@@ -37,3 +39,5 @@ void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
 }
 void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
 void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+
+#endif  // AVATARMAP_COUNTING_NEW_COUNTER_ONLY

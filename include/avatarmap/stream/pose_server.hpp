@@ -1,0 +1,102 @@
+// The browser viewer's server (docs/viewer.md): serves the viewer page (the project's
+// viewer/ folder), the JavaScript modules it imports (three.js and three-vrm, fetched from npm
+// by scripts/fetch_viewer_modules.sh) and the avatar and clip it shows, and broadcasts proxy
+// poses to every connected page over a WebSocket. Bound to 127.0.0.1 by default.
+//
+// Threads: start() runs the server on a thread of its own; publish() may be called from any
+// thread (the live loop's) and never waits for a client: it replaces the newest pose, and each
+// page is sent the newest pose when its connection can take one, so a slow page skips poses
+// instead of queueing them. A page that disconnects, mid-message or not, only ends its own
+// connection.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "avatarmap/core/status.hpp"
+#include "avatarmap/skeleton/proxy_pose.hpp"
+
+namespace avatarmap {
+
+/// The WebSocket subprotocol a page asks for (new WebSocket(url, k_pose_socket_protocol)); a
+/// connection without it is refused. Each message the server sends is one text frame holding
+/// one line of *.pose.jsonl (docs/file-formats.md) without its newline.
+inline constexpr const char* k_pose_socket_protocol = "avatarmap.pose";
+/// The WebSocket's path.
+inline constexpr const char* k_pose_socket_path = "/pose";
+
+struct pose_server_options {
+  /// Address to listen on: an IPv4 or IPv6 literal, or "localhost" (= 127.0.0.1). Anything
+  /// but a loopback address makes the page, avatar and poses visible to the network.
+  std::string host = "127.0.0.1";
+  /// TCP port, 0 to 65535; 0 lets the system choose a free one (see pose_server::port()).
+  int port = 8080;
+  /// Folder with the viewer page (index.html, viewer.js): required.
+  std::string page_dir;
+  /// Folder with three/, three-vrm/, three-vrm-animation/ (scripts/fetch_viewer_modules.sh):
+  /// required.
+  std::string modules_dir;
+  /// Avatar (.vrm) the page loads, served as /avatar.vrm; empty = none (the page asks for
+  /// one to be dropped on it).
+  std::string avatar_path;
+  /// VRM Animation (.vrma) the page plays in a loop, served as /clip.vrma; empty = none.
+  std::string clip_path;
+  /// WebSocket URL the page takes its poses from; empty = this server's own k_pose_socket_path.
+  /// (`avatarmap view --connect PORT` points the page at a `live --serve PORT`.)
+  std::string pose_socket_url;
+  /// Called on the server's thread with one line about each page that connects, leaves or
+  /// reports its first posed frame; may be empty. Must not call back into the server.
+  std::function<void(std::string_view)> on_event;
+
+  /// ok, or a message naming the field and its allowed range (a missing folder or file).
+  status validate() const;
+};
+
+/// Counters since start(), readable from any thread.
+struct pose_server_stats {
+  int pages_connected = 0;           // WebSocket connections open now
+  long connections = 0;              // WebSocket connections accepted in all
+  long published = 0;                // publish() calls
+  long sent = 0;                     // pose messages handed to connections, all together
+  long skipped = 0;                  // poses a connection never got because a newer one came first
+  double first_posed_frame_ms = -1;  // the latest page's report: page load -> first posed frame
+};
+
+class pose_server {
+ public:
+  pose_server();
+  ~pose_server();  // stop()s
+  pose_server(const pose_server&) = delete;
+  pose_server& operator=(const pose_server&) = delete;
+
+  /// Validates the options, binds host:port and starts the server's thread. Fails with a
+  /// message that says what to do: invalid options, the port in use, an address that is not
+  /// this machine's, a port below 1024 without the right, a build without the server library.
+  /// Call at most once.
+  status start(const pose_server_options& options);
+  /// Stops the thread and closes every connection; idempotent.
+  void stop();
+
+  /// The port listened on (the chosen one when options.port was 0); 0 before start().
+  int port() const;
+  /// http://HOST:PORT/ (IPv6 hosts in brackets); empty before start().
+  std::string url() const;
+
+  /// Makes `pose` the newest pose and wakes the server to send it to every page. Any thread,
+  /// before, during or after start(); never blocks on a client, never allocates.
+  void publish(const proxy_pose& pose);
+
+  pose_server_stats stats() const;
+
+  /// False in a build without the server library (libwebsockets): start() then fails.
+  static bool available();
+
+ private:
+  struct impl;
+  std::unique_ptr<impl> impl_;
+};
+
+}  // namespace avatarmap

@@ -1,0 +1,221 @@
+// `avatarmap view [FILE] --avatar AVATAR.vrm`: serves the browser viewer (docs/viewer.md) with
+// the avatar, and plays FILE in it: a *.pose.jsonl is played by a pose_file_player into the
+// pose server (so the page is driven over its WebSocket exactly as by `live --serve`), a .vrma
+// by the page itself. --connect points the page at a `live --serve` server instead.
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <string>
+#include <thread>
+
+#include "avatarmap/export/vrma.hpp"
+#include "avatarmap/rig/avatar_loader.hpp"
+#include "avatarmap/stream/pose_file_player.hpp"
+#include "avatarmap/stream/pose_server.hpp"
+#include "cli/cli_args.hpp"
+#include "cli/commands.hpp"
+#include "cli/viewer_setup.hpp"
+
+extern char** environ;
+
+namespace avatarmap::cli {
+namespace {
+
+const char* k_view_help =
+    "Usage: avatarmap view [FILE] --avatar AVATAR.vrm [options]\n"
+    "\n"
+    "Serves the browser viewer: a page (three.js + three-vrm) that shows AVATAR.vrm posed by\n"
+    "proxy poses sent over a WebSocket. Prints the page's URL on standard output; open it in a\n"
+    "browser. Runs until Ctrl-C (or --seconds).\n"
+    "  FILE.pose.jsonl   played in a loop at its own time stamps, streamed to every page as\n"
+    "                    `avatarmap live --serve` streams live poses\n"
+    "  FILE.vrma         played in a loop by the page (three-vrm-animation)\n"
+    "  no FILE           the avatar in its rest pose, or the poses of --connect\n"
+    "\n"
+    "Options:\n"
+    "  --avatar PATH         the VRM 0.x or 1.0 avatar to show (required for now)\n"
+    "  --port P              port to serve on (default 8080; 0 picks a free one)\n"
+    "  --host H              address to listen on (default 127.0.0.1: this machine only;\n"
+    "                        0.0.0.0 shows the page, avatar and poses to the network)\n"
+    "  --connect [HOST:]PORT the page takes its poses from `avatarmap live --serve PORT`\n"
+    "                        (host default 127.0.0.1)\n"
+    "  --open                open the page in the desktop's browser (xdg-open)\n"
+    "  --seconds S           stop after S seconds\n"
+    "  --quiet               no lines about pages connecting and leaving\n"
+    "\n"
+    "The page's modules come from scripts/fetch_viewer_modules.sh (run by scripts/setup.sh);\n"
+    "AVATARMAP_VIEWER_MODULES and AVATARMAP_VIEWER_PAGE override where they are looked for.\n";
+
+volatile std::sig_atomic_t g_stop = 0;
+void on_stop_signal(int) { g_stop = 1; }
+
+bool ends_with_nocase(const std::string& s, const std::string& suffix) {
+  if (s.size() < suffix.size()) return false;
+  for (std::size_t i = 0; i < suffix.size(); ++i) {
+    char c = s[s.size() - suffix.size() + i];
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+    if (c != suffix[i]) return false;
+  }
+  return true;
+}
+
+// Opens `url` with xdg-open without waiting for the browser; false when it cannot be run.
+bool open_in_browser(const std::string& url) {
+  pid_t pid = 0;
+  std::string program = "xdg-open";
+  char* argv[] = {program.data(), const_cast<char*>(url.c_str()), nullptr};
+  if (posix_spawnp(&pid, "xdg-open", nullptr, nullptr, argv, environ) != 0) return false;
+  std::thread([pid] { waitpid(pid, nullptr, 0); }).detach();
+  return true;
+}
+
+}  // namespace
+
+int run_view(int argc, char** argv) {
+  args a(argc, argv, 2);
+  if (a.flag("--help") || a.flag("-h")) {
+    std::fputs(k_view_help, stdout);
+    return 0;
+  }
+  std::string avatar, host = "127.0.0.1", connect;
+  double port = 8080, seconds = 0;
+  a.value("--avatar", avatar);
+  a.value("--host", host);
+  a.number("--port", port);
+  a.value("--connect", connect);
+  a.number("--seconds", seconds);
+  const bool open = a.flag("--open");
+  const bool quiet = a.flag("--quiet");
+  if (!a.error().empty() || !a.check_no_options() || a.rest().size() > 1) {
+    std::fprintf(stderr, "avatarmap view: %s\n",
+                 !a.error().empty() ? a.error().c_str() : "give at most one FILE (see --help)");
+    return 2;
+  }
+  if (avatar.empty()) {
+    std::fprintf(stderr,
+                 "avatarmap view: give the avatar to show with --avatar FILE.vrm (a VRM 0.x or "
+                 "1.0 model)\n");
+    return 2;
+  }
+  if (!(port >= 0 && port <= 65535 && port == static_cast<int>(port)) || !(seconds >= 0)) {
+    std::fprintf(stderr, "avatarmap view: --port must be an integer in 0..65535, --seconds >= 0\n");
+    return 2;
+  }
+  const std::string file = a.rest().empty() ? std::string() : a.rest()[0];
+  const bool pose_file = ends_with_nocase(file, ".pose.jsonl");
+  const bool clip_file = ends_with_nocase(file, ".vrma");
+  if (!file.empty() && !pose_file && !clip_file) {
+    std::fprintf(stderr, "avatarmap view: %s: FILE must be a .pose.jsonl or a .vrma\n",
+                 file.c_str());
+    return 2;
+  }
+  pose_server_options o = default_viewer_options("view");
+  if (quiet) o.on_event = nullptr;
+  o.host = host;
+  o.port = static_cast<int>(port);
+  if (!connect.empty()) {
+    if (pose_file) {
+      std::fprintf(stderr,
+                   "avatarmap view: --connect and a .pose.jsonl are two sources of poses: give "
+                   "one\n");
+      return 2;
+    }
+    std::string live_host = "127.0.0.1", error;
+    int live_port = 0;
+    if (!parse_host_port(connect, live_host, live_port, error) || live_port == 0) {
+      std::fprintf(stderr, "avatarmap view: --connect: %s\n",
+                   error.empty() ? "the port of a live server cannot be 0" : error.c_str());
+      return 2;
+    }
+    const bool v6 = live_host.find(':') != std::string::npos;
+    o.pose_socket_url = "ws://" + (v6 ? "[" + live_host + "]" : live_host) + ":" +
+                        std::to_string(live_port) + k_pose_socket_path;
+  }
+
+  // The avatar and the clip are checked by the project's own readers (docs/security.md) before
+  // a browser is given them.
+  raw_rig rig;
+  if (status st = load_avatar(avatar, rig); !st) {
+    std::fprintf(stderr, "avatarmap view: %s\n", st.message().c_str());
+    return 1;
+  }
+  if (rig.source != rig_source::vrm0 && rig.source != rig_source::vrm1) {
+    std::fprintf(stderr,
+                 "avatarmap view: %s is not a VRM avatar (no VRM humanoid): the viewer shows VRM "
+                 "0.x and 1.0 models (.vrm)\n",
+                 avatar.c_str());
+    return 1;
+  }
+  o.avatar_path = avatar;
+  pose_file_player player;
+  if (pose_file) {
+    if (status st = player.open(file); !st) {
+      std::fprintf(stderr, "avatarmap view: %s\n", st.message().c_str());
+      return 1;
+    }
+  } else if (clip_file) {
+    vrma_clip clip;
+    if (status st = read_vrma(file, clip); !st) {
+      std::fprintf(stderr, "avatarmap view: %s\n", st.message().c_str());
+      return 1;
+    }
+    o.clip_path = file;
+  }
+
+  pose_server server;
+  if (status st = server.start(o); !st) {
+    std::fprintf(stderr, "avatarmap view: %s\n", st.message().c_str());
+    return 1;
+  }
+  std::printf("%s\n", server.url().c_str());
+  std::fflush(stdout);
+  if (!quiet) {
+    std::fprintf(stderr, "view: showing %s", avatar.c_str());
+    if (pose_file)
+      std::fprintf(stderr, ", playing %s (%ld poses, %.1f s) in a loop", file.c_str(),
+                   player.frames(), player.duration());
+    else if (clip_file)
+      std::fprintf(stderr, ", the page plays %s in a loop", file.c_str());
+    if (!o.pose_socket_url.empty())
+      std::fprintf(stderr, ", poses from %s", o.pose_socket_url.c_str());
+    std::fprintf(stderr, "; %s\n", seconds > 0 ? "stops after --seconds" : "Ctrl-C stops");
+  }
+  if (pose_file) player.start([&server](const proxy_pose& p) { server.publish(p); });
+  if (open && !open_in_browser(server.url()))
+    std::fprintf(stderr, "view: could not run xdg-open; open %s yourself\n", server.url().c_str());
+
+  g_stop = 0;
+  std::signal(SIGINT, on_stop_signal);
+  std::signal(SIGTERM, on_stop_signal);
+  const auto start = std::chrono::steady_clock::now();
+  status playing;
+  while (!g_stop) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (seconds > 0 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= seconds)
+      break;
+    if (pose_file && !(playing = player.error()).ok()) break;
+  }
+  player.stop();
+  const pose_server_stats stats = server.stats();
+  server.stop();
+  if (!playing.ok()) {
+    std::fprintf(stderr, "avatarmap view: %s\n", playing.message().c_str());
+    return 1;
+  }
+  if (!quiet) {
+    std::fprintf(stderr, "view: %ld page connections, %ld poses sent", stats.connections,
+                 stats.sent);
+    if (stats.first_posed_frame_ms >= 0)
+      std::fprintf(stderr, "; the last page drew its first posed frame %.0f ms after loading",
+                   stats.first_posed_frame_ms);
+    std::fputs("\n", stderr);
+  }
+  return 0;
+}
+
+}  // namespace avatarmap::cli

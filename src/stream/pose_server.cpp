@@ -1,0 +1,609 @@
+// The viewer's HTTP + WebSocket server on libwebsockets (include/avatarmap/stream/pose_server.hpp,
+// docs/viewer.md). One lws context with one service thread; publish() hands poses over
+// through a mutex-guarded "newest pose" buffer and lws_cancel_service(), which wakes the service
+// thread, which asks every WebSocket connection for a writeable callback; each connection then
+// sends the newest pose if it has not sent it yet. lws keeps at most the unsent rest of one
+// message per connection, so a slow page skips poses instead of queueing them.
+#include "avatarmap/stream/pose_server.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <cstring>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <thread>
+#include <vector>
+
+#include "io/pose_text.hpp"
+
+#if defined(AVATARMAP_HAVE_WEBSOCKETS)
+#include <libwebsockets.h>
+#endif
+
+namespace avatarmap {
+
+namespace {
+
+bool is_file(const std::string& p) {
+  struct stat st {};
+  return !p.empty() && ::stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+// A numeric address for `host` ("localhost" = 127.0.0.1); false when it is not one.
+bool parse_host(const std::string& host, sockaddr_storage& out, socklen_t& out_len) {
+  std::memset(&out, 0, sizeof out);
+  const std::string h = host == "localhost" ? "127.0.0.1" : host;
+  auto* v4 = reinterpret_cast<sockaddr_in*>(&out);
+  if (inet_pton(AF_INET, h.c_str(), &v4->sin_addr) == 1) {
+    v4->sin_family = AF_INET;
+    out_len = sizeof(sockaddr_in);
+    return true;
+  }
+  auto* v6 = reinterpret_cast<sockaddr_in6*>(&out);
+  if (inet_pton(AF_INET6, h.c_str(), &v6->sin6_addr) == 1) {
+    v6->sin6_family = AF_INET6;
+    out_len = sizeof(sockaddr_in6);
+    return true;
+  }
+  return false;
+}
+
+[[maybe_unused]] bool is_loopback(const sockaddr_storage& a) {
+  if (a.ss_family == AF_INET) {
+    const auto* v4 = reinterpret_cast<const sockaddr_in*>(&a);
+    return (ntohl(v4->sin_addr.s_addr) >> 24) == 127;
+  }
+  const auto* v6 = reinterpret_cast<const sockaddr_in6*>(&a);
+  return IN6_IS_ADDR_LOOPBACK(&v6->sin6_addr);
+}
+
+// The host part of "HOST[:PORT]" or "[V6]:PORT" or a URL "scheme://HOST[:PORT]/...".
+[[maybe_unused]] std::string_view host_part(std::string_view s) {
+  if (auto p = s.find("://"); p != std::string_view::npos) s.remove_prefix(p + 3);
+  if (!s.empty() && s[0] == '[') {
+    const auto e = s.find(']');
+    return e == std::string_view::npos ? std::string_view{} : s.substr(0, e + 1);
+  }
+  return s.substr(0, s.find_first_of(":/"));
+}
+
+// A loopback name a browser may use: 127.x.x.x, localhost, [::1].
+[[maybe_unused]] bool is_loopback_name(std::string_view h) {
+  if (h == "localhost" || h == "[::1]") return true;
+  in_addr a{};
+  return inet_pton(AF_INET, std::string(h).c_str(), &a) == 1 && (ntohl(a.s_addr) >> 24) == 127;
+}
+
+// What binding `host`:`port` fails with, checked by binding a socket of our own (lws reports
+// only that it could not); empty when it can be bound.
+[[maybe_unused]] std::string bind_problem(const sockaddr_storage& addr, socklen_t len,
+                                          const std::string& host, int port) {
+  const int fd = ::socket(addr.ss_family, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return std::string("cannot create a socket: ") + std::strerror(errno);
+  const int one = 1;
+  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+  sockaddr_storage a = addr;
+  if (a.ss_family == AF_INET)
+    reinterpret_cast<sockaddr_in*>(&a)->sin_port = htons(static_cast<uint16_t>(port));
+  else
+    reinterpret_cast<sockaddr_in6*>(&a)->sin6_port = htons(static_cast<uint16_t>(port));
+  std::string problem;
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&a), len) != 0) {
+    const int e = errno;
+    const std::string where = host + " port " + std::to_string(port);
+    if (e == EADDRINUSE)
+      problem = where + " is in use by another program: choose another port (--port; 0 picks a " +
+                "free one) or stop the program that holds it";
+    else if (e == EADDRNOTAVAIL)
+      problem = host + " is not an address of this machine: use 127.0.0.1 (the default) or one " +
+                "of its own addresses";
+    else if (e == EACCES)
+      problem = where + ": ports below 1024 need administrator rights; choose a port from 1024";
+    else
+      problem = where + ": " + std::strerror(e);
+  }
+  ::close(fd);
+  return problem;
+}
+
+}  // namespace
+
+status pose_server_options::validate() const {
+  sockaddr_storage a{};
+  socklen_t len = 0;
+  if (!parse_host(host, a, len))
+    return status::error("pose server: host '" + host +
+                         "' is not an IPv4 or IPv6 address (or localhost); e.g. 127.0.0.1");
+  if (port < 0 || port > 65535)
+    return status::error("pose server: port " + std::to_string(port) +
+                         " is outside 0..65535 (0 picks a free port)");
+  if (!is_file(page_dir + "/index.html"))
+    return status::error("pose server: the viewer page is missing (" + page_dir +
+                         "/index.html); point page_dir at the project's viewer/ folder");
+  if (!is_file(modules_dir + "/three/build/three.module.js") ||
+      !is_file(modules_dir + "/three-vrm/lib/three-vrm.module.js") ||
+      !is_file(modules_dir + "/three-vrm-animation/lib/three-vrm-animation.module.js"))
+    return status::error("pose server: three.js and three-vrm are missing from '" + modules_dir +
+                         "': run scripts/fetch_viewer_modules.sh (or scripts/setup.sh), or set "
+                         "AVATARMAP_VIEWER_MODULES to the folder it fills");
+  if (!avatar_path.empty() && !is_file(avatar_path))
+    return status::error("pose server: avatar '" + avatar_path + "' is not a readable file");
+  if (!clip_path.empty() && !is_file(clip_path))
+    return status::error("pose server: clip '" + clip_path + "' is not a readable file");
+  return {};
+}
+
+#if defined(AVATARMAP_HAVE_WEBSOCKETS)
+
+namespace {
+
+// Bytes of one message: a pose line with every bone (confidence is not sent).
+constexpr std::size_t k_message_capacity = io_detail::k_pose_line_max;
+// Room write_shortest_float may use past the reserved bytes (pose_text.hpp).
+constexpr std::size_t k_message_slack = io_detail::k_shortest_float_room + 32;
+// A page's messages (its report) are small; longer ones are ignored.
+constexpr std::size_t k_rx_max = 256;
+
+struct http_session {
+  bool config_pending;  // /config.json: headers sent, body to write when writeable
+};
+
+struct ws_session {
+  std::uint64_t sent_seq;  // the newest pose this connection has been handed (0 = none)
+  std::size_t rx_len;
+  bool rx_overflow;
+  char rx[k_rx_max];
+  char peer[64];
+};
+
+int http_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, size_t len);
+int ws_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, size_t len);
+
+// protocols[0] takes plain HTTP (and refuses WebSockets without our subprotocol).
+const lws_protocols k_protocols[] = {
+    {"http", http_callback, sizeof(http_session), 0, 0, nullptr, 0},
+    {k_pose_socket_protocol, ws_callback, sizeof(ws_session), k_rx_max, 0, nullptr, 0},
+    {nullptr, nullptr, 0, 0, 0, nullptr, 0}};
+
+// lws's error log lines, kept for start()'s message; lws prints nothing itself.
+std::mutex g_log_mutex;
+std::string g_last_log;
+void lws_log_sink(int level, const char* line) {
+  if (level != LLL_ERR) return;
+  std::lock_guard<std::mutex> lock(g_log_mutex);
+  g_last_log = line;
+  while (!g_last_log.empty() && (g_last_log.back() == '\n' || g_last_log.back() == '\r'))
+    g_last_log.pop_back();
+}
+
+// What the service thread's callbacks and publish() share (the context's user data).
+struct server_state {
+  pose_server_options options;
+  bool loopback = true;
+  int port = 0;
+  std::string url;
+  std::string config_json;
+  std::thread thread;
+  std::atomic<bool> stopping{false};
+  bool started = false;
+
+  // The newest pose, written by publish() (any thread), read by the service thread.
+  mutable std::mutex m;
+  lws_context* context = nullptr;  // under m for publish(); set before the thread starts
+  std::vector<char> latest = std::vector<char>(k_message_capacity + k_message_slack);
+  std::size_t latest_size = 0;
+  std::uint64_t seq = 0;
+
+  // Service thread only.
+  std::vector<unsigned char> send_buffer =
+      std::vector<unsigned char>(LWS_PRE + k_message_capacity + k_message_slack);
+  std::vector<unsigned char> http_buffer = std::vector<unsigned char>(LWS_PRE + 4096);
+
+  std::atomic<int> open{0};
+  std::atomic<long> connections{0}, published{0}, sent{0}, skipped{0};
+  std::atomic<double> first_posed_ms{-1.0};
+
+  void event(const std::string& line) const {
+    if (options.on_event) options.on_event(line);
+  }
+
+  // Whether a request's Host header names this server: any name when listening beyond
+  // loopback; else only loopback names, so that a web page that rebinds its own domain name to
+  // 127.0.0.1 cannot read the avatar or the poses (DNS rebinding).
+  bool host_allowed(lws* wsi) const {
+    if (!loopback) return true;
+    char host[256];
+    if (lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) <= 0) return false;
+    return is_loopback_name(host_part(host));
+  }
+  // A WebSocket's Origin: absent (not a browser), or a page served from a loopback name (this
+  // server's or `view --connect`'s), or with a non-loopback listener the Host itself.
+  bool origin_allowed(lws* wsi) const {
+    char origin[256];
+    const int n = lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN);
+    if (n <= 0) return lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) == 0;
+    const std::string_view oh = host_part(origin);
+    if (is_loopback_name(oh)) return true;
+    if (loopback) return false;
+    char host[256];
+    return lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) > 0 && host_part(host) == oh;
+  }
+};
+
+server_state* server_of(lws* wsi) {
+  return static_cast<server_state*>(lws_context_user(lws_get_context(wsi)));
+}
+
+// A path below a served folder: segments of [A-Za-z0-9._-], none empty or starting with '.'.
+bool safe_relative_path(std::string_view p) {
+  if (p.empty() || p.size() > 512) return false;
+  std::size_t start = 0;
+  while (start <= p.size()) {
+    std::size_t end = p.find('/', start);
+    if (end == std::string_view::npos) end = p.size();
+    const std::string_view seg = p.substr(start, end - start);
+    if (seg.empty() || seg[0] == '.') return false;
+    for (char c : seg)
+      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-'))
+        return false;
+    start = end + 1;
+  }
+  return true;
+}
+
+const char* mime_of(std::string_view path) {
+  auto ends = [&](std::string_view e) {
+    return path.size() >= e.size() && path.substr(path.size() - e.size()) == e;
+  };
+  if (ends(".html")) return "text/html; charset=utf-8";
+  if (ends(".js")) return "text/javascript; charset=utf-8";
+  if (ends(".css")) return "text/css; charset=utf-8";
+  if (ends(".json")) return "application/json";
+  if (ends(".vrm") || ends(".vrma") || ends(".glb")) return "model/gltf-binary";
+  if (ends(".png")) return "image/png";
+  return nullptr;  // not served
+}
+
+// The file a GET path names, or empty.
+std::string route(const server_state& s, std::string_view path) {
+  if (path == "/" || path == "/index.html") return s.options.page_dir + "/index.html";
+  if (path == "/avatar.vrm") return s.options.avatar_path;
+  if (path == "/clip.vrma") return s.options.clip_path;
+  constexpr std::string_view modules = "/modules/";
+  if (path.substr(0, modules.size()) == modules) {
+    std::string_view rest = path.substr(modules.size());
+    const std::string_view package = rest.substr(0, rest.find('/'));
+    if (package != "three" && package != "three-vrm" && package != "three-vrm-animation") return {};
+    if (!safe_relative_path(rest) || rest.size() < 3 || rest.substr(rest.size() - 3) != ".js")
+      return {};
+    return s.options.modules_dir + "/" + std::string(rest);
+  }
+  // The page's own files: one level, no folders.
+  std::string_view name = path.substr(1);
+  if (name.find('/') != std::string_view::npos || !safe_relative_path(name)) return {};
+  return s.options.page_dir + "/" + std::string(name);
+}
+
+// Headers every served file carries: no MIME sniffing, no framing by other sites, no referrer.
+constexpr char k_file_headers[] =
+    "x-content-type-options: nosniff\r\nx-frame-options: deny\r\nreferrer-policy: no-referrer\r\n";
+
+int finish(lws* wsi) { return lws_http_transaction_completed(wsi) ? -1 : 0; }
+
+int refuse(lws* wsi, unsigned code, const char* body) {
+  lws_return_http_status(wsi, code, body);
+  return -1;  // close: error answers are rare and the page never makes them
+}
+
+int http_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, size_t len) {
+  auto* session = static_cast<http_session*>(user);
+  switch (reason) {
+    case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+      return 1;  // a WebSocket without our subprotocol
+    case LWS_CALLBACK_HTTP: {
+      server_state& s = *server_of(wsi);
+      session->config_pending = false;
+      if (!s.host_allowed(wsi))
+        return refuse(wsi, HTTP_STATUS_FORBIDDEN,
+                      "this server answers only to 127.0.0.1 and localhost");
+      if (lws_hdr_total_length(wsi, WSI_TOKEN_GET_URI) <= 0)
+        return refuse(wsi, HTTP_STATUS_METHOD_NOT_ALLOWED, "only GET");
+      const std::string_view path(static_cast<const char*>(in),
+                                  in ? std::strlen(static_cast<const char*>(in)) : 0);
+      if (path == "/config.json") {
+        unsigned char* start = s.http_buffer.data() + LWS_PRE;
+        unsigned char* p = start;
+        unsigned char* end = s.http_buffer.data() + s.http_buffer.size() - 1;
+        if (lws_add_http_common_headers(wsi, HTTP_STATUS_OK, "application/json",
+                                        s.config_json.size(), &p, end) ||
+            lws_add_http_header_by_token(wsi, WSI_TOKEN_HTTP_CACHE_CONTROL,
+                                         reinterpret_cast<const unsigned char*>("no-store"), 8, &p,
+                                         end) ||
+            lws_finalize_write_http_header(wsi, start, &p, end))
+          return 1;
+        session->config_pending = true;
+        lws_callback_on_writable(wsi);
+        return 0;
+      }
+      const std::string file = route(s, path);
+      // The avatar and the clip are glTF binaries whatever their names end with.
+      const char* mime =
+          path == "/avatar.vrm" || path == "/clip.vrma" ? "model/gltf-binary" : mime_of(file);
+      if (file.empty() || !mime || !is_file(file))
+        return refuse(wsi, HTTP_STATUS_NOT_FOUND, "not found");
+      const int n = lws_serve_http_file(wsi, file.c_str(), mime, k_file_headers,
+                                        static_cast<int>(sizeof k_file_headers - 1));
+      if (n < 0 || (n > 0 && lws_http_transaction_completed(wsi))) return -1;
+      return 0;
+    }
+    case LWS_CALLBACK_HTTP_WRITEABLE: {
+      if (!session || !session->config_pending) return 0;
+      server_state& s = *server_of(wsi);
+      session->config_pending = false;
+      const std::size_t n = std::min(s.config_json.size(), s.http_buffer.size() - LWS_PRE);
+      std::memcpy(s.http_buffer.data() + LWS_PRE, s.config_json.data(), n);
+      if (lws_write(wsi, s.http_buffer.data() + LWS_PRE, n, LWS_WRITE_HTTP_FINAL) !=
+          static_cast<int>(n))
+        return 1;
+      return finish(wsi);
+    }
+    case LWS_CALLBACK_HTTP_FILE_COMPLETION:
+      return finish(wsi);
+    default:
+      return lws_callback_http_dummy(wsi, reason, user, in, len);
+  }
+}
+
+int ws_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, size_t len) {
+  auto* session = static_cast<ws_session*>(user);
+  switch (reason) {
+    case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION: {
+      server_state& s = *server_of(wsi);
+      char uri[64];
+      if (lws_hdr_copy(wsi, uri, sizeof uri, WSI_TOKEN_GET_URI) <= 0 ||
+          std::strcmp(uri, k_pose_socket_path) != 0)
+        return 1;
+      if (!s.host_allowed(wsi) || !s.origin_allowed(wsi)) {
+        s.event("refused a WebSocket from a page of another site (Origin or Host not loopback)");
+        return 1;
+      }
+      return 0;
+    }
+    case LWS_CALLBACK_ESTABLISHED: {
+      server_state& s = *server_of(wsi);
+      session->sent_seq = 0;
+      session->rx_len = 0;
+      session->rx_overflow = false;
+      session->peer[0] = '\0';
+      lws_get_peer_simple(wsi, session->peer, sizeof session->peer);
+      const int open = ++s.open;
+      ++s.connections;
+      s.event("page connected from " + std::string(session->peer) + " (" + std::to_string(open) +
+              " open)");
+      lws_callback_on_writable(wsi);
+      return 0;
+    }
+    case LWS_CALLBACK_SERVER_WRITEABLE: {
+      server_state& s = *server_of(wsi);
+      std::size_t n = 0;
+      std::uint64_t seq = 0;
+      {
+        std::lock_guard<std::mutex> lock(s.m);
+        if (s.seq == session->sent_seq || s.latest_size == 0) return 0;
+        n = s.latest_size;
+        seq = s.seq;
+        std::memcpy(s.send_buffer.data() + LWS_PRE, s.latest.data(), n);
+      }
+      if (session->sent_seq != 0 && seq > session->sent_seq + 1)
+        s.skipped += static_cast<long>(seq - session->sent_seq - 1);
+      session->sent_seq = seq;
+      // lws sends what the socket takes and keeps the rest, then calls back only when it is
+      // out: at most one message waits per connection.
+      if (lws_write(wsi, s.send_buffer.data() + LWS_PRE, n, LWS_WRITE_TEXT) < static_cast<int>(n))
+        return -1;
+      ++s.sent;
+      return 0;
+    }
+    case LWS_CALLBACK_RECEIVE: {
+      // The page's one report: {"first_posed_ms": X}. Anything else is ignored.
+      if (session->rx_len + len > k_rx_max - 1) session->rx_overflow = true;
+      if (!session->rx_overflow) {
+        std::memcpy(session->rx + session->rx_len, in, len);
+        session->rx_len += len;
+      }
+      if (!lws_is_final_fragment(wsi)) return 0;
+      if (!session->rx_overflow) {
+        session->rx[session->rx_len] = '\0';
+        constexpr const char* key = "\"first_posed_ms\":";
+        if (const char* at = std::strstr(session->rx, key)) {
+          char* end = nullptr;
+          const double ms = std::strtod(at + std::strlen(key), &end);
+          if (end != at + std::strlen(key) && ms >= 0 && ms < 1e9) {
+            server_state& s = *server_of(wsi);
+            s.first_posed_ms = ms;
+            char line[192];
+            std::snprintf(line, sizeof line,
+                          "page at %s showed its first posed frame %.0f ms after it began loading",
+                          session->peer, ms);
+            s.event(line);
+          }
+        }
+      }
+      session->rx_len = 0;
+      session->rx_overflow = false;
+      return 0;
+    }
+    case LWS_CALLBACK_CLOSED: {
+      server_state& s = *server_of(wsi);
+      const int open = --s.open;
+      s.event("page at " + std::string(session->peer) + " left (" + std::to_string(open) +
+              " open)");
+      return 0;
+    }
+    case LWS_CALLBACK_EVENT_WAIT_CANCELLED:
+      // publish() woke the service: every connection that has not sent the newest pose asks
+      // to write (a connection still sending its last message is called when it is done).
+      lws_callback_on_writable_all_protocol(lws_get_context(wsi), &k_protocols[1]);
+      return 0;
+    default:
+      return 0;
+  }
+}
+
+}  // namespace
+
+struct pose_server::impl : server_state {};
+
+pose_server::pose_server() : impl_(std::make_unique<impl>()) {}
+pose_server::~pose_server() { stop(); }
+
+bool pose_server::available() { return true; }
+
+status pose_server::start(const pose_server_options& options) {
+  if (impl_->started || impl_->stopping)
+    return status::error("pose server: start() was already called (one start per server)");
+  if (status st = options.validate(); !st) return st;
+  impl& s = *impl_;
+  s.options = options;
+  sockaddr_storage addr{};
+  socklen_t addr_len = 0;
+  parse_host(options.host, addr, addr_len);
+  s.loopback = is_loopback(addr);
+  const std::string host = options.host == "localhost" ? "127.0.0.1" : options.host;
+  if (options.port != 0) {
+    if (std::string problem = bind_problem(addr, addr_len, host, options.port); !problem.empty())
+      return status::error("pose server: " + problem);
+  }
+
+  nlohmann::json config;
+  config["protocol"] = k_pose_socket_protocol;
+  config["avatar"] = options.avatar_path.empty() ? nlohmann::json() : nlohmann::json("/avatar.vrm");
+  config["clip"] = options.clip_path.empty() ? nlohmann::json() : nlohmann::json("/clip.vrma");
+  config["pose_socket"] =
+      options.pose_socket_url.empty() ? nlohmann::json() : nlohmann::json(options.pose_socket_url);
+  auto base_name = [](const std::string& p) { return p.substr(p.find_last_of('/') + 1); };
+  config["avatar_name"] = base_name(options.avatar_path);
+  config["clip_name"] = base_name(options.clip_path);
+  s.config_json = config.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  if (s.config_json.size() > s.http_buffer.size() - LWS_PRE - 1)
+    return status::error("pose server: the avatar or clip path is too long");
+
+  lws_set_log_level(LLL_ERR, lws_log_sink);
+  lws_context_creation_info info;
+  std::memset(&info, 0, sizeof info);
+  info.port = options.port;
+  info.iface = host.c_str();
+  info.protocols = k_protocols;
+  info.user = &s;
+  // Not LWS_SERVER_OPTION_HTTP_HEADERS_SECURITY_BEST_PRACTICES_ENFORCE: its fixed
+  // Content-Security-Policy forbids the page's inline import map; route()'s answers carry
+  // k_file_headers instead.
+  info.options = LWS_SERVER_OPTION_FAIL_UPON_UNABLE_TO_BIND;
+  if (addr.ss_family == AF_INET) info.options |= LWS_SERVER_OPTION_DISABLE_IPV6;
+  info.vhost_name = "avatarmap";
+  info.server_string = "avatarmap";
+  info.timeout_secs = 20;
+  lws_context* ctx = lws_create_context(&info);
+  if (!ctx) {
+    std::string why;
+    if (options.port != 0) why = bind_problem(addr, addr_len, host, options.port);
+    if (why.empty()) {
+      std::lock_guard<std::mutex> lock(g_log_mutex);
+      why = "could not start on " + host + " port " + std::to_string(options.port) +
+            (g_last_log.empty() ? std::string() : " (" + g_last_log + ")");
+    }
+    return status::error("pose server: " + why);
+  }
+  lws_vhost* vh = lws_get_vhost_by_name(ctx, "avatarmap");
+  s.port = vh ? lws_get_vhost_listen_port(vh) : options.port;
+  const std::string shown = host == "0.0.0.0" ? "127.0.0.1" : host == "::" ? "::1" : host;
+  s.url = "http://" + (shown.find(':') != std::string::npos ? "[" + shown + "]" : shown) + ":" +
+          std::to_string(s.port) + "/";
+  {
+    std::lock_guard<std::mutex> lock(s.m);
+    s.context = ctx;
+  }
+  s.started = true;
+  s.thread = std::thread([&s, ctx] {
+    while (!s.stopping.load()) lws_service(ctx, 0);
+  });
+  return {};
+}
+
+void pose_server::stop() {
+  impl& s = *impl_;
+  if (!s.started) return;
+  s.started = false;
+  lws_context* ctx = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(s.m);
+    ctx = s.context;
+    s.context = nullptr;
+  }
+  s.stopping = true;
+  lws_cancel_service(ctx);
+  s.thread.join();
+  lws_context_destroy(ctx);
+}
+
+int pose_server::port() const { return impl_->port; }
+std::string pose_server::url() const { return impl_->url; }
+
+void pose_server::publish(const proxy_pose& pose) {
+  impl& s = *impl_;
+  ++s.published;
+  std::lock_guard<std::mutex> lock(s.m);
+  io_detail::memory_text text(s.latest.data(), k_message_capacity);
+  if (!io_detail::put_pose_line(text, pose, pose_write_options{}, false)) return;
+  s.latest_size = text.size();
+  ++s.seq;
+  if (s.context) lws_cancel_service(s.context);
+}
+
+pose_server_stats pose_server::stats() const {
+  const impl& s = *impl_;
+  pose_server_stats r;
+  r.pages_connected = s.open.load();
+  r.connections = s.connections.load();
+  r.published = s.published.load();
+  r.sent = s.sent.load();
+  r.skipped = s.skipped.load();
+  r.first_posed_frame_ms = s.first_posed_ms.load();
+  return r;
+}
+
+#else  // no libwebsockets: a server that says so
+
+struct pose_server::impl {
+  std::atomic<long> published{0};
+};
+pose_server::pose_server() : impl_(std::make_unique<impl>()) {}
+pose_server::~pose_server() = default;
+bool pose_server::available() { return false; }
+status pose_server::start(const pose_server_options& options) {
+  if (status st = options.validate(); !st) return st;
+  return status::error(
+      "pose server: this build has no WebSocket server (libwebsockets was not found when it was "
+      "built): install libwebsockets-dev (scripts/setup.sh) and build again");
+}
+void pose_server::stop() {}
+int pose_server::port() const { return 0; }
+std::string pose_server::url() const { return {}; }
+void pose_server::publish(const proxy_pose&) { ++impl_->published; }
+pose_server_stats pose_server::stats() const {
+  pose_server_stats r;
+  r.published = impl_->published.load();
+  return r;
+}
+
+#endif
+
+}  // namespace avatarmap

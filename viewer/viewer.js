@@ -1,0 +1,299 @@
+// avatarmap's browser viewer (docs/viewer.md). Loads the avatar the server names in
+// /config.json, then either applies the proxy poses that arrive on the WebSocket (one
+// *.pose.jsonl line per message: VRM 1.0 normalised local rotations [x, y, z, w], the hips
+// position in metres, expression weights) or plays the server's .vrma clip in a loop. Poses
+// win over the clip: the first pose that arrives stops it.
+//
+// For tests and tools: window.avatarmapViewer.state() says what the page shows; ?hud=0 hides
+// the text box; the page logs "avatarmap-viewer: first posed frame N ms" and sends
+// {"first_posed_ms": N} to the server once it has drawn its first posed frame (N counted from
+// the start of the page's navigation).
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { VRMLoaderPlugin, VRMUtils } from '@pixiv/three-vrm';
+import { VRMAnimationLoaderPlugin, createVRMAnimationClip } from '@pixiv/three-vrm-animation';
+
+const params = new URLSearchParams(location.search);
+const hudElement = document.getElementById('hud');
+if (params.get('hud') === '0') hudElement.style.display = 'none';
+
+const state = {
+  avatar: 'none',        // none | loading | ready | failed
+  avatarName: '',
+  mode: 'rest',          // rest | live | clip
+  socket: 'closed',      // closed | connecting | open
+  socketUrl: '',
+  posesReceived: 0,
+  posesApplied: 0,
+  badMessages: 0,
+  lastPoseT: null,       // t of the newest applied pose (seconds)
+  clipName: '',
+  clipTime: null,        // seconds into the clip
+  clipDuration: null,
+  firstPosedMs: null,
+  frames: 0,
+  error: '',
+};
+window.avatarmapViewer = { state: () => ({ ...state }) };
+
+// ---- scene ----------------------------------------------------------------------------------
+const renderer = new THREE.WebGLRenderer({ antialias: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+renderer.setSize(window.innerWidth, window.innerHeight);
+renderer.setClearColor(0x1e2430);
+renderer.outputColorSpace = THREE.SRGBColorSpace;
+document.body.appendChild(renderer.domElement);
+
+const scene = new THREE.Scene();
+scene.add(new THREE.AmbientLight(0xffffff, 1.2));
+const sun = new THREE.DirectionalLight(0xffffff, 2.0);
+sun.position.set(0.5, 1.5, 2.0);
+scene.add(sun);
+
+const camera = new THREE.PerspectiveCamera(30, window.innerWidth / window.innerHeight, 0.05, 50);
+camera.position.set(0, 1.2, 4.5);
+const controls = new OrbitControls(camera, renderer.domElement);
+controls.target.set(0, 1.0, 0);
+controls.update();
+
+window.addEventListener('resize', () => {
+  camera.aspect = window.innerWidth / window.innerHeight;
+  camera.updateProjectionMatrix();
+  renderer.setSize(window.innerWidth, window.innerHeight);
+});
+
+// ---- avatar ---------------------------------------------------------------------------------
+let vrm = null;
+let restHipsY = 1.0;     // the avatar's hips height in its rest pose (normalised space)
+let restHips = [0, 1, 0];
+let mixer = null;
+let clipAction = null;
+
+function gltfLoader() {
+  const loader = new GLTFLoader();
+  loader.register((parser) => new VRMLoaderPlugin(parser));
+  loader.register((parser) => new VRMAnimationLoaderPlugin(parser));
+  return loader;
+}
+
+// Frames the avatar from the front (it faces +Z after rotateVRM0), with room above the head for
+// raised hands and on both sides for a T-pose.
+function frameAvatar() {
+  vrm.scene.updateMatrixWorld(true);
+  const box = new THREE.Box3().setFromObject(vrm.scene);
+  const height = Math.max(0.2, box.max.y - box.min.y);
+  const centreY = box.min.y + 0.55 * height;
+  const visible = 1.45 * height;
+  const fov = THREE.MathUtils.degToRad(camera.fov);
+  const fitHeight = visible / 2 / Math.tan(fov / 2);
+  const fitWidth = (1.3 * height) / 2 / Math.tan(fov / 2) / Math.max(0.2, camera.aspect);
+  const distance = Math.max(fitHeight, fitWidth);
+  camera.position.set(0, centreY, distance);
+  controls.target.set(0, centreY, 0);
+  controls.update();
+}
+
+async function loadAvatar(url, name) {
+  state.avatar = 'loading';
+  state.avatarName = name;
+  try {
+    const gltf = await gltfLoader().loadAsync(url);
+    const loaded = gltf.userData.vrm;
+    if (!loaded) throw new Error(`${name} is not a VRM avatar (no VRM extension)`);
+    if (vrm) {
+      scene.remove(vrm.scene);
+      VRMUtils.deepDispose(vrm.scene);
+    }
+    VRMUtils.removeUnnecessaryVertices(gltf.scene);
+    VRMUtils.rotateVRM0(loaded);  // VRM 0.x faces -Z: turn it to face +Z as VRM 1.0 does
+    vrm = loaded;
+    scene.add(vrm.scene);
+    const rest = vrm.humanoid.normalizedRestPose.hips?.position ?? [0, 1, 0];
+    restHips = rest;
+    restHipsY = Math.max(0.1, rest[1]);
+    standingHipsY = 0;
+    firstHips = null;
+    frameAvatar();
+    state.avatar = 'ready';
+    state.error = '';
+    if (config.clip) await loadClip(config.clip, config.clip_name || 'clip');
+  } catch (e) {
+    state.avatar = 'failed';
+    state.error = `could not load the avatar ${name}: ${e.message ?? e}`;
+    console.error('avatarmap-viewer:', state.error);
+  }
+}
+
+async function loadClip(url, name) {
+  try {
+    const gltf = await gltfLoader().loadAsync(url);
+    const animation = gltf.userData.vrmAnimations?.[0];
+    if (!animation) throw new Error(`${name} holds no VRM Animation`);
+    const clip = createVRMAnimationClip(animation, vrm);
+    mixer = new THREE.AnimationMixer(vrm.scene);
+    clipAction = mixer.clipAction(clip);
+    clipAction.setLoop(THREE.LoopRepeat, Infinity).play();
+    state.clipName = name;
+    state.clipDuration = clip.duration;
+    if (state.mode !== 'live') state.mode = 'clip';
+  } catch (e) {
+    state.error = `could not play ${name}: ${e.message ?? e}`;
+    console.error('avatarmap-viewer:', state.error);
+  }
+}
+
+// ---- poses ----------------------------------------------------------------------------------
+let newestMessage = null;  // only the newest pose is parsed, once per drawn frame
+let standingHipsY = 0;     // the highest hips height seen: the performer standing
+let firstHips = null;      // the first pose's hips: horizontal motion is shown relative to it
+
+function applyPose(pose) {
+  // VRM 0.x models keep their own axes under three-vrm's normalised bones: X and Z flip (as
+  // three-vrm-animation does for VRMA clips).
+  const flip = vrm.meta?.metaVersion === '0' ? -1 : 1;
+  const bones = pose.bones ?? {};
+  for (const name in bones) {
+    const q = bones[name];
+    const node = vrm.humanoid.getNormalizedBoneNode(name);
+    if (!node || !Array.isArray(q) || q.length !== 4) continue;
+    node.quaternion.set(flip * q[0], q[1], flip * q[2], q[3]);
+  }
+  const h = pose.hips_position;
+  const hips = vrm.humanoid.getNormalizedBoneNode('hips');
+  if (hips && Array.isArray(h) && h.length === 3 && h.every(Number.isFinite)) {
+    if (!firstHips) firstHips = h;
+    standingHipsY = Math.min(2.5, Math.max(standingHipsY, h[1], 0.3));
+    const s = restHipsY / standingHipsY;  // performer metres -> avatar metres
+    hips.position.set(restHips[0] + flip * (h[0] - firstHips[0]) * s, h[1] * s,
+                      restHips[2] + flip * (h[2] - firstHips[2]) * s);
+  }
+  const weights = pose.expressions ?? {};
+  const expressions = vrm.expressionManager;
+  if (expressions) {
+    for (const name in weights) {
+      if (expressions.getExpression(name)) expressions.setValue(name, Number(weights[name]) || 0);
+    }
+  }
+  state.lastPoseT = typeof pose.t === 'number' ? pose.t : null;
+  state.posesApplied++;
+}
+
+let socket = null;
+function connect(url) {
+  state.socket = 'connecting';
+  state.socketUrl = url;
+  socket = new WebSocket(url, config.protocol || 'avatarmap.pose');
+  socket.onopen = () => {
+    state.socket = 'open';
+    if (state.firstPosedMs !== null) report();
+  };
+  socket.onmessage = (event) => {
+    newestMessage = event.data;
+    state.posesReceived++;
+  };
+  socket.onclose = () => {
+    state.socket = 'closed';
+    setTimeout(() => connect(url), 1000);  // the sender may come (back) later
+  };
+}
+
+function report() {
+  if (socket && socket.readyState === WebSocket.OPEN)
+    socket.send(JSON.stringify({ first_posed_ms: state.firstPosedMs }));
+}
+
+// ---- drop a .vrm ----------------------------------------------------------------------------
+document.body.addEventListener('dragover', (e) => {
+  e.preventDefault();
+  document.body.classList.add('dragging');
+});
+document.body.addEventListener('dragleave', () => document.body.classList.remove('dragging'));
+document.body.addEventListener('drop', (e) => {
+  e.preventDefault();
+  document.body.classList.remove('dragging');
+  const file = e.dataTransfer.files[0];
+  if (file) loadAvatar(URL.createObjectURL(file), file.name);
+});
+
+// ---- loop -----------------------------------------------------------------------------------
+const clock = new THREE.Clock();
+let rate = { count: 0, since: performance.now(), perSecond: 0 };
+
+function hudText() {
+  const lines = [];
+  if (state.avatar === 'none')
+    lines.push('No avatar: drop a .vrm file on this page, or run\n' +
+               'avatarmap view --avatar FILE.vrm --connect PORT');
+  else lines.push(`avatar ${state.avatarName} (${state.avatar})`);
+  if (state.mode === 'clip' && state.clipTime !== null)
+    lines.push(`clip ${state.clipName}: ${state.clipTime.toFixed(1)} / ${state.clipDuration.toFixed(1)} s`);
+  lines.push(`poses: ${state.socketUrl} ${state.socket}` +
+             (state.mode === 'live' ? `, ${rate.perSecond.toFixed(0)}/s, t ${(state.lastPoseT ?? 0).toFixed(2)} s` : ''));
+  return lines.join('\n');
+}
+
+function frame() {
+  requestAnimationFrame(frame);
+  const delta = Math.min(clock.getDelta(), 0.1);
+  let posed = false;
+  if (vrm) {
+    if (newestMessage !== null) {
+      const text = newestMessage;
+      newestMessage = null;
+      try {
+        const pose = JSON.parse(text);
+        if (mixer) {
+          mixer.stopAllAction();
+          mixer = null;
+        }
+        state.mode = 'live';
+        applyPose(pose);
+        posed = true;
+        rate.count++;
+      } catch (e) {
+        state.badMessages++;
+      }
+    } else if (mixer) {
+      mixer.update(delta);
+      state.clipTime = clipAction.time;
+      posed = true;
+    }
+    vrm.update(delta);
+  }
+  controls.update();
+  renderer.render(scene, camera);
+  state.frames++;
+  if (posed && state.firstPosedMs === null) {
+    state.firstPosedMs = performance.now();
+    console.log(`avatarmap-viewer: first posed frame ${state.firstPosedMs.toFixed(0)} ms`);
+    report();
+  }
+  const now = performance.now();
+  if (now - rate.since >= 1000) {
+    rate.perSecond = (rate.count * 1000) / (now - rate.since);
+    rate = { count: 0, since: now, perSecond: rate.perSecond };
+  }
+  if (hudElement.style.display !== 'none' && state.frames % 10 === 0) {
+    hudElement.textContent = hudText();
+    if (state.error) {
+      const error = document.createElement('div');
+      error.className = 'error';
+      error.textContent = state.error;
+      hudElement.appendChild(error);
+    }
+  }
+}
+
+// ---- start ----------------------------------------------------------------------------------
+let config = {};
+try {
+  const response = await fetch('/config.json', { cache: 'no-store' });
+  config = await response.json();
+} catch (e) {
+  state.error = `could not read /config.json: ${e.message ?? e}`;
+}
+const scheme = location.protocol === 'https:' ? 'wss' : 'ws';
+connect(config.pose_socket || `${scheme}://${location.host}/pose`);
+requestAnimationFrame(frame);
+if (config.avatar) loadAvatar(config.avatar, config.avatar_name || 'avatar.vrm');
