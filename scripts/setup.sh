@@ -7,6 +7,7 @@ packages=(build-essential cmake ninja-build pkg-config
           libglm-dev libeigen3-dev nlohmann-json3-dev libtinygltf-dev
           libgtest-dev libgmock-dev libbenchmark-dev libstb-dev python3
           libavformat-dev libavcodec-dev libavutil-dev libswscale-dev
+          libavdevice-dev ffmpeg  # devices (v4l2:, lavfi:); the ffmpeg tool streams in tests
           python3-onnx python3-numpy  # python3-onnx: the tflite -> ONNX converter (tools/convert)
           liblo-tools)  # oscdump, oscsend: the independent OSC receiver of the VMC tests
 # The browser viewer (docs/viewer.md): its server library, and headless Chromium for its tests.

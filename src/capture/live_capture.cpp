@@ -154,6 +154,18 @@ status run_live(const frame_grabber& grab, const frame_consumer& consume,
     failure = std::current_exception();
   }
   stop.store(true);
+  bool source_ended = false;
+  {
+    std::lock_guard<std::mutex> lock(m);
+    source_ended = source_done;
+  }
+  if (!source_ended && options.wake_grabber) {
+    try {
+      options.wake_grabber();
+    } catch (...) {
+      if (!failure) failure = std::current_exception();
+    }
+  }
   grabber.join();
   if (failure) std::rethrow_exception(failure);
 

@@ -2,16 +2,23 @@
 #include "avatarmap/capture/video_source.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
+#include <mutex>
 #include <string>
 #include <system_error>
+#include <thread>
 #include <utility>
 #include <vector>
 
 #include "capture/frame_pattern.hpp"
+#include "capture/input_spec.hpp"
 
 #if AVATARMAP_HAVE_FFMPEG
 extern "C" {
@@ -23,8 +30,12 @@ extern "C" {
 #include <libavutil/imgutils.h>
 #include <libavutil/log.h>
 #include <libavutil/mem.h>
+#include <libavutil/opt.h>
 #include <libavutil/pixdesc.h>
 #include <libswscale/swscale.h>
+#if AVATARMAP_HAVE_AVDEVICE
+#include <libavdevice/avdevice.h>
+#endif
 }
 #endif
 
@@ -45,6 +56,29 @@ status check_options(const video_source_options& o) {
   if (o.max_size < 1 || o.max_size > 16384)
     return status::error("video_source: max_size is " + std::to_string(o.max_size) +
                          ", allowed 1..16384");
+  if (!o.video_size.empty()) {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(o.video_size.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' ||
+        w < 1 || h < 1 || w > 16384 || h > 16384)
+      return status::error("video_source: video_size is '" + o.video_size +
+                           "', wanted WIDTHxHEIGHT, each 1..16384 (e.g. 1280x720)");
+  }
+  if (!(o.framerate >= 0.0 && o.framerate <= 1000.0))
+    return status::error(
+        "video_source: framerate must be 0 (the device's default) or in "
+        "(0, 1000] frames per second");
+  if (o.input_format.size() > 32 ||
+      !std::all_of(o.input_format.begin(), o.input_format.end(),
+                   [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }))
+    return status::error("video_source: input_format is '" + o.input_format +
+                         "', wanted a pixel format or codec name (letters, digits, '_'; e.g. "
+                         "mjpeg, yuyv422)");
+  for (const double s : {o.open_timeout_seconds, o.stall_timeout_seconds})
+    if (!(s >= 0.1 && s <= 3600.0))
+      return status::error(
+          "video_source: open_timeout_seconds and stall_timeout_seconds must "
+          "be in 0.1..3600");
   return {};
 }
 
@@ -135,16 +169,111 @@ AVPixelFormat unjpeg(AVPixelFormat f, bool& out_full_range) {
 // a caller that goes on after every error must not loop forever on a hopeless file.
 constexpr int k_max_consecutive_errors = 64;
 
+using steady = std::chrono::steady_clock;
+
+// Network protocols a URL may use, also for what a stream opens in turn (RTSP's RTP over UDP
+// or TCP, HTTPS's TLS, an HLS playlist's segments and keys): FFmpeg's protocol_whitelist.
+// Local ones (file, pipe, fd, concat, subfile, data, unix, cache) are never in it, so that
+// what a stream says cannot make avatarmap read a local file.
+constexpr const char* k_network_protocols[] = {
+    "udp",     "udplite", "rtp",    "srtp",      "tcp",         "tls",       "http",
+    "https",   "srt",     "rist",   "rtmp",      "rtmpe",       "rtmps",     "rtmpt",
+    "rtmpte",  "rtmpts",  "mmsh",   "mmst",      "ftp",         "sftp",      "gopher",
+    "gophers", "sctp",    "crypto", "httpproxy", "ffrtmpcrypt", "ffrtmphttp"};
+// Of those, helpers that a stream uses and a user does not write as a scheme.
+constexpr const char* k_helper_protocols[] = {"crypto", "httpproxy", "ffrtmpcrypt", "ffrtmphttp"};
+
+// Quick start of URLs: probing measures no frame rate from frames (FFmpeg's default reads
+// 20 frames for it, unless the stream states its rate: 4 s at 5 fps). Probing still reads
+// until it has seen the codec's parameters (a key frame), up to FFmpeg's default 5 MB / 5 s,
+// which a stream joined between key frames needs. What probing read is still delivered (no
+// fflags nobuffer): `capture` loses nothing, and the live loop drops what is stale (it keeps
+// only the newest frame).
+constexpr const char* k_stream_fpsprobesize = "0";  // frames
+// A device opened non-blocking (so that a stalled one cannot hang next()) is polled this
+// often while it has no frame.
+constexpr std::chrono::milliseconds k_device_poll{1};
+
+void register_devices() {
+#if AVATARMAP_HAVE_AVDEVICE
+  static std::once_flag once;
+  std::call_once(once, [] { avdevice_register_all(); });
+#endif
+}
+
+bool in_list(const std::string& name, const char* const* begin, const char* const* end) {
+  return std::any_of(begin, end, [&](const char* p) { return name == p; });
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string r;
+  for (const std::string& s : v) r += (r.empty() ? "" : ", ") + s;
+  return r.empty() ? "none" : r;
+}
+
+std::string seconds_text(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", s);
+  return buf;
+}
+
+// The camera nodes /dev/video* present now, for a message.
+std::string present_cameras() {
+  std::vector<std::string> r;
+  std::error_code ec;
+  for (fs::directory_iterator it("/dev", ec), end; !ec && it != end; it.increment(ec))
+    if (it->path().filename().string().rfind("video", 0) == 0) r.push_back(it->path().string());
+  std::sort(r.begin(), r.end());
+  return r.empty() ? "none" : join(r);
+}
+
 }  // namespace
+
+video_source_inputs video_source_supported_inputs() {
+  video_source_inputs r;
+#if AVATARMAP_HAVE_AVDEVICE
+  register_devices();
+  for (const AVInputFormat* f = nullptr; (f = av_input_video_device_next(f)) != nullptr;) {
+    const std::string names = f->name;  // "video4linux2,v4l2": one format, two names
+    for (std::size_t b = 0; b <= names.size();) {
+      std::size_t e = names.find(',', b);
+      if (e == std::string::npos) e = names.size();
+      if (e > b) r.devices.push_back(names.substr(b, e - b));
+      b = e + 1;
+    }
+  }
+#endif
+  void* opaque = nullptr;
+  bool has_tls = false;
+  while (const char* name = avio_enum_protocols(&opaque, 0)) {
+    const std::string n = name;
+    has_tls = has_tls || n == "tls";
+    if (in_list(n, std::begin(k_network_protocols), std::end(k_network_protocols)) &&
+        !in_list(n, std::begin(k_helper_protocols), std::end(k_helper_protocols)))
+      r.url_schemes.push_back(n);
+  }
+  if (av_find_input_format("rtsp")) {  // a demuxer, not a protocol: it opens RTP, UDP, TCP
+    r.url_schemes.push_back("rtsp");
+    if (has_tls) r.url_schemes.push_back("rtsps");
+  }
+  for (auto* v : {&r.devices, &r.url_schemes}) {
+    std::sort(v->begin(), v->end());
+    v->erase(std::unique(v->begin(), v->end()), v->end());
+  }
+  return r;
+}
 
 struct video_source::impl {
   video_source_options options;
   video_info info;
   std::string path;
   std::string error;
+  std::string end_reason;
   bool open = false;
+  bool live = false;  // a device or a URL: deadlines apply, the end is explained
 
-  // The file being decoded (the whole video, or one image of a sequence).
+  // The file being decoded (the whole video, or one image of a sequence); for a device or
+  // URL, the input as given (messages name it).
   std::string file;
   AVFormatContext* fmt = nullptr;
   AVCodecContext* dec = nullptr;
@@ -156,6 +285,12 @@ struct video_source::impl {
   std::string deferred_error;  // a read error, reported once the decoder is drained
   int consecutive_errors = 0;
   std::int64_t frames_out = 0;  // frames returned so far (all files)
+
+  // FFmpeg's interrupt callback: blocking reads (network waits, device probing) return
+  // AVERROR_EXIT once interrupt() was called or the deadline (steady clock, ns) has passed.
+  std::atomic<bool> abort{false};
+  std::atomic<std::int64_t> deadline{std::numeric_limits<std::int64_t>::max()};
+  std::atomic<bool> deadline_hit{false};
 
   // Image sequences.
   std::vector<std::string> files;
@@ -187,34 +322,213 @@ struct video_source::impl {
     deferred_error.clear();
   }
 
-  // Opens `name` (a file, or a device when `device_format` is given) and its decoder; on
-  // success fills the parts of `info` that come from the stream.
-  status open_file(const std::string& name, const AVInputFormat* device_format,
-                   video_info& out_info) {
+  void set_deadline(double seconds) {
+    deadline_hit = false;
+    deadline = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                   steady::now().time_since_epoch() + std::chrono::duration<double>(seconds))
+                   .count();
+  }
+  void clear_deadline() {
+    deadline_hit = false;
+    deadline = std::numeric_limits<std::int64_t>::max();
+  }
+  // True once interrupt() was called or the deadline passed (then deadline_hit is set).
+  bool should_stop() {
+    if (abort.load(std::memory_order_relaxed)) return true;
+    const std::int64_t d = deadline.load(std::memory_order_relaxed);
+    if (d == std::numeric_limits<std::int64_t>::max()) return false;
+    const std::int64_t now =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(steady::now().time_since_epoch())
+            .count();
+    if (now < d) return false;
+    deadline_hit = true;
+    return true;
+  }
+  static int interrupt_callback(void* opaque) {
+    return static_cast<impl*>(opaque)->should_stop() ? 1 : 0;
+  }
+
+  // Opens `url` with the demuxer `format` (nullptr: probed) and the options `opts` (freed
+  // here) into `fmt`, with the interrupt callback; returns 0 or FFmpeg's error code.
+  int open_input(const std::string& url, const AVInputFormat* format, AVDictionary*& opts,
+                 bool nonblock) {
     close_file();
+    fmt = avformat_alloc_context();
+    if (!fmt) {
+      av_dict_free(&opts);
+      return AVERROR(ENOMEM);
+    }
+    fmt->interrupt_callback.callback = &impl::interrupt_callback;
+    fmt->interrupt_callback.opaque = this;
+    if (nonblock) fmt->flags |= AVFMT_FLAG_NONBLOCK;
+    const int err = avformat_open_input(&fmt, url.c_str(), format, &opts);
+    av_dict_free(&opts);
+    if (err < 0) fmt = nullptr;  // freed by avformat_open_input
+    return err;
+  }
+
+  // Opens the file `name` and its decoder; on success fills the parts of `out_info` that
+  // come from the stream.
+  status open_file(const std::string& name, video_info& out_info) {
     file = name;
     AVDictionary* fmt_options = nullptr;
-    std::string url = name;
-    if (!device_format) {
-      // A file name is a file name: never a protocol ("concat:", "http:" ...), also not
-      // for what the file refers to (playlists), and never a pattern (image2 reads '%').
-      url = "file:" + name;
-      av_dict_set(&fmt_options, "protocol_whitelist", "file", 0);
-      av_dict_set(&fmt_options, "pattern_type", "none", 0);
-    }
-    int err = avformat_open_input(&fmt, url.c_str(), device_format, &fmt_options);
-    av_dict_free(&fmt_options);
-    if (err < 0) {
-      fmt = nullptr;
-      if (device_format)
-        return status::error(name + ": cannot open the camera (" + av_error_text(err) + ")");
+    // A file name is a file name: never a protocol ("concat:", "http:" ...), also not for
+    // what the file refers to (playlists), and never a pattern (image2 reads '%').
+    av_dict_set(&fmt_options, "protocol_whitelist", "file", 0);
+    av_dict_set(&fmt_options, "pattern_type", "none", 0);
+    const int err = open_input("file:" + name, nullptr, fmt_options, false);
+    if (err < 0)
       return status::error(name + ": cannot be read as media (" + av_error_text(err) +
                            "): not a media file, or a truncated or corrupt one");
+    return open_decoder(out_info, false);
+  }
+
+  // Opens the device FORMAT:DEVICE of `spec` with the options' size, rate and format.
+  status open_device(const input_spec& spec) {
+    file = path;
+#if AVATARMAP_HAVE_AVDEVICE
+    constexpr bool have_devices = true;
+#else
+    constexpr bool have_devices = false;
+#endif
+    if (!have_devices)
+      return status::error(path + ": no such file, and input devices (" + spec.name +
+                           ":DEVICE) are not available: avatarmap was built without "
+                           "libavdevice (install libavdevice-dev and rebuild)");
+    const video_source_inputs inputs = video_source_supported_inputs();
+    if (std::find(inputs.devices.begin(), inputs.devices.end(), spec.name) == inputs.devices.end())
+      return status::error(path + ": no such file, and '" + spec.name +
+                           "' is not a video input device of this FFmpeg (devices: " +
+                           join(inputs.devices) + "; URLs are written SCHEME://...)");
+    const AVInputFormat* device = av_find_input_format(spec.name.c_str());
+    if (!device) return status::error(path + ": the device '" + spec.name + "' is not available");
+    // What the device accepts is in its private options.
+    auto takes = [&](const char* option) {
+      const AVClass* cls = device->priv_class;
+      return cls && av_opt_find(&cls, option, nullptr, 0, AV_OPT_SEARCH_FAKE_OBJ) != nullptr;
+    };
+    AVDictionary* opts = nullptr;
+    struct wanted {
+      const char* flag;
+      const char* option;
+      std::string value;
+    };
+    const char* format_option = takes("input_format") ? "input_format" : "pixel_format";
+    const wanted asked[] = {
+        {"video size (--video-size)", "video_size", options.video_size},
+        {"frame rate (--framerate)", "framerate",
+         options.framerate > 0 ? seconds_text(options.framerate) : std::string()},
+        {"input format (--input-format)", format_option, options.input_format}};
+    for (const wanted& w : asked) {
+      if (w.value.empty()) continue;
+      if (!takes(w.option)) {
+        av_dict_free(&opts);
+        return status::error(path + ": the device '" + spec.name + "' takes no " + w.flag +
+                             (spec.name == "lavfi" ? " (give it in the filter graph, e.g. "
+                                                     "lavfi:testsrc=size=640x480:rate=30)"
+                                                   : ""));
+      }
+      av_dict_set(&opts, w.option, w.value.c_str(), 0);
     }
+    set_deadline(options.open_timeout_seconds);
+    const int err = open_input(spec.target, device, opts, true);
+    if (err < 0) {
+      std::string m = path + ": cannot open the device (" + av_error_text(err) + ")";
+      if (deadline_hit)
+        m = path + ": nothing came from the device within " +
+            seconds_text(options.open_timeout_seconds) +
+            " s (--open-seconds); check that it is connected and delivering";
+      else if (err == AVERROR(ENOENT) && (spec.name == "v4l2" || spec.name == "video4linux2"))
+        m += ": no camera at " + spec.target + " (cameras here: " + present_cameras() +
+             "); check the cable and the name";
+      else if (err == AVERROR(EACCES) || err == AVERROR(EPERM))
+        m += ": this user may not read it (on Linux: add the user to the 'video' group)";
+      else if (err == AVERROR(EBUSY))
+        m += ": another program is using it";
+      else if (err == AVERROR(EINVAL) && !(options.video_size.empty() && options.framerate == 0 &&
+                                           options.input_format.empty()))
+        m += ": check that the device supports the size, rate and format asked";
+      else
+        m += ": check the device name, that it is connected, and that no other program "
+             "holds it";
+      return status::error(m);
+    }
+    const status st = open_decoder(info, true);
+    clear_deadline();
+    if (!st) return st;
+    info.kind = video_source_kind::camera;
+    return {};
+  }
+
+  // Opens the URL of `spec`: its scheme must be one of this build's network protocols.
+  status open_url(const input_spec& spec) {
+    file = path;
+    const video_source_inputs inputs = video_source_supported_inputs();
+    if (std::find(inputs.url_schemes.begin(), inputs.url_schemes.end(), spec.name) ==
+        inputs.url_schemes.end())
+      return status::error(path + ": unknown URL scheme '" + spec.name + "': this build reads " +
+                           join(inputs.url_schemes) +
+                           " (and files, folders, patterns, devices FORMAT:DEVICE)");
+    std::string whitelist;
+    for (const char* p : k_network_protocols)
+      whitelist += (whitelist.empty() ? "" : ",") + std::string(p);
+    const std::string stall_us =
+        std::to_string(static_cast<std::int64_t>((options.stall_timeout_seconds + 1.0) * 1e6));
+    AVDictionary* opts = nullptr;
+    av_dict_set(&opts, "protocol_whitelist", whitelist.c_str(), 0);
+    av_dict_set(&opts, "fpsprobesize", k_stream_fpsprobesize, 0);
+    // Protocols' own time-outs, a second after the interrupt callback's (which gives the
+    // clearer message): a read that waits longer fails.
+    av_dict_set(&opts, "rw_timeout", stall_us.c_str(), 0);
+    if (spec.name == "rtsp" || spec.name == "rtsps")
+      av_dict_set(&opts, "timeout", stall_us.c_str(), 0);  // RTSP's socket time-out
+    if (spec.name == "udp" || spec.name == "udplite") {
+      // A reader that falls behind loses packets instead of failing the stream.
+      av_dict_set(&opts, "overrun_nonfatal", "1", 0);
+    }
+    set_deadline(options.open_timeout_seconds);
+    const int err = open_input(spec.target, nullptr, opts, false);
+    if (err < 0) {
+      std::string m = path + ": cannot open the stream (" + av_error_text(err) + ")";
+      if (deadline_hit || err == AVERROR(ETIMEDOUT))
+        m = path + ": nothing came within " + seconds_text(options.open_timeout_seconds) +
+            " s (--open-seconds); check that the sender runs and sends to this address and "
+            "port";
+      else if (err == AVERROR(ECONNREFUSED))
+        m += ": no server at this address and port; check the URL and that the server runs";
+      else if (err == AVERROR_INVALIDDATA)
+        m += ": what came is not a stream FFmpeg can read";
+      else
+        m += ": check the URL, and that the stream runs and is reachable from here";
+      return status::error(m);
+    }
+    status st = open_decoder(info, false);
+    if (st && fmt->pb && (deadline_hit || fmt->pb->error == AVERROR(ETIMEDOUT))) {
+      // Probing waited for more than the stream sent (within the open time-out, or a read
+      // within rw_timeout) and stopped with what it had, which was enough. The reader took
+      // the time-out for an end: reading goes on from where it stopped.
+      fmt->pb->eof_reached = 0;
+      fmt->pb->error = 0;
+    }
+    clear_deadline();
+    if (!st) {
+      if (deadline_hit)
+        return status::error(path + ": no picture within " +
+                             seconds_text(options.open_timeout_seconds) +
+                             " s (--open-seconds): " + st.message());
+      return st;
+    }
+    info.kind = video_source_kind::stream;
+    return {};
+  }
+
+  // Reads the stream information of the open `fmt` and opens the decoder of its video.
+  status open_decoder(video_info& out_info, bool device) {
+    const std::string& name = file;
     // Probing may decode a first picture; FFmpeg refuses pictures over about 16250x16250
     // itself (av_image_check_size), so the allocation is bounded as with max_size's limit.
     // max_pixels is not given here: the size must come out to be reported against max_size.
-    err = avformat_find_stream_info(fmt, nullptr);
+    int err = avformat_find_stream_info(fmt, nullptr);
     if (err < 0)
       return status::error(name + ": cannot read the stream information (" + av_error_text(err) +
                            ")");
@@ -264,9 +578,9 @@ struct video_source::impl {
 
     const char* demuxer = fmt->iformat->name;
     const bool still =
-        std::strcmp(demuxer, "image2") == 0 || std::strstr(demuxer, "_pipe") != nullptr;
-    out_info.kind = device_format ? video_source_kind::camera
-                                  : (still ? video_source_kind::image : video_source_kind::video);
+        !live && (std::strcmp(demuxer, "image2") == 0 || std::strstr(demuxer, "_pipe") != nullptr);
+    out_info.kind = device ? video_source_kind::camera
+                           : (still ? video_source_kind::image : video_source_kind::video);
     out_info.width = par->width;
     out_info.height = par->height;
     out_info.codec = avcodec_get_name(par->codec_id);
@@ -405,8 +719,14 @@ struct video_source::impl {
         continue;
       }
       err = av_read_frame(fmt, packet);
+      if (err == AVERROR(EAGAIN) && !should_stop()) {  // a non-blocking device, no frame yet
+        std::this_thread::sleep_for(k_device_poll);
+        continue;
+      }
       if (err < 0) {
-        if (err != AVERROR_EOF && !(fmt->pb && avio_feof(fmt->pb)))
+        if (live)
+          explain_end(err);
+        else if (err != AVERROR_EOF && !(fmt->pb && avio_feof(fmt->pb)))
           deferred_error = file + ": read error after frame " + std::to_string(frames_out) + " (" +
                            av_error_text(err) + "): truncated or corrupt data";
         avcodec_send_packet(dec, nullptr);
@@ -415,6 +735,11 @@ struct video_source::impl {
       }
       if (packet->stream_index != stream) {
         av_packet_unref(packet);
+        if (live && should_stop()) {  // other streams' data, but no picture in time
+          explain_end(AVERROR_EXIT);
+          avcodec_send_packet(dec, nullptr);
+          eof_sent = true;
+        }
         continue;
       }
       const std::int64_t packet_pts = packet->pts;
@@ -428,6 +753,32 @@ struct video_source::impl {
         return fail(file + ": decode error " + where + " (" + av_error_text(err) + ")");
       }
     }
+  }
+
+  // Why a live input stopped giving packets (`err` from av_read_frame), into end_reason.
+  void explain_end(int err) {
+    if (abort.load()) {
+      end_reason.clear();  // the caller asked for it
+      return;
+    }
+    const bool camera = info.kind == video_source_kind::camera;
+    // A demuxer may turn its reader's failure into end of file: the reader keeps the cause
+    // (sticky: a frame decoded since may have cleared deadline_hit). AVERROR_EXIT comes only
+    // from the interrupt callback, and not from interrupt() here: the deadline.
+    const int io_error = fmt->pb ? fmt->pb->error : 0;
+    if (deadline_hit || err == AVERROR(ETIMEDOUT) || err == AVERROR_EXIT ||
+        io_error == AVERROR(ETIMEDOUT) || io_error == AVERROR_EXIT)
+      end_reason = "no frame from " + file + " for " + seconds_text(options.stall_timeout_seconds) +
+                   (camera ? " s: the device stalled or was disconnected"
+                           : " s: the stream stalled or ended");
+    else if ((err == AVERROR_EOF || (fmt->pb && avio_feof(fmt->pb))) && io_error == 0)
+      end_reason = file + (camera ? ": the device ended" : ": the stream ended");
+    else
+      end_reason =
+          file +
+          (camera ? ": the device failed or was disconnected" : ": the stream ended or broke off") +
+          " (read error after frame " + std::to_string(frames_out) + ": " +
+          av_error_text(io_error != 0 ? io_error : err) + ")";
   }
 
   read_result next_in_sequence(image_view& out, double& out_t) {
@@ -450,7 +801,7 @@ struct video_source::impl {
       if (next_file >= files.size()) return read_result::end;
       const std::string name = files[next_file++];
       video_info file_info;
-      status st = open_file(name, nullptr, file_info);
+      status st = open_file(name, file_info);
       if (!st) {
         close_file();
         return fail(st.message());
@@ -471,6 +822,13 @@ void video_source_quiet_log(bool quiet) { av_log_set_level(quiet ? AV_LOG_QUIET 
 status video_source::open(const std::string& path, const video_source_options& options) {
   close();
   if (status st = check_options(options); !st) return st;
+  std::error_code ec;
+  const input_spec spec = classify_input(path, fs::exists(path, ec));
+  if (spec.kind != input_kind::device &&
+      (!options.video_size.empty() || options.framerate > 0 || !options.input_format.empty()))
+    return status::error(path +
+                         ": a video size, frame rate or input format is for devices "
+                         "(FORMAT:DEVICE, e.g. v4l2:/dev/video0), not for files or URLs");
   auto p = std::make_unique<impl>();
   p->options = options;
   p->path = path;
@@ -478,44 +836,35 @@ status video_source::open(const std::string& path, const video_source_options& o
   p->frame = av_frame_alloc();
   if (!p->packet || !p->frame) return status::error(path + ": out of memory");
 
-  // A camera: FORMAT:DEVICE where FORMAT is an input device FFmpeg knows.
-  const std::size_t colon = path.find(':');
-  if (colon != std::string::npos && colon > 1 && path.compare(0, 5, "file:") != 0) {
-    const std::string format = path.substr(0, colon);
-    std::error_code ec;
-    if (!fs::exists(path, ec) && (format == "v4l2" || format == "video4linux2" ||
-                                  format == "avfoundation" || format == "dshow")) {
-      const AVInputFormat* device = av_find_input_format(format.c_str());
-      if (!device)
-        return status::error(path + ": camera input '" + format +
-                             "' is not available: avatarmap is built without libavdevice");
-      if (status st = p->open_file(path.substr(colon + 1), device, p->info); !st) return st;
-      p->open = true;
-      impl_ = std::move(p);
-      return {};
-    }
+  if (spec.kind == input_kind::device || spec.kind == input_kind::url) {
+    p->live = true;
+    register_devices();
+    if (status st = spec.kind == input_kind::device ? p->open_device(spec) : p->open_url(spec); !st)
+      return st;
+    p->open = true;
+    impl_ = std::move(p);
+    return {};
   }
 
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) {
-    p->files = folder_images(path);
+  const std::string& file = spec.target;  // "file:" removed
+  if (fs::is_directory(file, ec)) {
+    p->files = folder_images(file);
     if (p->files.empty())
       return status::error(path +
                            ": the folder has no image files (jpg, png, bmp, tif, webp, "
                            "ppm)");
-  } else if (fs::exists(path, ec)) {
-    if (!fs::is_regular_file(path, ec)) return status::error(path + ": not a regular file");
-    if (fs::file_size(path, ec) == 0) return status::error(path + ": empty file");
-    if (status st = p->open_file(path, nullptr, p->info); !st) return st;
+  } else if (fs::exists(file, ec)) {
+    if (!fs::is_regular_file(file, ec)) return status::error(path + ": not a regular file");
+    if (fs::file_size(file, ec) == 0) return status::error(path + ": empty file");
+    if (status st = p->open_file(file, p->info); !st) return st;
     p->open = true;
     impl_ = std::move(p);
     return {};
   } else {
     std::string prefix, suffix;
     int width = 0;
-    if (path.find('%') == std::string::npos)
-      return status::error(path + ": no such file or folder");
-    if (!parse_frame_pattern(path, prefix, suffix, width))
+    if (spec.kind != input_kind::pattern) return status::error(path + ": no such file or folder");
+    if (!parse_frame_pattern(file, prefix, suffix, width))
       return status::error(path + ": not a file, and not a pattern with one %d or %0Nd");
     p->files = pattern_images(prefix, suffix, width);
     if (p->files.empty())
@@ -525,7 +874,7 @@ status video_source::open(const std::string& path, const video_source_options& o
 
   // A sequence: the first image gives the size and codec.
   video_info first;
-  if (status st = p->open_file(p->files.front(), nullptr, first); !st) return st;
+  if (status st = p->open_file(p->files.front(), first); !st) return st;
   p->close_file();
   p->info.kind = video_source_kind::sequence;
   p->info.width = first.width;
@@ -545,7 +894,9 @@ read_result video_source::next(image_view& out, double& out_t) {
   s.error.clear();
   if (s.info.kind == video_source_kind::sequence) return s.next_in_sequence(out, out_t);
   if (!s.fmt) return read_result::end;
+  if (s.live) s.set_deadline(s.options.stall_timeout_seconds);
   const read_result r = s.decode(out, out_t);
+  if (s.live) s.clear_deadline();
   if (r == read_result::frame && s.info.kind == video_source_kind::image) {
     // A still image is one frame: of a file of concatenated images, the first.
     out_t = 0.0;
@@ -565,7 +916,16 @@ const std::string& video_source::error() const {
   return impl_ ? impl_->error : k_empty;
 }
 
+const std::string& video_source::end_reason() const {
+  static const std::string k_empty;
+  return impl_ ? impl_->end_reason : k_empty;
+}
+
 bool video_source::is_open() const { return impl_ && impl_->open; }
+
+void video_source::interrupt() {
+  if (impl_) impl_->abort.store(true);
+}
 
 void video_source::close() { impl_.reset(); }
 
@@ -606,9 +966,18 @@ const std::string& video_source::error() const {
   return k_empty;
 }
 
+const std::string& video_source::end_reason() const {
+  static const std::string k_empty;
+  return k_empty;
+}
+
 bool video_source::is_open() const { return false; }
 
+void video_source::interrupt() {}
+
 void video_source::close() { impl_.reset(); }
+
+video_source_inputs video_source_supported_inputs() { return {}; }
 
 #endif  // AVATARMAP_HAVE_FFMPEG
 

@@ -1,5 +1,6 @@
-// `avatarmap capture INPUT -o OUT.landmarks.jsonl`: video, image or image sequence in,
-// landmarks out, through the ONNX backend (body, hands, face), with an optional overlay.
+// `avatarmap capture INPUT -o OUT.landmarks.jsonl`: video, image, image sequence, device or
+// network stream in, landmarks out, through the ONNX backend (body, hands, face), with an
+// optional overlay.
 #include <unistd.h>
 
 #include <chrono>
@@ -25,22 +26,26 @@ namespace {
 const char* k_capture_help =
     "Usage: avatarmap capture INPUT -o OUT.landmarks.jsonl [options]\n"
     "\n"
-    "Estimates landmarks on every frame of INPUT (a video file, an image, a folder of images\n"
-    "or a printf pattern like frames/%05d.png) with MediaPipe's models run by ONNX Runtime,\n"
-    "and writes them as *.landmarks.jsonl (docs/file-formats.md): the body (33 points, image\n"
-    "+ world) and, when asked, both hands and the face mesh. Video is tracked (detectors run\n"
-    "only when a part is lost) and smoothed as MediaPipe does; --static treats every frame\n"
-    "on its own.\n"
+    "Estimates landmarks on every frame of INPUT (a video file, an image, a folder of images,\n"
+    "a printf pattern like frames/%05d.png, a device or a network stream: see below) with\n"
+    "MediaPipe's models run by ONNX Runtime, and writes them as *.landmarks.jsonl\n"
+    "(docs/file-formats.md): the body (33 points, image + world) and, when asked, both hands\n"
+    "and the face mesh. Video is tracked (detectors run only when a part is lost) and\n"
+    "smoothed as MediaPipe does; --static treats every frame on its own. A device or stream\n"
+    "is read until it ends, stalls (--stall-seconds) or --seconds have passed; what was\n"
+    "captured is written.\n"
     "\n"
     "Options:\n"
     "  -o, --output PATH     where to write the landmarks (required; written atomically)\n"
     "  --overlay PATH        also draw the landmarks on the frames: PATH.mp4/.mkv/.avi writes\n"
     "                        a video, PATH.png one image (the first frame) and a pattern like\n"
     "                        overlay_%05d.png one image per frame\n"
-    "  --loop N              run over INPUT N times (times keep increasing; for soak tests)\n"
+    "  --loop N              run over INPUT N times (times keep increasing; for soak tests;\n"
+    "                        files only)\n"
+    "  --seconds S           stop after S seconds of input (frame times)\n"
     "  --progress / --quiet  force / silence the progress line (default: on a terminal)\n"
-    "\n"
-    "Estimator options:\n";
+    "\n";
+const char* k_capture_estimator_help = "Estimator options:\n";
 
 }  // namespace
 
@@ -48,20 +53,24 @@ int run_capture(int argc, char** argv) {
   args a(argc, argv, 2);
   if (a.flag("--help") || a.flag("-h")) {
     std::fputs(k_capture_help, stdout);
+    std::fputs(k_input_options_help, stdout);
+    std::fputs(k_capture_estimator_help, stdout);
     std::fputs(k_estimator_options_help, stdout);
     return 0;
   }
   std::string out_path, overlay_path, error;
   a.value("--output", out_path, "-o");
   a.value("--overlay", overlay_path);
-  double loops = 1;
+  double loops = 1, seconds = 0;
   a.number("--loop", loops);
+  a.number("--seconds", seconds);
   bool progress = isatty(STDERR_FILENO);
   if (a.flag("--progress")) progress = true;
   const bool quiet = a.flag("--quiet");
   if (quiet) progress = false;
   estimator_options ec;
-  if (!parse_estimator_options(a, false, ec, error)) {
+  video_source_options vo;
+  if (!parse_estimator_options(a, false, ec, error) || !parse_input_options(a, vo, error)) {
     std::fprintf(stderr, "avatarmap capture: %s\n", error.c_str());
     return 2;
   }
@@ -76,14 +85,24 @@ int run_capture(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap capture: --loop wants a whole number >= 1\n");
     return 2;
   }
+  if (!(seconds >= 0)) {
+    std::fprintf(stderr, "avatarmap capture: --seconds must be >= 0\n");
+    return 2;
+  }
   const std::string input = a.rest()[0];
 
   video_source source;
   video_source_quiet_log(true);
-  status st = source.open(input);
+  status st = source.open(input, vo);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
     return 1;
+  }
+  const bool live_input = source.info().kind == video_source_kind::camera ||
+                          source.info().kind == video_source_kind::stream;
+  if (live_input && loops > 1) {
+    std::fprintf(stderr, "avatarmap capture: --loop is for files, not devices or streams\n");
+    return 2;
   }
   std::unique_ptr<estimator> est;
   st = make_estimator(ec, est);
@@ -132,13 +151,17 @@ int run_capture(int argc, char** argv) {
       d.kind = source.next(v, t);
       if (d.kind == read_result::end && ++pass < passes) {
         t_offset = t_last + (info.fps > 0 ? 1.0 / info.fps : 1.0 / 30.0);
-        const status o = source.open(input);
+        const status o = source.open(input, vo);
         if (o.ok()) continue;
         d.kind = read_result::error;
         d.error = o.message();
         return false;
       }
       if (d.kind == read_result::end) return false;
+      if (d.kind == read_result::frame && seconds > 0 && t + t_offset >= seconds) {
+        d.kind = read_result::end;
+        return false;
+      }
       if (d.kind == read_result::error) {
         d.error = source.error();
         return true;
@@ -212,6 +235,8 @@ int run_capture(int argc, char** argv) {
       }
     }
   }
+  if (!source.end_reason().empty())  // a device or stream that stalled or ended
+    std::fprintf(stderr, "%scapture: %s\n", progress ? "\n" : "", source.end_reason().c_str());
   st = writer.commit();
   if (st.ok() && overlay.is_open()) st = overlay.close();
   if (!st.ok()) {

@@ -19,6 +19,42 @@ const char* const k_estimator_options_help =
     "                        scripts/prepare_capture.sh fills)\n"
     "  --static              detect on every frame (images unrelated to each other)\n";
 
+const char* const k_input_options_help =
+    "INPUT is a video file, an image, a folder of images, a printf pattern\n"
+    "(frames/%05d.png), a device FORMAT:DEVICE (v4l2:/dev/video0, x11grab::0.0, a test\n"
+    "pattern lavfi:testsrc=size=640x480:rate=30) or a URL (udp://127.0.0.1:5000,\n"
+    "rtp://, rtsp://HOST/PATH, srt://, http(s)://, tcp://, ...); an unknown scheme or device\n"
+    "is refused with the list this build has (docs/live.md).\n"
+    "\n"
+    "Input options:\n"
+    "  --video-size WxH      devices: frame size to ask for (e.g. 1280x720)\n"
+    "  --framerate N         devices: frame rate to ask for\n"
+    "  --input-format NAME   devices: pixel format or codec to ask for (v4l2: mjpeg, yuyv422)\n"
+    "  --open-seconds S      devices and URLs: give up when no picture came within S s of\n"
+    "                        opening (default 10)\n"
+    "  --stall-seconds S     devices and URLs: stop when no frame came for S s (default 5):\n"
+    "                        \"no frame from INPUT for S s: the stream stalled or ended\"\n"
+    "\n";
+
+bool parse_input_options(args& a, video_source_options& out, std::string& error) {
+  a.value("--video-size", out.video_size);
+  a.value("--input-format", out.input_format);
+  a.number("--framerate", out.framerate);
+  a.number("--open-seconds", out.open_timeout_seconds);
+  a.number("--stall-seconds", out.stall_timeout_seconds);
+  int w = 0, h = 0;
+  if (!a.error().empty())
+    error = a.error();
+  else if (!out.video_size.empty() && !parse_image_size(out.video_size, w, h))
+    error = "--video-size wants WIDTHxHEIGHT (e.g. 1280x720), got '" + out.video_size + "'";
+  else if (!(out.framerate >= 0 && out.framerate <= 1000))
+    error = "--framerate must be in (0, 1000] frames per second";
+  else if (!(out.open_timeout_seconds >= 0.1 && out.open_timeout_seconds <= 3600) ||
+           !(out.stall_timeout_seconds >= 0.1 && out.stall_timeout_seconds <= 3600))
+    error = "--open-seconds and --stall-seconds must be in 0.1..3600";
+  return error.empty();
+}
+
 namespace {
 
 std::string default_models_dir() {

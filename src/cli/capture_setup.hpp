@@ -7,6 +7,7 @@
 #include <string>
 
 #include "avatarmap/capture/estimator.hpp"
+#include "avatarmap/capture/video_source.hpp"
 #include "cli/cli_args.hpp"
 
 namespace avatarmap::cli {
@@ -19,6 +20,14 @@ extern const char* const k_estimator_options_help;
 /// false with a message for a bad value.
 bool parse_estimator_options(args& a, bool hands_face_default, estimator_options& out,
                              std::string& error);
+
+/// The input options' help lines: what INPUT may be, and the device and live-input options.
+extern const char* const k_input_options_help;
+
+/// Reads --video-size, --framerate, --input-format, --open-seconds and --stall-seconds into
+/// `out` (checked by video_source::open). False with a message for a value that is not a
+/// number.
+bool parse_input_options(args& a, video_source_options& out, std::string& error);
 
 /// Creates the ONNX estimator; the error says how to get the models.
 status make_estimator(const estimator_options& options, std::unique_ptr<estimator>& out);

@@ -1,5 +1,6 @@
-// `avatarmap live INPUT`: the latest-frame live loop (capture/live_capture.hpp). A camera, or
-// a file paced to its time stamps as a camera would deliver it; frames the estimator cannot
+// `avatarmap live INPUT`: the latest-frame live loop (capture/live_capture.hpp). A camera, a
+// network stream, or a file paced to its time stamps as a camera would deliver it (devices and
+// URLs deliver at their own pace; docs/live.md); frames the estimator cannot
 // keep up with are dropped. Each processed frame is solved, filtered by the live filter
 // (pose_filter, unless --filter none) and pushed to the pose resampler; an output thread
 // samples it at --fps (a higher rate than capture) into OUT.pose.jsonl and, with --vmc, to a
@@ -33,8 +34,10 @@ namespace {
 const char* k_live_help =
     "Usage: avatarmap live INPUT [-o OUT.pose.jsonl] [options]\n"
     "\n"
-    "Runs the capture live: INPUT is a camera (v4l2:/dev/video0, where FFmpeg's devices are\n"
-    "built in) or a file, which is then delivered at its own frame rate as a camera would.\n"
+    "Runs the capture live: INPUT is a camera or other device (v4l2:/dev/video0), a network\n"
+    "stream (udp://127.0.0.1:5000, rtsp://, srt://, http://, ...) or a file, which is then\n"
+    "delivered at its own frame rate as a camera would. A device or stream that sends no frame\n"
+    "for --stall-seconds, or ends, stops the loop with a message; -o is still written.\n"
     "Only the newest frame is processed; frames that arrive while the estimator is busy are\n"
     "dropped and counted. Each result is solved into a proxy pose, filtered and handed to\n"
     "the resampler, and the output runs at --fps from it (slerp between captured frames,\n"
@@ -53,8 +56,8 @@ const char* k_live_help =
     "  --serve [HOST:]PORT   serve the browser viewer and stream the output poses to it\n"
     "                        (docs/viewer.md; host default 127.0.0.1, port 0 picks one)\n"
     "  --quiet               no progress line and no summary\n"
-    "\n"
-    "Estimator options (hands and face off unless asked):\n";
+    "\n";
+const char* k_live_estimator_help = "Estimator options (hands and face off unless asked):\n";
 
 }  // namespace
 
@@ -62,6 +65,8 @@ int run_live_command(int argc, char** argv) {
   args a(argc, argv, 2);
   if (a.flag("--help") || a.flag("-h")) {
     std::fputs(k_live_help, stdout);
+    std::fputs(k_input_options_help, stdout);
+    std::fputs(k_live_estimator_help, stdout);
     std::fputs(k_estimator_options_help, stdout);
     std::fputs("\nVMC protocol output (docs/vmc.md):\n", stdout);
     std::fputs(k_live_vmc_help, stdout);
@@ -82,7 +87,8 @@ int run_live_command(int argc, char** argv) {
   live_vmc vmc;
   if (const int rc = vmc.read_options(a)) return rc;
   estimator_options ec;
-  if (!parse_estimator_options(a, false, ec, error)) {
+  video_source_options vo;
+  if (!parse_estimator_options(a, false, ec, error) || !parse_input_options(a, vo, error)) {
     std::fprintf(stderr, "avatarmap live: %s\n", error.c_str());
     return 2;
   }
@@ -120,7 +126,7 @@ int run_live_command(int argc, char** argv) {
   if (const int rc = vmc.open()) return rc;
   video_source source;
   video_source_quiet_log(true);
-  status st = source.open(a.rest()[0]);
+  status st = source.open(a.rest()[0], vo);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap live: %s\n", st.message().c_str());
     return 1;
@@ -197,7 +203,13 @@ int run_live_command(int argc, char** argv) {
   long with_body = 0;
   auto last_progress = clock_type::now();
   live_options lo;
-  lo.pace_to_timestamps = !unpaced;
+  // Devices and live streams deliver at their own pace: pacing them would only add latency.
+  // A stream with a duration is a file on a server (HTTP, HLS on demand): paced like a file.
+  const video_source_kind kind = source.info().kind;
+  const bool live_input = kind == video_source_kind::camera ||
+                          (kind == video_source_kind::stream && source.info().duration <= 0);
+  lo.pace_to_timestamps = !unpaced && !live_input;
+  lo.wake_grabber = [&] { source.interrupt(); };
   lo.max_seconds = seconds;
   live_stats stats;
   status est_status;
@@ -237,6 +249,8 @@ int run_live_command(int argc, char** argv) {
                 lo, stats);
   done.store(true);
   output.join();
+  if (!source.end_reason().empty())  // a device or stream that stalled or ended
+    std::fprintf(stderr, "%slive: %s\n", progress ? "\n" : "", source.end_reason().c_str());
   if (st.ok()) st = est_status;
   if (st.ok()) st = write_status;
   if (st.ok() && writing) st = writer.commit();

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -103,6 +105,53 @@ TEST(live_capture, consumer_and_time_limit_stop_an_endless_source) {
           .ok());
   EXPECT_GE(s.processed, 1);
   EXPECT_LT(s.grabbed, 1000) << "paced at 100 fps, 0.2 s cannot publish 1000 frames";
+}
+
+// A grabber blocked in a read (a stalled stream) is woken by wake_grabber when the loop stops
+// for its own reasons; a source that ended is not woken.
+TEST(live_capture, wake_grabber_unblocks_a_blocked_source) {
+  std::mutex m;
+  std::condition_variable cv;
+  bool woken = false;
+  int wakes = 0;
+  int calls = 0;
+  std::vector<std::uint8_t> px(4 * 2 * 3);
+  // Frame 0 at once, then blocks until woken (an hour at most), then ends.
+  auto blocking = [&](image_view& out, double& t) {
+    if (calls++ == 0) {
+      out = {px.data(), 4, 2, 12, pixel_format::rgb8};
+      t = 0;
+      return read_result::frame;
+    }
+    std::unique_lock<std::mutex> lock(m);
+    cv.wait_for(lock, std::chrono::hours(1), [&] { return woken; });
+    return read_result::end;
+  };
+  live_options o;
+  o.pace_to_timestamps = false;
+  o.max_seconds = 0.2;
+  o.wake_grabber = [&] {
+    std::lock_guard<std::mutex> lock(m);
+    woken = true;
+    ++wakes;
+    cv.notify_all();
+  };
+  live_stats s;
+  ASSERT_TRUE(run_live(
+                  blocking, [](const image_view&, const live_frame_info&) { return true; }, o, s)
+                  .ok());
+  EXPECT_EQ(wakes, 1);
+  EXPECT_EQ(s.processed, 1);
+
+  numbered_source ending{3, 1000.0};
+  wakes = 0;
+  o.max_seconds = 0;
+  ASSERT_TRUE(
+      run_live(
+          std::ref(ending), [](const image_view&, const live_frame_info&) { return true; }, o, s)
+          .ok());
+  EXPECT_EQ(wakes, 0) << "the source ended by itself";
+  EXPECT_EQ(s.grabbed, 3);
 }
 
 TEST(live_capture, rejects_bad_options) {

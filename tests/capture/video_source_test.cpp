@@ -291,7 +291,7 @@ TEST(VideoSource, OpenErrorsNameThePath) {
   EXPECT_FALSE(src.is_open());
 }
 
-TEST(VideoSource, CameraWithoutAvdeviceSaysSo) {
+TEST(VideoSource, CameraThatCannotOpenIsNamed) {
   SKIP_WITHOUT_FFMPEG();
   video_source src;
   const status st = src.open("v4l2:/dev/video0");

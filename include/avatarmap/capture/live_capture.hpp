@@ -45,6 +45,11 @@ struct live_options {
   double max_seconds = 0.0;
   /// Latency samples kept for the percentiles (older ones are overwritten). >= 1.
   int latency_samples = 1 << 16;
+  /// Called once when the loop stops for another reason than the source's end (the
+  /// consumer, max_seconds), from the calling thread while the grabber may be inside the
+  /// grab function: it must make that call return soon (video_source::interrupt), else the
+  /// loop waits for the source's next frame or its own time-out. May be empty.
+  std::function<void()> wake_grabber;
 };
 
 struct live_stats {
@@ -59,7 +64,8 @@ struct live_stats {
   double latency_max_ms = 0.0;
 };
 
-/// Runs the loop until the source ends, the consumer returns false, or max_seconds pass.
+/// Runs the loop until the source ends, the consumer returns false, or max_seconds pass
+/// (then options.wake_grabber is called).
 /// The consumer runs on the calling thread. Errors: bad options (latency_samples < 1). A
 /// consumer that throws is not supported (the loop stops the grabber and rethrows).
 status run_live(const frame_grabber& grab, const frame_consumer& consume,
