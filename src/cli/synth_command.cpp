@@ -397,9 +397,9 @@ int run_demo(int argc, char** argv) {
               avatar.c_str(), glb.c_str(), written);
   const std::filesystem::path shown = std::filesystem::absolute(glb, ec);
   std::printf(
-      "watch it: open %s in a glTF viewer: Blender (File > Import > glTF 2.0, then play), or\n"
-      "  drag it into a browser viewer (the three.js editor, the Babylon.js sandbox)\n",
-      ec ? glb.c_str() : shown.c_str());
+      "watch it in the browser viewer: avatarmap view %s --avatar %s (then open the address it\n"
+      "  prints), or open %s in a glTF viewer (Blender: File > Import > glTF 2.0, then play)\n",
+      vrma.c_str(), avatar.c_str(), ec ? glb.c_str() : shown.c_str());
   return 0;
 }
 

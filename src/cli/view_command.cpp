@@ -4,14 +4,17 @@
 // by the page itself. --connect points the page at a `live --serve` server instead.
 #include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <thread>
 
+#include "avatarmap/avatar/builtin_avatar.hpp"
 #include "avatarmap/export/vrma.hpp"
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "avatarmap/stream/pose_file_player.hpp"
@@ -26,7 +29,7 @@ namespace avatarmap::cli {
 namespace {
 
 const char* k_view_help =
-    "Usage: avatarmap view [FILE] --avatar AVATAR.vrm [options]\n"
+    "Usage: avatarmap view [FILE] [--avatar AVATAR.vrm] [options]\n"
     "\n"
     "Serves the browser viewer: a page (three.js + three-vrm) that shows AVATAR.vrm posed by\n"
     "proxy poses sent over a WebSocket. Prints the page's URL on standard output; open it in a\n"
@@ -37,7 +40,8 @@ const char* k_view_help =
     "  no FILE           the avatar in its rest pose, or the poses of --connect\n"
     "\n"
     "Options:\n"
-    "  --avatar PATH         the VRM 0.x or 1.0 avatar to show (required for now)\n"
+    "  --avatar PATH         the VRM 0.x or 1.0 avatar to show (default: the built-in one,\n"
+    "                        as `avatarmap avatar` writes it)\n"
     "  --port P              port to serve on (default 8080; 0 picks a free one)\n"
     "  --host H              address to listen on (default 127.0.0.1: this machine only;\n"
     "                        0.0.0.0 shows the page, avatar and poses to the network)\n"
@@ -95,12 +99,6 @@ int run_view(int argc, char** argv) {
                  !a.error().empty() ? a.error().c_str() : "give at most one FILE (see --help)");
     return 2;
   }
-  if (avatar.empty()) {
-    std::fprintf(stderr,
-                 "avatarmap view: give the avatar to show with --avatar FILE.vrm (a VRM 0.x or "
-                 "1.0 model)\n");
-    return 2;
-  }
   if (!(port >= 0 && port <= 65535 && port == static_cast<int>(port)) || !(seconds >= 0)) {
     std::fprintf(stderr, "avatarmap view: --port must be an integer in 0..65535, --seconds >= 0\n");
     return 2;
@@ -134,6 +132,29 @@ int run_view(int argc, char** argv) {
     const bool v6 = live_host.find(':') != std::string::npos;
     o.pose_socket_url = "ws://" + (v6 ? "[" + live_host + "]" : live_host) + ":" +
                         std::to_string(live_port) + k_pose_socket_path;
+  }
+
+  // Without --avatar: the built-in avatar (`avatarmap avatar`), written to a temporary file that
+  // is removed when the viewer stops.
+  struct temporary_file {
+    std::string path;
+    ~temporary_file() {
+      if (!path.empty()) std::remove(path.c_str());
+    }
+  } builtin;
+  if (avatar.empty()) {
+    std::error_code ec;
+    const std::filesystem::path dir = std::filesystem::temp_directory_path(ec);
+    builtin.path = (ec ? std::filesystem::path(".") : dir).string() + "/avatarmap-view-" +
+                   std::to_string(static_cast<long>(getpid())) + ".vrm";
+    if (status st = write_builtin_avatar(builtin.path); !st) {
+      builtin.path.clear();
+      std::fprintf(stderr,
+                   "avatarmap view: the built-in avatar: %s (--avatar FILE.vrm shows another)\n",
+                   st.message().c_str());
+      return 1;
+    }
+    avatar = builtin.path;
   }
 
   // The avatar and the clip are checked by the project's own readers (docs/security.md) before
@@ -174,7 +195,8 @@ int run_view(int argc, char** argv) {
   std::printf("%s\n", server.url().c_str());
   std::fflush(stdout);
   if (!quiet) {
-    std::fprintf(stderr, "view: showing %s", avatar.c_str());
+    std::fprintf(stderr, "view: showing %s",
+                 builtin.path.empty() ? avatar.c_str() : "the built-in avatar");
     if (pose_file)
       std::fprintf(stderr, ", playing %s (%ld poses, %.1f s) in a loop", file.c_str(),
                    player.frames(), player.duration());

@@ -503,7 +503,8 @@ PY
       [ "$(head -c 4 "avatarmap-demo/$f" 2>/dev/null)" = glTF ] || fail "demo did not write avatarmap-demo/$f"
     done
     expect_in out.txt "the motion on it to avatarmap-demo/demo.glb (300 frames)"
-    expect_in out.txt "watch it: open $dir/avatarmap-demo/demo.glb"
+    expect_in out.txt "watch it in the browser viewer: avatarmap view avatarmap-demo/demo.vrma --avatar avatarmap-demo/avatar.vrm"
+    expect_in out.txt "open $dir/avatarmap-demo/demo.glb in a glTF viewer"
     run 0 inspect avatarmap-demo/demo.glb
     expect_in out.txt "declared: 55 of 55 bones"
     run 0 demo --keep "$dir/kept/new"

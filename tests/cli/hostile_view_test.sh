@@ -8,8 +8,6 @@ source "$(dirname "$0")/hostile_lib.sh"
 
 run ok view --help
 expect_in out.txt "--connect"
-run 2 view
-expect_in err.txt "--avatar FILE.vrm"
 run 2 view take.mp4 --avatar me.vrm
 expect_in err.txt "FILE must be a .pose.jsonl or a .vrma"
 printf '{"t":0}\n' >one.pose.jsonl
