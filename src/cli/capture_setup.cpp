@@ -105,13 +105,22 @@ bool parse_estimator_options(args& a, bool hands_face_default, estimator_options
   return true;
 }
 
+namespace {
+status with_models_hint(const status& st) {
+  if (st.ok()) return st;
+  return status::error(st.message() +
+                       " (scripts/prepare_capture.sh fetches and converts the "
+                       "models; --models DIR points elsewhere)");
+}
+}  // namespace
+
 status make_estimator(const estimator_options& options, std::unique_ptr<estimator>& out) {
-  status st = create_estimator("onnx", options, out);
-  if (!st.ok())
-    return status::error(st.message() +
-                         " (scripts/prepare_capture.sh fetches and converts the "
-                         "models; --models DIR points elsewhere)");
-  return {};
+  return with_models_hint(create_estimator("onnx", options, out));
+}
+
+status make_capture_pipeline(const capture_pipeline_options& options,
+                             std::unique_ptr<capture_pipeline>& out) {
+  return with_models_hint(capture_pipeline::create(options, out));
 }
 
 void timing_totals::add(const estimator_timings& t) {

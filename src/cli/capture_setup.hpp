@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "avatarmap/capture/capture_pipeline.hpp"
 #include "avatarmap/capture/estimator.hpp"
 #include "avatarmap/capture/video_source.hpp"
 #include "cli/cli_args.hpp"
@@ -31,6 +32,9 @@ bool parse_input_options(args& a, video_source_options& out, std::string& error)
 
 /// Creates the ONNX estimator; the error says how to get the models.
 status make_estimator(const estimator_options& options, std::unique_ptr<estimator>& out);
+/// The same for a capture pipeline (estimator + solver + live filter), with the same hint.
+status make_capture_pipeline(const capture_pipeline_options& options,
+                             std::unique_ptr<capture_pipeline>& out);
 
 /// Sums of estimator_timings over frames, for the summary line.
 struct timing_totals {

@@ -16,12 +16,11 @@
 #include <string>
 #include <thread>
 
+#include "avatarmap/capture/capture_pipeline.hpp"
 #include "avatarmap/capture/live_capture.hpp"
 #include "avatarmap/capture/video_source.hpp"
 #include "avatarmap/io/pose_file.hpp"
-#include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/stream/pose_server.hpp"
-#include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
 #include "cli/capture_setup.hpp"
 #include "cli/commands.hpp"
@@ -131,20 +130,20 @@ int run_live_command(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap live: %s\n", st.message().c_str());
     return 1;
   }
-  std::unique_ptr<estimator> est;
-  st = make_estimator(ec, est);
+  // Each frame: landmarks -> proxy pose -> live filter, the library's capture pipeline (the C
+  // API's estimator and live handles run the same).
+  const video_info info = source.info();
+  capture_pipeline_options po;
+  po.estimator = ec;
+  po.solver.image_width = static_cast<float>(info.width);
+  po.solver.image_height = static_cast<float>(info.height);
+  po.filter.enabled = filter_name == "live";
+  std::unique_ptr<capture_pipeline> pipeline;
+  st = make_capture_pipeline(po, pipeline);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap live: %s\n", st.message().c_str());
     return 1;
   }
-  const video_info info = source.info();
-  solver_options so;
-  so.image_width = static_cast<float>(info.width);
-  so.image_height = static_cast<float>(info.height);
-  frame_solver solver(so);
-  pose_filter_options fo;
-  fo.enabled = filter_name == "live";
-  pose_filter filter(fo);
   pose_writer writer;
   const bool writing = !out_path.empty();
   if (!out_path.empty()) {
@@ -196,9 +195,6 @@ int run_live_command(int argc, char** argv) {
 
   landmark_frame frame;
   proxy_pose pose;
-  estimate_args ea;
-  ea.hands = ec.hands;
-  ea.face = ec.face;
   timing_totals timings;
   long with_body = 0;
   auto last_progress = clock_type::now();
@@ -218,15 +214,10 @@ int run_live_command(int argc, char** argv) {
                   const auto arrived = clock_type::now() -
                                        std::chrono::duration_cast<clock_type::duration>(
                                            std::chrono::duration<double, std::milli>(info_.age_ms));
-                  ea.image = img;
-                  ea.t = info_.t;
-                  est_status = est->estimate(ea, frame);
+                  est_status = pipeline->process(img, info_.t, frame, pose);
                   if (!est_status.ok()) return false;
-                  frame.t = info_.t;
-                  if (const estimator_timings* et = est->last_timings()) timings.add(*et);
+                  if (const estimator_timings* et = pipeline->last_timings()) timings.add(*et);
                   with_body += frame.has(frame_part::pose);
-                  solver.solve(frame, pose);
-                  filter.apply(pose, pose);
                   {
                     std::lock_guard<std::mutex> lock(m);
                     resampler.push(pose);
