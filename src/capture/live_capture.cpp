@@ -15,18 +15,6 @@ namespace {
 
 using clock_type = std::chrono::steady_clock;
 
-int bytes_per_pixel(pixel_format f) {
-  switch (f) {
-    case pixel_format::rgba8:
-    case pixel_format::bgra8:
-      return 4;
-    case pixel_format::gray8:
-      return 1;
-    default:
-      return 3;
-  }
-}
-
 // A frame copied out of the source's buffer, rows packed.
 struct frame_slot {
   std::vector<std::uint8_t> pixels;
@@ -36,7 +24,7 @@ struct frame_slot {
   clock_type::time_point published{};
 
   void copy_from(const image_view& v, double time, long i) {
-    const int bpp = bytes_per_pixel(v.format);
+    const int bpp = image_bytes_per_pixel(v.format);
     const size_t row = static_cast<size_t>(v.width) * bpp;
     const size_t need = row * static_cast<size_t>(v.height);
     if (pixels.size() < need) pixels.resize(need);  // first frame, or a larger one
