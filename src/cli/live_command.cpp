@@ -111,9 +111,11 @@ int run_live_command(int argc, char** argv) {
     return 2;
   }
   // The viewer's server first: a port in use is reported before the models load.
-  pose_server server;  // its own thread; publish() never waits for a page
+  pose_server server;         // its own thread; publish() never waits for a page
+  builtin_avatar_file shown;  // the page shows the built-in avatar
   if (!serve.empty()) {
     if (quiet) serve_options.on_event = nullptr;
+    if (shown.write().ok()) serve_options.avatar_path = shown.path;
     const status serve_status = server.start(serve_options);
     if (!serve_status.ok()) {
       std::fprintf(stderr, "avatarmap live: %s\n", serve_status.message().c_str());

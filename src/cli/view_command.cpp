@@ -10,11 +10,9 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
-#include <filesystem>
 #include <string>
 #include <thread>
 
-#include "avatarmap/avatar/builtin_avatar.hpp"
 #include "avatarmap/export/vrma.hpp"
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "avatarmap/stream/pose_file_player.hpp"
@@ -136,19 +134,9 @@ int run_view(int argc, char** argv) {
 
   // Without --avatar: the built-in avatar (`avatarmap avatar`), written to a temporary file that
   // is removed when the viewer stops.
-  struct temporary_file {
-    std::string path;
-    ~temporary_file() {
-      if (!path.empty()) std::remove(path.c_str());
-    }
-  } builtin;
+  builtin_avatar_file builtin;
   if (avatar.empty()) {
-    std::error_code ec;
-    const std::filesystem::path dir = std::filesystem::temp_directory_path(ec);
-    builtin.path = (ec ? std::filesystem::path(".") : dir).string() + "/avatarmap-view-" +
-                   std::to_string(static_cast<long>(getpid())) + ".vrm";
-    if (status st = write_builtin_avatar(builtin.path); !st) {
-      builtin.path.clear();
+    if (status st = builtin.write(); !st) {
       std::fprintf(stderr,
                    "avatarmap view: the built-in avatar: %s (--avatar FILE.vrm shows another)\n",
                    st.message().c_str());

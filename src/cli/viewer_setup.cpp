@@ -2,9 +2,13 @@
 #include "cli/viewer_setup.hpp"
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+
+#include "avatarmap/avatar/builtin_avatar.hpp"
 
 namespace avatarmap::cli {
 
@@ -66,6 +70,20 @@ bool parse_host_port(const std::string& text, std::string& out_host, int& out_po
   out_host = host;
   out_port = static_cast<int>(p);
   return true;
+}
+
+status builtin_avatar_file::write() {
+  std::error_code ec;
+  const std::filesystem::path dir = std::filesystem::temp_directory_path(ec);
+  const std::string p = (ec ? std::filesystem::path(".") : dir).string() + "/avatarmap-viewer-" +
+                        std::to_string(static_cast<long>(getpid())) + ".vrm";
+  if (status st = write_builtin_avatar(p); !st) return st;
+  path = p;
+  return {};
+}
+
+builtin_avatar_file::~builtin_avatar_file() {
+  if (!path.empty()) std::remove(path.c_str());
 }
 
 }  // namespace avatarmap::cli

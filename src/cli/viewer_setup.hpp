@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "avatarmap/core/status.hpp"
 #include "avatarmap/stream/pose_server.hpp"
 
 namespace avatarmap::cli {
@@ -18,5 +19,13 @@ pose_server_options default_viewer_options(const char* command);
 /// out_port (0..65535); false with a message otherwise.
 bool parse_host_port(const std::string& text, std::string& out_host, int& out_port,
                      std::string& error);
+
+/// The built-in avatar (`avatarmap avatar`) written to a temporary file for the viewer to serve,
+/// removed when this goes out of scope.
+struct builtin_avatar_file {
+  std::string path;  // empty until write() succeeds
+  status write();
+  ~builtin_avatar_file();
+};
 
 }  // namespace avatarmap::cli
