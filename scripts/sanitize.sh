@@ -61,7 +61,7 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/tool
 #    core; they test packaging, not memory safety, and the normal run covers them.
 #  - convert.tflite2onnx_selftest: Python and numpy only, no avatarmap code.
 # Run apart, below: the tests that load the C library into CPython ($python_tests).
-python_tests='^(c_api_python_ctypes.*|cli\.hostile_time_test)$'
+python_tests='^(c_api_python_.*|cli\.hostile_time_test)$'
 excluded='^(package_.*|convert\.tflite2onnx_selftest)$'
 cd "$build"
 ctest --output-on-failure -j "$jobs" -E "$excluded|$python_tests" || failed+=(tests)

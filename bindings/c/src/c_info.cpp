@@ -33,12 +33,10 @@ static_assert(AVM_EXPRESSION_BROW_DOWN_RIGHT == am::idx(am::expression::brow_dow
               "avm_expression must follow avatarmap::expression");
 
 namespace {
-const char* status_text(avm_status status) noexcept {
-  // A C caller may pass any int: read it as one (an out-of-range value is not an avm_status in
-  // C++, and switching on it would be undefined).
-  int value = 0;
-  static_assert(sizeof value == sizeof status, "avm_status is an int");
-  std::memcpy(&value, &status, sizeof value);
+// `value` is the caller's avm_status read as an int: a C caller may pass any int, and an
+// out-of-range value is not an avm_status in C++ (loading or switching on it would be
+// undefined).
+const char* status_text(int value) noexcept {
   switch (value) {
     case AVM_OK:
       return "ok";
@@ -78,7 +76,10 @@ AVATARMAP_C_API const char* avm_version_string(void) {
 }
 
 AVATARMAP_C_API const char* avm_status_string(avm_status status) {
-  return guard_value<const char*>("unknown status", [&] { return status_text(status); });
+  int value = 0;
+  static_assert(sizeof value == sizeof status, "avm_status is an int");
+  std::memcpy(&value, &status, sizeof value);  // never loaded as an avm_status
+  return guard_value<const char*>("unknown status", [value] { return status_text(value); });
 }
 
 AVATARMAP_C_API const char* avm_last_create_error(void) {
