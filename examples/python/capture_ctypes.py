@@ -30,6 +30,7 @@ from solve_ctypes import (AVM_OK, AvmError, AvmFrame, AvmPose,  # noqa: E402
                           AvmSolverOptions, load_library, text)
 
 AVM_ERROR_END_OF_FILE = 4
+AVM_ERROR_UNSUPPORTED = 5
 AVM_PIXEL_RGB8 = 0
 AVM_BONE_LEFT_UPPER_ARM = None  # looked up by name
 
@@ -170,6 +171,9 @@ def main():
     handle = ctypes.c_void_p()
     create = lib.avm_live_create if args.live else lib.avm_estimator_create
     st = create(ctypes.byref(opts), None, ctypes.byref(handle))
+    if st == AVM_ERROR_UNSUPPORTED and args.skip_if_unavailable:
+        print("skipped: %s" % text(lib.avm_last_create_error()))  # a build without ONNX Runtime
+        return 77
     if st != AVM_OK:
         raise AvmError("%s: %s: %s" % ("avm_live_create" if args.live else "avm_estimator_create",
                                        text(lib.avm_status_string(st)),
