@@ -35,7 +35,8 @@ struct video_errors {
   int found = 0;
 };
 
-video_errors run_squats(pose_smoothing smoothing, double eps_px) {
+// `clock_fps` > 0: frame i is given the time i / clock_fps instead of the video's own (5 fps).
+video_errors run_squats(pose_smoothing smoothing, double eps_px, double clock_fps = 0.0) {
   video_errors e;
   const std::string dir = test::test_data_path("motion/tfjs-models");
   const nlohmann::json ref = load_json(dir + "/pose_squats.full.json");
@@ -56,6 +57,7 @@ video_errors run_squats(pose_smoothing smoothing, double eps_px) {
     const size_t i = static_cast<size_t>(e.frames++);
     if (i >= ref.size()) break;
     f.clear();
+    if (clock_fps > 0.0) t = static_cast<double>(i) / clock_fps;
     f.t = t;
     if (p->process(img, f) != pose_result::found) continue;
     ++e.found;
@@ -116,6 +118,33 @@ TEST(pose_video, squats_vs_mediapipe_reference) {
       EXPECT_LT(e.max_coord_px, 1.25 * eps_px);
     }
   }
+}
+
+// tfjs-models' own video test feeds this 5 fps video to MediaPipe with time stamps 33.3 ms
+// apart (its simulatedInterval: a 30 fps clock), and MediaPipe's current pose graph smooths
+// with One Euro filters. Under those conditions our pipeline meets the test's own tolerance
+// on every coordinate: the misses above come from the clock, not from the models or the crops.
+TEST(pose_video, squats_on_the_references_clock_meet_every_tolerance) {
+  if (test::models_dir().empty()) GTEST_SKIP() << "AVATARMAP_MODELS is not set";
+  if (test::test_data_path("motion/tfjs-models/pose_squats.mp4").empty() ||
+      !video_source_available())
+    GTEST_SKIP() << "AVATARMAP_TEST_DATA is not set or no FFmpeg";
+  const nlohmann::json eps =
+      load_json(test::test_data_path("motion/tfjs-models/expected_from_tests.json"));
+  const double eps_px = eps["pose-detection::EPSILON_VIDEO"].get<double>();
+  const double eps_world = eps["pose-detection::EPSILON_VIDEO_WORLD"].get<double>();
+  const video_errors e = run_squats(pose_smoothing::one_euro, eps_px, 1000.0 / 33.3333);
+  ASSERT_EQ(e.frames, 65);
+  double mean = 0.0;
+  for (double x : e.point_px) mean += x;
+  mean /= std::max<size_t>(1, e.point_px.size());
+  std::printf(
+      "[figures] pose_squats.mp4 One Euro on a 30 fps clock: mean %.2f px, max coordinate %.1f "
+      "px, %d of %d coordinates over %.0f px; world max %.3f m\n",
+      mean, e.max_coord_px, e.coords_over, e.coords, eps_px, e.max_world_m);
+  EXPECT_EQ(e.coords_over, 0);
+  EXPECT_LE(e.max_coord_px, eps_px);
+  EXPECT_LE(e.max_world_m, eps_world);
 }
 
 }  // namespace
