@@ -52,8 +52,9 @@ const char* k_live_help =
     "                        none: the solver's poses as they are\n"
     "  --seconds S           stop after S seconds (default: when the input ends)\n"
     "  --unpaced             deliver file frames as fast as they decode (stress test)\n"
-    "  --serve [HOST:]PORT   serve the browser viewer and stream the output poses to it\n"
-    "                        (docs/viewer.md; host default 127.0.0.1, port 0 picks one)\n"
+    "  --serve [HOST:]PORT   serve the browser viewer and stream the output poses to it, on\n"
+    "                        the built-in avatar (docs/viewer.md; host default 127.0.0.1,\n"
+    "                        port 0 picks one)\n"
     "  --quiet               no progress line and no summary\n"
     "\n";
 const char* k_live_estimator_help = "Estimator options (hands and face off unless asked):\n";

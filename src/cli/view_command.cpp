@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "avatarmap/export/vrma.hpp"
+#include "avatarmap/jobs/clip_output.hpp"
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "avatarmap/stream/pose_file_player.hpp"
 #include "avatarmap/stream/pose_server.hpp"
@@ -55,16 +56,6 @@ const char* k_view_help =
 volatile std::sig_atomic_t g_stop = 0;
 void on_stop_signal(int) { g_stop = 1; }
 
-bool ends_with_nocase(const std::string& s, const std::string& suffix) {
-  if (s.size() < suffix.size()) return false;
-  for (std::size_t i = 0; i < suffix.size(); ++i) {
-    char c = s[s.size() - suffix.size() + i];
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-    if (c != suffix[i]) return false;
-  }
-  return true;
-}
-
 // Opens `url` with xdg-open without waiting for the browser; false when it cannot be run.
 bool open_in_browser(const std::string& url) {
   pid_t pid = 0;
@@ -102,8 +93,10 @@ int run_view(int argc, char** argv) {
     return 2;
   }
   const std::string file = a.rest().empty() ? std::string() : a.rest()[0];
-  const bool pose_file = ends_with_nocase(file, ".pose.jsonl");
-  const bool clip_file = ends_with_nocase(file, ".vrma");
+  // The file's kind by its extension, any case (as the clip writers read output names).
+  const clip_format_info* kind = file.empty() ? nullptr : find_clip_format(file);
+  const bool pose_file = kind != nullptr && kind->format == clip_format::pose_jsonl;
+  const bool clip_file = kind != nullptr && kind->format == clip_format::vrma;
   if (!file.empty() && !pose_file && !clip_file) {
     std::fprintf(stderr, "avatarmap view: %s: FILE must be a .pose.jsonl or a .vrma\n",
                  file.c_str());

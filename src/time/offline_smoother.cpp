@@ -265,7 +265,7 @@ bool offline_smoother::push(const proxy_pose& in) noexcept {
 }
 
 // A hand seen for less than k_min_detection_seconds between frames where it was not detected
-// at all (confidence 0; or the start of the take) is taken for a false detection: the hand
+// at all (confidence 0, or a new segment of the take) is taken for a false detection: the hand
 // landmark model also answers on a crop that holds no hand, or a hand turned the wrong way,
 // and such answers rarely last. Its frames become gaps (filled from the frames around them)
 // as long as none of them has been emitted. Checked when the hand is missed again, per bone.

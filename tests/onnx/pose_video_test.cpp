@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "avatarmap/capture/pose_pipeline.hpp"
@@ -80,15 +81,21 @@ video_errors run_squats(pose_smoothing smoothing, double eps_px, double clock_fp
   return e;
 }
 
+// tfjs-models' video tolerances (expected_from_tests.json): EPSILON_VIDEO pixels, and
+// EPSILON_VIDEO_WORLD metres.
+std::pair<double, double> video_tolerances() {
+  const nlohmann::json eps =
+      load_json(test::test_data_path("motion/tfjs-models/expected_from_tests.json"));
+  return {eps["pose-detection::EPSILON_VIDEO"].get<double>(),
+          eps["pose-detection::EPSILON_VIDEO_WORLD"].get<double>()};
+}
+
 TEST(pose_video, squats_vs_mediapipe_reference) {
   if (test::models_dir().empty()) GTEST_SKIP() << "AVATARMAP_MODELS is not set";
   if (test::test_data_path("motion/tfjs-models/pose_squats.mp4").empty() ||
       !video_source_available())
     GTEST_SKIP() << "AVATARMAP_TEST_DATA is not set or no FFmpeg";
-  const nlohmann::json eps =
-      load_json(test::test_data_path("motion/tfjs-models/expected_from_tests.json"));
-  const double eps_px = eps["pose-detection::EPSILON_VIDEO"].get<double>();
-  const double eps_world = eps["pose-detection::EPSILON_VIDEO_WORLD"].get<double>();
+  const auto [eps_px, eps_world] = video_tolerances();
   const char* names[] = {"velocity filter", "One Euro", "unsmoothed"};
   for (pose_smoothing mode :
        {pose_smoothing::velocity, pose_smoothing::one_euro, pose_smoothing::none}) {
@@ -129,10 +136,7 @@ TEST(pose_video, squats_on_the_references_clock_meet_every_tolerance) {
   if (test::test_data_path("motion/tfjs-models/pose_squats.mp4").empty() ||
       !video_source_available())
     GTEST_SKIP() << "AVATARMAP_TEST_DATA is not set or no FFmpeg";
-  const nlohmann::json eps =
-      load_json(test::test_data_path("motion/tfjs-models/expected_from_tests.json"));
-  const double eps_px = eps["pose-detection::EPSILON_VIDEO"].get<double>();
-  const double eps_world = eps["pose-detection::EPSILON_VIDEO_WORLD"].get<double>();
+  const auto [eps_px, eps_world] = video_tolerances();
   const video_errors e = run_squats(pose_smoothing::one_euro, eps_px, 1000.0 / 33.3333);
   ASSERT_EQ(e.frames, 65);
   double mean = 0.0;
