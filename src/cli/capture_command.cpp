@@ -190,33 +190,15 @@ int run_capture(int argc, char** argv) {
   ea.hands = ec.hands;
   ea.face = ec.face;
   jobs_detail::prefetch_ring<decoded> ring(3, decode);
-  for (;;) {
-    decoded& d = ring.next();
-    if (d.kind == read_result::end) break;
-    if (d.kind == read_result::error) {
-      ++errors;
-      std::fprintf(stderr, "warning: %s\n", d.error.c_str());
-      ring.release();
-      continue;
-    }
-    ea.image = d.view;
-    ea.t = d.t;
-    st = est->estimate(ea, frame);
-    if (!st.ok()) {
-      std::fprintf(stderr, "avatarmap capture: frame at %.3f s: %s\n", ea.t, st.message().c_str());
-      return 1;
-    }
-    frame.t = ea.t;
+  // A frame given back by the estimator: counted, written, drawn.
+  auto emit = [&](const decoded& d) {
+    frame.t = d.t;
     for (int p = 0; p < k_frame_part_count; ++p)
       part_frames[p] += frame.has(static_cast<frame_part>(p));
     if (const estimator_timings* et = est->last_timings()) timings.add(*et);
-    st = writer.write(frame);
-    if (st.ok() && overlay.is_open()) st = overlay.write(d.view, frame);
-    ring.release();
-    if (!st.ok()) {
-      std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
-      return 1;
-    }
+    status w = writer.write(frame);
+    if (w.ok() && overlay.is_open()) w = overlay.write(d.view, frame);
+    if (!w.ok()) return w;
     ++frames;
     if (frames == 100) rss_warm = resident_kib();
     if (frames % 100 == 0) rss_peak = std::max(rss_peak, resident_kib());
@@ -233,6 +215,51 @@ int run_capture(int argc, char** argv) {
           std::fprintf(stderr, "\rcapture: %ld frames, %.1f frames/s   ", frames, frames / el);
         std::fflush(stderr);
       }
+    }
+    return status{};
+  };
+  // Frames go through estimate_pipelined(): with two lanes the estimator gives a frame back
+  // one call later (its body ran beside the previous frame's hands and face), so the decoded
+  // frame in flight is held in the ring until then.
+  const bool delayed = est->pipeline_delay() > 0;
+  const decoded* in_flight = nullptr;
+  bool ready = false;
+  for (;;) {
+    decoded& d = ring.next();
+    if (d.kind != read_result::frame && in_flight) {  // end or a broken frame: drain first
+      st = est->estimate_pipelined(nullptr, frame, ready);
+      if (st.ok() && ready) st = emit(*in_flight);
+      if (!st.ok()) {
+        std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
+        return 1;
+      }
+      ring.release();
+      in_flight = nullptr;
+    }
+    if (d.kind == read_result::end) break;
+    if (d.kind == read_result::error) {
+      ++errors;
+      std::fprintf(stderr, "warning: %s\n", d.error.c_str());
+      ring.release();
+      continue;
+    }
+    ea.image = d.view;
+    ea.t = d.t;
+    st = est->estimate_pipelined(&ea, frame, ready);
+    if (!st.ok()) {
+      std::fprintf(stderr, "avatarmap capture: frame at %.3f s: %s\n", ea.t, st.message().c_str());
+      return 1;
+    }
+    if (ready) st = emit(in_flight ? *in_flight : d);
+    if (!st.ok()) {
+      std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
+      return 1;
+    }
+    if (!delayed) {
+      ring.release();
+    } else {
+      if (in_flight) ring.release();
+      in_flight = &d;
     }
   }
   if (!source.end_reason().empty())  // a device or stream that stalled or ended

@@ -11,8 +11,11 @@ const char* const k_estimator_options_help =
     "  --face / --no-face    estimate the face mesh (468 points)\n"
     "  --hand-model lite|full  hand landmark model (default full)\n"
     "  --mirrored            the input is mirrored (a selfie preview); sides stay the person's\n"
-    "  --threads N           ONNX Runtime threads, one pool for all models (default 2; 1 is\n"
-    "                        better when another process keeps a core busy)\n"
+    "  --threads N           threads for the models (default 2; 1 is better when another\n"
+    "                        process keeps a core busy)\n"
+    "  --lanes 1|2           with hands or face and 2+ threads: 2 (default) runs the hands\n"
+    "                        and face beside the body (of the next frame, for files), each\n"
+    "                        model on one thread; 1 runs every model on all threads in turn\n"
     "  --spin                let ONNX Runtime's threads spin between operators: faster on an\n"
     "                        idle machine, much slower when another process is busy\n"
     "  --models DIR          converted models (default: $AVATARMAP_MODELS/onnx, else the cache\n"
@@ -76,8 +79,9 @@ bool parse_estimator_options(args& a, bool hands_face_default, estimator_options
   a.value("--model", model);
   a.value("--hand-model", hand_model);
   a.value("--models", o.source);
-  double threads = 2;
+  double threads = 2, lanes = 2;
   a.number("--threads", threads);
+  a.number("--lanes", lanes);
   o.static_images = a.flag("--static");
   o.mirrored_input = a.flag("--mirrored");
   o.spin = a.flag("--spin");
@@ -102,6 +106,11 @@ bool parse_estimator_options(args& a, bool hands_face_default, estimator_options
     return false;
   }
   o.threads = static_cast<int>(threads);
+  if (lanes != 1 && lanes != 2) {
+    error = "--lanes is 1 or 2";
+    return false;
+  }
+  o.lanes = static_cast<int>(lanes);
   return true;
 }
 
@@ -141,7 +150,8 @@ void timing_totals::add(const estimator_timings& t) {
 void timing_totals::print(std::FILE* to) const {
   if (frames == 0) return;
   const double n = static_cast<double>(frames);
-  std::fprintf(to, "per frame (ms, mean over %ld frames): estimate %.2f", frames, sum.total_ms / n);
+  std::fprintf(to, "per frame (ms, mean over %ld frames): all stages %.2f", frames,
+               sum.total_ms / n);
   auto stage = [&](const char* name, double ms) {
     if (ms > 0) std::fprintf(to, ", %s %.2f", name, ms / n);
   };

@@ -46,13 +46,15 @@ class prefetch_ring {
   prefetch_ring(const prefetch_ring&) = delete;
   prefetch_ring& operator=(const prefetch_ring&) = delete;
 
-  /// Waits for the next item; valid until release(). Not to be called after the last item.
+  /// Waits for the next item; valid until release() hands it back. The caller may hold
+  /// several items (each next() takes one more, release() gives back the oldest held), at
+  /// most capacity - 1 at a time.
   Slot& next() {
-    const size_t t = tail_.load(std::memory_order_relaxed);  // only this thread writes it
+    const size_t t = taken_++;  // only this thread touches taken_
     if (head_.load() == t) wait_for_items(t);
     return slots_[t % slots_.size()];
   }
-  /// Hands the current item's slot back to the producer.
+  /// Hands the oldest item the caller holds back to the producer.
   void release() {
     const size_t t = tail_.load(std::memory_order_relaxed) + 1;
     tail_.store(t);
@@ -107,7 +109,8 @@ class prefetch_ring {
   std::mutex mutex_;  // only for sleeping and waking
   std::condition_variable not_empty_, not_full_;
   std::atomic<size_t> head_{0};  // items produced
-  std::atomic<size_t> tail_{0};  // items consumed
+  std::atomic<size_t> tail_{0};  // items consumed (released)
+  size_t taken_ = 0;             // items the caller has taken (>= tail_)
   // What a sleeping side waits for (items, free slots); 0 when it is not sleeping.
   std::atomic<size_t> consumer_wants_{0}, producer_wants_{0};
   std::atomic<bool> done_{false};  // the last item is ready

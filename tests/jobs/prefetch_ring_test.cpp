@@ -114,5 +114,34 @@ TEST(prefetch_ring, destroying_it_with_the_producer_blocked_on_a_full_ring_retur
   }
 }
 
+// The caller may hold two items (a frame in flight in a pipelined estimator and the next):
+// each next() takes a new one, release() gives back the oldest, and the contents of a held
+// item stay what they were while the producer refills the other slots.
+TEST(prefetch_ring, caller_holds_two_items) {
+  constexpr long k_items = 500;
+  for (int capacity : {2, 3, 8}) {
+    long produced = 0;
+    prefetch_ring<item> ring(capacity, [&](item& it) {
+      dawdle(produced, 5);
+      it.value = produced++;
+      it.last = produced == k_items;
+      return !it.last;
+    });
+    const item* held = &ring.next();
+    ASSERT_EQ(held->value, 0);
+    long seen = 1;
+    for (;;) {
+      const item& it = ring.next();
+      EXPECT_EQ(it.value, seen) << "capacity " << capacity;
+      EXPECT_EQ(held->value, seen - 1) << "a held item changed";
+      ++seen;
+      ring.release();  // the older one
+      held = &it;
+      if (it.last) break;
+    }
+    EXPECT_EQ(seen, k_items);
+  }
+}
+
 }  // namespace
 }  // namespace avatarmap::jobs_detail

@@ -357,7 +357,9 @@ TEST(hand_pipeline, hands_jpg_from_body_regions) {
 
 // ---- asl_hand.25fps.mp4 (tracking) -----------------------------------------------------------
 
-TEST(hand_video, asl_hand_vs_mediapipe_reference) {
+// The reference was made with the full hand model; the lite model (the speed switch) is
+// measured against it too, and its figures printed (docs/capture.md), not asserted.
+void asl_hand_vs_reference(hand_model_complexity complexity) {
   HAND_SKIP_WITHOUT_DATA();
   const std::string dir = test::test_data_path("motion/tfjs-models");
   if (!video_source_available()) GTEST_SKIP() << "built without FFmpeg";
@@ -368,6 +370,7 @@ TEST(hand_video, asl_hand_vs_mediapipe_reference) {
   const double eps_world = eps["hand-pose-detection::EPSILON_VIDEO_WORLD"].get<double>();
 
   hand_pipeline_options o;
+  o.complexity = complexity;
   o.max_hands = 1;  // as the reference (tfjs-models' test: maxHands 1)
   auto p = make(o);
   ASSERT_NE(p, nullptr);
@@ -419,20 +422,29 @@ TEST(hand_video, asl_hand_vs_mediapipe_reference) {
   stats(point_px, pm, pp, px);
   stats(world_m, wm, wp, wx);
   std::printf(
-      "[figures] asl_hand.25fps.mp4 (%d frames, hand found in %d, palm detector on %d): "
+      "[figures] %s: asl_hand.25fps.mp4 (%d frames, hand found in %d, palm detector on %d): "
       "per coordinate mean %.2f px, p95 %.2f px, max %.2f px, %d of %zu (%.2f%%) over %.0f px; "
       "per point mean %.2f px, p95 %.2f px, max %.2f px; world per coordinate mean %.4f m, "
       "p95 %.4f m, max %.4f m, %d of %zu (%.2f%%) over %.3f m; median frame %.2f ms\n",
-      frames, found, palm_runs, cm, cp, cx, over, coord_px.size(),
-      100.0 * over / std::max<size_t>(1, coord_px.size()), eps_px, pm, pp, px, wm, wp, wx,
-      world_over, world_m.size(), 100.0 * world_over / std::max<size_t>(1, world_m.size()),
-      eps_world, median(ms));
+      complexity == hand_model_complexity::full ? "full" : "lite", frames, found, palm_runs, cm, cp,
+      cx, over, coord_px.size(), 100.0 * over / std::max<size_t>(1, coord_px.size()), eps_px, pm,
+      pp, px, wm, wp, wx, world_over, world_m.size(),
+      100.0 * world_over / std::max<size_t>(1, world_m.size()), eps_world, median(ms));
+  if (complexity != hand_model_complexity::full) return;
   // tfjs-models asserts every coordinate of every frame within EPSILON_VIDEO (image) and
   // EPSILON_VIDEO_WORLD (world).
   EXPECT_EQ(found, frames) << "the reference has the hand in every frame";
   EXPECT_EQ(over, 0);
   EXPECT_EQ(world_over, 0);
   EXPECT_LT(palm_runs, frames / 10) << "tracking, not detecting every frame";
+}
+
+TEST(hand_video, asl_hand_vs_mediapipe_reference) {
+  asl_hand_vs_reference(hand_model_complexity::full);
+}
+
+TEST(hand_video, asl_hand_lite_model_figures) {
+  asl_hand_vs_reference(hand_model_complexity::lite);
 }
 
 // ---- latency ---------------------------------------------------------------------------------

@@ -66,11 +66,16 @@ struct estimator_options {
   /// onnx: the images are mirrored (a selfie preview). Sides in the output are always the
   /// person's own; this only tells the hand model's handedness how to read the image.
   bool mirrored_input = false;
+  /// onnx: with hands or face and threads >= 2, run the models on two lanes (the calling
+  /// thread and a worker, each with threads / 2 ORT threads): the hands and the face of a
+  /// frame side by side, and in estimate_pipelined() the body of the next frame beside them.
+  /// 1: one lane, every model on all `threads` ORT threads (docs/capture.md, "Two lanes").
+  int lanes = 2;
 };
 
 /// Where the time of the last estimate() went, milliseconds (0 for a stage that did not run).
 struct estimator_timings {
-  double total_ms = 0.0;
+  double total_ms = 0.0;  // the stages below summed (with two lanes they overlap in time)
   double pose_detector_ms = 0.0;
   double pose_landmark_ms = 0.0;
   double palm_detector_ms = 0.0;
@@ -90,7 +95,25 @@ class estimator {
   /// Backend name as listed in estimator_backends().
   virtual std::string_view name() const = 0;
   /// Per-stage timings of the last estimate(), or nullptr for a backend without stages.
+  /// After estimate_pipelined(): those of the frame it gave back.
   virtual const estimator_timings* last_timings() const { return nullptr; }
+
+  /// Pipelined estimation, for files and other sources whose frames can wait: hands frame
+  /// `in` over and gives back, in `out`, the oldest frame that is finished (`ready` true), or
+  /// nothing yet (`ready` false). Frames come back in the order they went in, each with the
+  /// same landmarks estimate() would give (it only overlaps the work of neighbouring frames).
+  /// Call with `in` == nullptr after the last frame until `ready` is false, to drain. The
+  /// pixels of a frame must stay valid until that frame has come back: up to
+  /// pipeline_delay() calls later. The default finishes each frame in its own call.
+  virtual status estimate_pipelined(const estimate_args* in, landmark_frame& out, bool& ready) {
+    ready = false;
+    if (in == nullptr) return {};
+    status s = estimate(*in, out);
+    ready = s.ok();
+    return s;
+  }
+  /// How many calls of estimate_pipelined() a frame waits before it comes back (0 or 1).
+  virtual int pipeline_delay() const { return 0; }
 };
 
 /// One row of the backend table.

@@ -1,7 +1,7 @@
 // No heap allocation per frame in the capture pipelines' steady state outside ONNX Runtime:
-// the onnx estimator (body, hands, face; one thread, so ORT runs everything on this thread
-// inside bound_model::run) tracks pose.jpg frame after frame while a replaced global
-// operator new counts the allocations made outside ORT's Run. Its own executable, so the
+// the onnx estimator (body, hands, face; one ORT thread per lane, so ORT runs everything on
+// the lane's own thread inside bound_model::run) tracks pose.jpg frame after frame while a replaced
+// global operator new counts the allocations made outside ORT's Run. Its own executable, so the
 // replacement affects no other test.
 #include <gtest/gtest.h>
 
@@ -33,7 +33,9 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 namespace avatarmap {
 namespace {
 
-TEST(steady_state, no_allocation_outside_onnx_runtime) {
+// `threads` 1: one lane; 2: two lanes (a worker thread runs the hands beside the face, and
+// with `pipelined` the body of the next frame beside them).
+void count_steady_state_allocations(int threads, bool pipelined) {
   const std::string models = test::models_dir();
   if (models.empty()) GTEST_SKIP() << "AVATARMAP_MODELS is not set (folder of converted models)";
   if (test::test_data_dir().empty()) GTEST_SKIP() << test::k_no_test_data;
@@ -41,27 +43,42 @@ TEST(steady_state, no_allocation_outside_onnx_runtime) {
   ASSERT_TRUE(test::load_image(test::test_data_path("motion/tfjs-models/pose.jpg"), img));
   estimator_options o;
   o.source = models;
-  o.threads = 1;
+  o.threads = threads;
   o.hands = o.face = true;
   std::unique_ptr<estimator> est;
   const status s = create_estimator("onnx", o, est);
   ASSERT_TRUE(s.ok()) << s.message();
+  ASSERT_EQ(est->pipeline_delay(), threads > 1 ? 1 : 0);
   landmark_frame f;
   estimate_args a;
   a.image = img.view();
   int parts = 0;
+  g_outside = 0;
   for (int i = 0; i < 40; ++i) {
     a.t = i / 30.0;
     if (i == 10) g_counting = true;  // after warm-up: tracking, buffers sized
-    ASSERT_TRUE(est->estimate(a, f).ok());
-    parts |= static_cast<int>(f.parts);
+    bool ready = true;
+    if (pipelined)
+      ASSERT_TRUE(est->estimate_pipelined(&a, f, ready).ok());
+    else
+      ASSERT_TRUE(est->estimate(a, f).ok());
+    if (ready) parts |= static_cast<int>(f.parts);
   }
   g_counting = false;
   EXPECT_TRUE(f.has(frame_part::pose));
   EXPECT_TRUE(f.has(frame_part::face));
-  std::printf("[figures] parts seen: 0x%x; allocations outside ONNX Runtime in 30 frames: %ld\n",
-              parts, g_outside.load());
+  std::printf(
+      "[figures] threads %d%s: parts seen: 0x%x; allocations outside ONNX Runtime in 30 frames: "
+      "%ld\n",
+      threads, pipelined ? ", pipelined" : "", parts, g_outside.load());
   EXPECT_EQ(g_outside.load(), 0);
+}
+
+TEST(steady_state, no_allocation_outside_onnx_runtime) { count_steady_state_allocations(1, false); }
+
+TEST(steady_state, two_lanes_allocate_nothing_outside_onnx_runtime) {
+  count_steady_state_allocations(2, false);
+  count_steady_state_allocations(2, true);
 }
 
 // The same through capture_pipeline (what the C API's estimator and live handles run): the
