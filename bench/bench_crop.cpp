@@ -37,7 +37,7 @@ normalized_rect pose_roi(float rotation) {
 }
 
 void run_crop(benchmark::State& state, pixel_format format, int channels, float rotation,
-              crop_border border) {
+              crop_border border, crop_sampling sampling = crop_sampling::opencv) {
   const frame f = make_frame(format, channels);
   crop_options o;
   o.output_width = 256;
@@ -45,6 +45,7 @@ void run_crop(benchmark::State& state, pixel_format format, int channels, float 
   o.range_min = 0.0f;
   o.range_max = 1.0f;
   o.border = border;
+  o.sampling = sampling;
   std::vector<float> out(crop_output_size(o));
   image_crop_job job;
   job.image = f.view;
@@ -65,6 +66,13 @@ void bm_crop_rgb_rotated(benchmark::State& state) {
 void bm_crop_rgb_rotated_zero_border(benchmark::State& state) {
   run_crop(state, pixel_format::rgb8, 3, 0.4f, crop_border::zero);
 }
+// MediaPipe's OpenGL converter's sampling (the pipelines' default): float bilinear.
+void bm_crop_rgb_rotated_gl(benchmark::State& state) {
+  run_crop(state, pixel_format::rgb8, 3, 0.4f, crop_border::replicate, crop_sampling::gl);
+}
+void bm_crop_rgb_rotated_gl_zero_border(benchmark::State& state) {
+  run_crop(state, pixel_format::rgb8, 3, 0.4f, crop_border::zero, crop_sampling::gl);
+}
 void bm_crop_rgb_upright(benchmark::State& state) {
   run_crop(state, pixel_format::rgb8, 3, 0.0f, crop_border::replicate);
 }
@@ -83,6 +91,8 @@ void bm_memcpy_tensor(benchmark::State& state) {
 
 BENCHMARK(bm_crop_rgb_rotated);
 BENCHMARK(bm_crop_rgb_rotated_zero_border);
+BENCHMARK(bm_crop_rgb_rotated_gl);
+BENCHMARK(bm_crop_rgb_rotated_gl_zero_border);
 BENCHMARK(bm_crop_rgb_upright);
 BENCHMARK(bm_crop_bgra_rotated);
 BENCHMARK(bm_memcpy_tensor);

@@ -19,6 +19,8 @@ constexpr int k_weight_round = 1 << (k_weight_bits - 1);
 // ROIs reaching further than this from the origin (pixels) are rejected, which keeps every
 // sample position * 32 within int range without a per-pixel clamp.
 constexpr double k_coord_limit = static_cast<double>(1 << 24);
+constexpr int k_floor_offset_int = 1 << 26;
+constexpr double k_floor_offset = k_floor_offset_int;
 
 bool finite(float v) { return std::isfinite(v); }
 
@@ -106,6 +108,75 @@ void warp(const warp_args& a) {
         out[2] = sample(k_b);
       }
     }
+  }
+}
+
+// The OpenGL converter's sampling (crop_sampling::gl): `a.m` already maps pixel centres
+// (tensor x + 0.5 -> image position, pixel i's centre at i), bilinear weights in float, no
+// rounding to 8 bits.
+template <int k_bpp, int k_r, int k_g, int k_b, bool k_zero_border>
+void warp_gl(const warp_args& a) {
+  const double m0 = a.m[0], m1 = a.m[1], m2 = a.m[2], m3 = a.m[3], m4 = a.m[4], m5 = a.m[5];
+  const int last_x = a.width - 1, last_y = a.height - 1;
+  // MediaPipe's zero-border shader tests the texture coordinate against [0, 1]: positions
+  // beyond the outer edge of the edge pixels.
+  const double lo = -0.5, hi_x = a.width - 0.5, hi_y = a.height - 0.5;
+  const float scale = a.scale, offset = a.offset;
+  float* out = a.out;
+
+  for (int y = 0; y < a.out_height; ++y) {
+    const double row_x = m1 * y + m2;
+    const double row_y = m4 * y + m5;
+    for (int x = 0; x < a.out_width; ++x, out += 3) {
+      const double px = row_x + m0 * x;
+      const double py = row_y + m3 * x;
+      if (k_zero_border && (px < lo || px > hi_x || py < lo || py > hi_y)) {
+        out[0] = out[1] = out[2] = offset;
+        continue;
+      }
+      // floor() by truncating a positive number: positions are bounded by k_coord_limit, so
+      // adding twice that keeps them positive and in int range (and avoids a libm call).
+      const int sx = static_cast<int>(px + k_floor_offset) - k_floor_offset_int;
+      const int sy = static_cast<int>(py + k_floor_offset) - k_floor_offset_int;
+      const float ax = static_cast<float>(px - sx), ay = static_cast<float>(py - sy);
+      const int x0 = std::clamp(sx, 0, last_x), x1 = std::clamp(sx + 1, 0, last_x);
+      const int y0 = std::clamp(sy, 0, last_y), y1 = std::clamp(sy + 1, 0, last_y);
+      const std::uint8_t* r0 = a.data + y0 * a.stride;
+      const std::uint8_t* r1 = a.data + y1 * a.stride;
+      const std::uint8_t* p00 = r0 + x0 * k_bpp;
+      const std::uint8_t* p01 = r0 + x1 * k_bpp;
+      const std::uint8_t* p10 = r1 + x0 * k_bpp;
+      const std::uint8_t* p11 = r1 + x1 * k_bpp;
+      const float w00 = (1.f - ax) * (1.f - ay), w01 = ax * (1.f - ay);
+      const float w10 = (1.f - ax) * ay, w11 = ax * ay;
+      const auto sample = [&](int c) {
+        const float v = w00 * p00[c] + w01 * p01[c] + w10 * p10[c] + w11 * p11[c];
+        return v * scale + offset;
+      };
+      if constexpr (k_bpp == 1) {
+        out[0] = out[1] = out[2] = sample(0);
+      } else {
+        out[0] = sample(k_r);
+        out[1] = sample(k_g);
+        out[2] = sample(k_b);
+      }
+    }
+  }
+}
+
+template <bool k_zero_border>
+void warp_gl_any(pixel_format f, const warp_args& a) {
+  switch (f) {
+    case pixel_format::rgb8:
+      return warp_gl<3, 0, 1, 2, k_zero_border>(a);
+    case pixel_format::bgr8:
+      return warp_gl<3, 2, 1, 0, k_zero_border>(a);
+    case pixel_format::rgba8:
+      return warp_gl<4, 0, 1, 2, k_zero_border>(a);
+    case pixel_format::bgra8:
+      return warp_gl<4, 2, 1, 0, k_zero_border>(a);
+    case pixel_format::gray8:
+      return warp_gl<1, 0, 0, 0, k_zero_border>(a);
   }
 }
 
@@ -254,6 +325,9 @@ bool image_crop_job::validate() const {
       !(options.range_min < options.range_max)) {
     return false;
   }
+  if (options.border != crop_border::replicate && options.border != crop_border::zero) return false;
+  if (options.sampling != crop_sampling::opencv && options.sampling != crop_sampling::gl)
+    return false;
   if (output == nullptr || output_size < crop_output_size(options)) return false;
   crop_transform unused;
   return make_crop_transform(image.width, image.height, roi, options, unused);
@@ -276,7 +350,18 @@ bool image_crop_job::run() const {
   a.scale = (options.range_max - options.range_min) / 255.0f;
   a.offset = options.range_min;
   a.out = output;
-  if (options.border == crop_border::zero) {
+  const bool zero = options.border == crop_border::zero;
+  if (options.sampling == crop_sampling::gl) {
+    // Tensor pixel centres (x + 0.5) onto image pixel centres (i + 0.5, i.e. minus 0.5 in this
+    // file's integer-centre convention).
+    a.m[2] += 0.5 * (a.m[0] + a.m[1]) - 0.5;
+    a.m[5] += 0.5 * (a.m[3] + a.m[4]) - 0.5;
+    if (zero) {
+      warp_gl_any<true>(image.format, a);
+    } else {
+      warp_gl_any<false>(image.format, a);
+    }
+  } else if (zero) {
     warp_any<true>(image.format, a);
   } else {
     warp_any<false>(image.format, a);

@@ -232,20 +232,116 @@ TEST(ImageCrop, PixelFormatsAndStridesAgree) {
       37, 23, pixel_format::bgra8,
       [&](int x, int y, int c) { return c < 3 ? rgb(x, y, 2 - c) : 9; }, 3);
   normalized_rect roi{0.4f, 0.6f, 0.7f, 0.5f, 0.6f};
-  for (auto border : {crop_border::replicate, crop_border::zero}) {
-    crop_options o;
-    o.output_width = 19;
-    o.output_height = 13;
-    o.border = border;
-    const auto expected = crop(rgb_img, roi, o);
-    EXPECT_EQ(crop(bgr_img, roi, o), expected);
-    EXPECT_EQ(crop(rgba_img, roi, o), expected);
-    EXPECT_EQ(crop(bgra_img, roi, o), expected);
+  for (auto sampling : {crop_sampling::opencv, crop_sampling::gl}) {
+    for (auto border : {crop_border::replicate, crop_border::zero}) {
+      crop_options o;
+      o.output_width = 19;
+      o.output_height = 13;
+      o.border = border;
+      o.sampling = sampling;
+      const auto expected = crop(rgb_img, roi, o);
+      EXPECT_EQ(crop(bgr_img, roi, o), expected);
+      EXPECT_EQ(crop(rgba_img, roi, o), expected);
+      EXPECT_EQ(crop(bgra_img, roi, o), expected);
 
-    const auto gray = [](int x, int y, int) { return (x * 13 + y * 7) & 255; };
-    const auto gray_img = make_image(37, 23, pixel_format::gray8, gray, 2);
-    const auto gray_as_rgb = make_image(37, 23, pixel_format::rgb8, gray);
-    EXPECT_EQ(crop(gray_img, roi, o), crop(gray_as_rgb, roi, o));
+      const auto gray = [](int x, int y, int) { return (x * 13 + y * 7) & 255; };
+      const auto gray_img = make_image(37, 23, pixel_format::gray8, gray, 2);
+      const auto gray_as_rgb = make_image(37, 23, pixel_format::rgb8, gray);
+      EXPECT_EQ(crop(gray_img, roi, o), crop(gray_as_rgb, roi, o));
+    }
+  }
+}
+
+// --- crop_sampling::gl (MediaPipe's OpenGL converter) ----------------------------------------
+
+crop_options gl_options(int w, int h, crop_border border) {
+  crop_options o = options_0_255(w, h, false, border);
+  o.sampling = crop_sampling::gl;
+  return o;
+}
+
+TEST(ImageCropGl, IdentityRoiReproducesTheImage) {
+  // Pixel centres onto pixel centres: tensor x samples image x exactly.
+  const auto img = make_image(5, 4, pixel_format::rgb8, pattern);
+  for (auto border : {crop_border::replicate, crop_border::zero}) {
+    const auto o = gl_options(5, 4, border);
+    const auto out = crop(img, {}, o);
+    for (int y = 0; y < 4; ++y) {
+      for (int x = 0; x < 5; ++x) {
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(at(out, o, x, y, c), pattern(x, y, c));
+      }
+    }
+  }
+}
+
+TEST(ImageCropGl, HalfSizeAveragesEachTwoByTwoBlock) {
+  // Tensor pixel x's centre x + 0.5 is image position 2x + 1, i.e. halfway between the centres
+  // of pixels 2x and 2x + 1 (at 2x + 0.5 and 2x + 1.5): GL_LINEAR gives the mean of the 2 x 2
+  // block, unrounded (the CPU converter takes pixel 2x alone: HalfSizeTakesEveryOtherPixel).
+  const auto img = make_image(8, 6, pixel_format::rgb8, pattern);
+  const auto o = gl_options(4, 3, crop_border::replicate);
+  const auto out = crop(img, {}, o);
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 4; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        const float mean = (pattern(2 * x, 2 * y, c) + pattern(2 * x + 1, 2 * y, c) +
+                            pattern(2 * x, 2 * y + 1, c) + pattern(2 * x + 1, 2 * y + 1, c)) /
+                           4.0f;
+        ASSERT_FLOAT_EQ(at(out, o, x, y, c), mean) << x << "," << y << "," << c;
+      }
+    }
+  }
+}
+
+TEST(ImageCropGl, ZeroBorderCutsAtTheImagesOuterEdge) {
+  // A 4 x 4 image, ROI (the image's size) centred on an edge, 8 x 8 tensor: tensor pixel x
+  // samples image position 0.5 x - 0.25 + 2 (right edge) or - 2 (left edge), in this file's
+  // integer-centre convention. MediaPipe's zero-border shader blacks out positions beyond the
+  // outer edge (< -0.5 or > 3.5) and clamps the rest to the edge pixels: on the right edge
+  // x = 3 (3.25) keeps the edge value and x = 4 (3.75) is black; on the left edge x = 3 (-0.75)
+  // is black and x = 4 (-0.25) is the edge value. No blend towards black as in the CPU
+  // converter's (BorderModesOutsideTheImage). Replicate keeps the edge value everywhere.
+  const auto img = make_image(4, 4, pixel_format::rgb8, [](int, int, int c) { return 60 + c; });
+  for (const float centre_x : {1.0f, 0.0f}) {
+    normalized_rect roi;
+    roi.x_center = centre_x;
+    for (auto border : {crop_border::replicate, crop_border::zero}) {
+      crop_options o = gl_options(8, 8, border);
+      o.range_min = -1.0f;
+      o.range_max = 1.0f;
+      const auto out = crop(img, roi, o);
+      for (int y = 0; y < 8; ++y) {
+        for (int x = 0; x < 8; ++x) {
+          const bool outside = centre_x == 1.0f ? x >= 4 : x <= 3;
+          for (int c = 0; c < 3; ++c) {
+            const float expected =
+                border == crop_border::zero && outside ? -1.0f : (60 + c) * (2.0f / 255.0f) - 1.0f;
+            ASSERT_NEAR(at(out, o, x, y, c), expected, 1e-6f) << x << "," << y << "," << c;
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(ImageCropGl, SamplingChangesThePixelsNotTheTransform) {
+  // Landmarks go back through the same transform in both converters (MediaPipe projects them
+  // the same way); only the sampled pixels differ, by half a tensor pixel minus half an image
+  // pixel. A linear ramp in x shows it: value = 2 * position, so the GL crop reads
+  // 2 * (0.5 * scale - 0.5) more than the CPU crop, scale being ROI pixels per tensor pixel.
+  const auto img = make_image(64, 8, pixel_format::gray8, [](int x, int, int) { return 2 * x; });
+  const normalized_rect roi{0.5f, 0.5f, 0.5f, 1.0f, 0.0f};  // 32 x 8 px -> 8 x 2: scale 4
+  crop_options cpu = options_0_255(8, 2, false, crop_border::replicate);
+  crop_options gl = cpu;
+  gl.sampling = crop_sampling::gl;
+  crop_transform t_cpu, t_gl;
+  const auto a = crop(img, roi, cpu, &t_cpu);
+  const auto b = crop(img, roi, gl, &t_gl);
+  EXPECT_EQ(t_cpu.to_image, t_gl.to_image);
+  EXPECT_EQ(t_cpu.to_tensor, t_gl.to_tensor);
+  for (int x = 0; x < 8; ++x) {
+    EXPECT_FLOAT_EQ(at(a, cpu, x, 0, 0), 2.0f * (16 + 4 * x));
+    EXPECT_FLOAT_EQ(at(b, gl, x, 0, 0), 2.0f * (16 + 4 * x + 1.5f));
   }
 }
 
@@ -334,7 +430,7 @@ TEST(ImageCrop, ValidateRejectsEachBrokenInput) {
   good.output_size = out.size();
   ASSERT_TRUE(good.validate());
 
-  std::vector<image_crop_job> bad(15, good);
+  std::vector<image_crop_job> bad(17, good);
   bad[0].image.data = nullptr;
   bad[1].image.width = 0;
   bad[2].image.height = -1;
@@ -350,6 +446,8 @@ TEST(ImageCrop, ValidateRejectsEachBrokenInput) {
   bad[12].output_size = out.size() - 1;
   bad[13].image.format = static_cast<pixel_format>(99);
   bad[14].roi.width = 1e7f;  // corners beyond 2^24 px
+  bad[15].options.border = static_cast<crop_border>(9);
+  bad[16].options.sampling = static_cast<crop_sampling>(9);
   for (std::size_t i = 0; i < bad.size(); ++i) {
     EXPECT_FALSE(bad[i].validate()) << i;
     out[0] = 123.0f;

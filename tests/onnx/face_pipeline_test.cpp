@@ -211,8 +211,17 @@ TEST(face_pipeline, portrait_vs_mediapipe_face_mesh) {
   EXPECT_EQ(f.face_count, 468);
   EXPECT_GT(p->last_presence(), 0.9f);
 
-  // The detector against tfjs-models' short-range expectations (their EPSILON_IMAGE).
-  const detection& d = p->last_detection();
+  // The detector against tfjs-models' short-range expectations (their EPSILON_IMAGE). Those
+  // agree with the CPU converter's sampling (1.6 px); the OpenGL one (the default, which the
+  // mesh golden below was made with) moves the keypoints by up to 9 px, inside the 10 px but
+  // not by a margin worth asserting: checked with crop_sampling::opencv.
+  face_pipeline_options oc = o;
+  oc.sampling = crop_sampling::opencv;
+  std::unique_ptr<face_pipeline> cpu;
+  ASSERT_TRUE(face_pipeline::create(oc, cpu).ok());
+  landmark_frame fc;
+  ASSERT_EQ(cpu->process(img.view(), nullptr, fc), face_result::found) << cpu->last_error();
+  const detection& d = cpu->last_detection();
   const nlohmann::json& kp = tfjs["face-detection::SHORT_RANGE_EXPECTED_FACE_KEY_POINTS"];
   double det_max = 0;
   for (int k = 0; k < 6; ++k) {

@@ -118,6 +118,9 @@ struct face_pipeline_options {
   float nms_iou_threshold = 0.3f;    // weighted NMS overlap threshold, (0, 1]
   float min_presence = 0.5f;         // mesh face-presence score (sigmoid) below this: lost
   bool static_images = false;        // true: acquire on every frame (no tracking)
+  /// How the crops sample the image (image_crop.hpp): `gl`, MediaPipe's OpenGL converter (its
+  /// GPU and web graphs, which made the goldens: docs/capture.md), or `opencv`, its CPU one.
+  crop_sampling sampling = crop_sampling::gl;
   /// Scale of the pose-derived search region (Holistic: 3), in (0, 100].
   float pose_region_scale = 3.0f;
   /// While tracking with a body, move the tracked region by the body's head motion since the

@@ -150,6 +150,9 @@ struct hand_pipeline_options {
   /// moving hand leaves last frame's region; this keeps it tracked (one landmark run)
   /// instead of lost and found again from the body (two runs).
   bool follow_body_motion = true;
+  /// How the crops sample the image (image_crop.hpp): `gl`, MediaPipe's OpenGL converter (its
+  /// GPU and web graphs, which made the goldens: docs/capture.md), or `opencv`, its CPU one.
+  crop_sampling sampling = crop_sampling::gl;
 };
 
 /// Time spent in the last process() call, milliseconds (0 for a stage that did not run).

@@ -1,23 +1,26 @@
-// MediaPipe's ImageToTensor (CPU path) as a job: a rotated, optionally letterboxed region of
-// an image resampled into a float RGB tensor, plus the transform that maps landmarks found in
-// that tensor back onto the image.
+// MediaPipe's ImageToTensor (its CPU or OpenGL converter's sampling) as a job: a rotated,
+// optionally letterboxed region of an image resampled into a float RGB tensor, plus the transform
+// that maps landmarks found in that tensor back onto the image.
 //
 // Conventions (shared with MediaPipe; docs/capture.md):
 // - Image pixel coordinates: x right, y down, pixel (i, j) sampled at the integer point (i, j)
 //   (OpenCV's convention). Normalised image coordinates are pixel coordinates divided by the
 //   image width and height: (0.5, 0.5) is the point (width / 2, height / 2).
-// - Tensor pixel coordinates: the same convention in the output tensor. The tensor pixel
-//   (x, y) is sampled at the source point  centre + R(rotation) * ((x / W - 0.5) * roi_width,
-//   (y / H - 0.5) * roi_height)  in image pixels, W x H being the tensor size. Note the x / W
-//   (not (x + 0.5) / W): MediaPipe's CPU converter maps the tensor's corner points 0 and W onto
-//   the ROI's edges (cv::boxPoints -> cv::getPerspectiveTransform -> cv::warpPerspective), so
-//   this crop follows it, half-pixel shift included.
+// - Tensor pixel coordinates: the same convention in the output tensor. With the CPU
+//   converter's sampling (crop_sampling::opencv), the tensor pixel (x, y) is sampled at the source
+//   point  centre + R(rotation) * ((x / W - 0.5) * roi_width, (y / H - 0.5) * roi_height)  in image
+//   pixels, W x H being the tensor size. Note the x / W (not (x + 0.5) / W): MediaPipe's CPU
+//   converter maps the tensor's corner points 0 and W onto the ROI's edges (cv::boxPoints ->
+//   cv::getPerspectiveTransform -> cv::warpPerspective), so this crop follows it, half-pixel shift
+//   included.
 // - rotation: radians; positive turns the ROI clockwise on screen (y down), as in
 //   MediaPipe's NormalizedRect.
 //
-// Sampling reproduces OpenCV's 8-bit INTER_LINEAR warp bit for bit (up to double rounding at
-// exact ties): source positions are rounded to 1/32 pixel, the four weights are 15-bit fixed
-// point, the result is rounded to 8 bits and then mapped to [range_min, range_max] as
+// With crop_sampling::opencv (MediaPipe's CPU converter), sampling reproduces OpenCV's 8-bit
+// INTER_LINEAR warp bit for bit (up to double rounding at exact ties); crop_sampling::gl (its
+// OpenGL converter) samples pixel centres instead, see there. CPU converter details: source
+// positions are rounded to 1/32 pixel, the four weights are 15-bit fixed point, the result is
+// rounded to 8 bits and then mapped to [range_min, range_max] as
 // value * (range_max - range_min) / 255 + range_min.
 #pragma once
 
@@ -46,6 +49,23 @@ enum class crop_border : std::uint8_t {
   zero,       // black, i.e. range_min (cv::BORDER_CONSTANT with value 0)
 };
 
+/// Where tensor pixels sample the image and how. MediaPipe's ImageToTensor has two converters
+/// whose results differ by a shift that grows with the region's scale (half a tensor pixel,
+/// less half an image pixel):
+enum class crop_sampling : std::uint8_t {
+  /// The CPU converter (OpenCV, MediaPipe's C++ / Python CPU graphs): tensor pixel x samples
+  /// the ROI at x / W (its corner points 0 and W on the ROI's edges), image pixel i at i; 8-bit
+  /// bilinear with 1/32-pixel positions, bit for bit as cv::warpPerspective.
+  opencv,
+  /// The OpenGL converter (MediaPipe's GPU graphs and its web solutions, WebGL 2): pixel
+  /// centres, tensor pixel x at (x + 0.5) / W of the ROI, image pixel i at i + 0.5; bilinear in
+  /// float (GL_LINEAR). replicate is GL_CLAMP_TO_EDGE; zero is MediaPipe's shader for contexts
+  /// without GL_CLAMP_TO_BORDER (OpenGL ES 3.0, WebGL 2): a sample whose position lies beyond
+  /// the image's outer edge (more than half a pixel outside the edge pixels' centres) is 0,
+  /// anything inside is sampled clamped to the edge.
+  gl,
+};
+
 /// Fixed options of a crop, usually one per model input.
 struct crop_options {
   int output_width = 256;   // tensor width W, > 0
@@ -57,6 +77,7 @@ struct crop_options {
   /// (MediaPipe's PadRoi).
   bool keep_aspect_ratio = true;
   crop_border border = crop_border::replicate;
+  crop_sampling sampling = crop_sampling::opencv;
 };
 
 /// A point in tensor pixels or normalised image coordinates; z in the same units as x.

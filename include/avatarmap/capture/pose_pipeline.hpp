@@ -70,6 +70,9 @@ struct pose_pipeline_options {
   /// Video mode (static_images false): how landmarks are smoothed over time
   /// (landmark_smoothing.hpp), using the frame's time out.t.
   pose_smoothing smoothing = pose_smoothing::velocity;
+  /// How the crops sample the image (image_crop.hpp): `gl`, MediaPipe's OpenGL converter (its
+  /// GPU and web graphs, which made the goldens: docs/capture.md), or `opencv`, its CPU one.
+  crop_sampling sampling = crop_sampling::gl;
 };
 
 /// Time spent in the last process() call, milliseconds (0 for a stage that did not run).

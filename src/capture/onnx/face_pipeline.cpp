@@ -174,6 +174,7 @@ status face_pipeline::create(const face_pipeline_options& options,
   m->mesh_crop.range_max = 1.f;
   m->mesh_crop.keep_aspect_ratio = false;
   m->mesh_crop.border = crop_border::replicate;
+  m->detector_crop.sampling = m->mesh_crop.sampling = options.sampling;
   out.reset(new face_pipeline(std::move(m)));
   return {};
 }

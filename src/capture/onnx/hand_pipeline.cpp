@@ -396,6 +396,7 @@ status hand_pipeline::create(const hand_pipeline_options& options,
   m->landmark_crop.range_min = 0.f;
   m->landmark_crop.range_max = 1.f;
   m->landmark_crop.border = crop_border::replicate;
+  m->palm_crop.sampling = m->landmark_crop.sampling = options.sampling;
   out.reset(new hand_pipeline(std::move(m)));
   return {};
 }

@@ -263,6 +263,7 @@ status pose_pipeline::create(const pose_pipeline_options& options,
   m->landmark_crop.range_min = 0.f;
   m->landmark_crop.range_max = 1.f;
   m->landmark_crop.border = crop_border::replicate;
+  m->detector_crop.sampling = m->landmark_crop.sampling = options.sampling;
   out.reset(new pose_pipeline(std::move(m)));
   return {};
 }
