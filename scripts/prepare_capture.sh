@@ -38,8 +38,9 @@ hand_landmark_full
 face_detection_short_range
 face_landmark
 LIST
-# FLOPs per inference of each model, for bench/bench_models.cpp's share of the CPU's peak.
-if [ ! -f "$models/onnx/flops.json" ] || [ -n "$(find "$models/onnx" -name '*.onnx' -newer "$models/onnx/flops.json")" ]; then
+# FLOPs per inference of each model, for bench/bench_models.cpp's share of the CPU's peak
+# (-maxdepth 1: not the optimised copies in onnx/ort-optimized/, docs/capture.md "Start-up").
+if [ ! -f "$models/onnx/flops.json" ] || [ -n "$(find "$models/onnx" -maxdepth 1 -name '*.onnx' -newer "$models/onnx/flops.json")" ]; then
   /usr/bin/python3 "$root/tools/models/count_flops.py" "$models/onnx"/*.onnx \
     --json "$models/onnx/flops.json" >/dev/null
 fi

@@ -105,7 +105,10 @@ int run_capture(int argc, char** argv) {
     return 2;
   }
   std::unique_ptr<estimator> est;
+  const auto startup_t0 = std::chrono::steady_clock::now();
   st = make_estimator(ec, est);
+  const std::chrono::duration<double, std::milli> startup =
+      std::chrono::steady_clock::now() - startup_t0;
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap capture: %s\n", st.message().c_str());
     return 1;
@@ -185,6 +188,7 @@ int run_capture(int argc, char** argv) {
   long frames = 0, errors = 0, part_frames[k_frame_part_count] = {};
   long rss_warm = 0, rss_peak = 0;
   timing_totals timings;
+  timings.startup_ms = startup.count();
   landmark_frame frame;
   estimate_args ea;
   ea.hands = ec.hands;

@@ -148,6 +148,7 @@ void timing_totals::add(const estimator_timings& t) {
 }
 
 void timing_totals::print(std::FILE* to) const {
+  if (startup_ms > 0) std::fprintf(to, "start-up: %.0f ms (models)\n", startup_ms);
   if (frames == 0) return;
   const double n = static_cast<double>(frames);
   std::fprintf(to, "per frame (ms, mean over %ld frames): all stages %.2f", frames,

@@ -41,8 +41,10 @@ struct timing_totals {
   estimator_timings sum{};
   long frames = 0;
   long pose_detector_frames = 0, palm_frames = 0, face_detector_frames = 0;
+  double startup_ms = 0;  // creating the estimator (loading the models); 0 = not measured
   void add(const estimator_timings& t);
-  /// Prints mean milliseconds per frame for each stage that ran.
+  /// Prints "start-up: N ms (models)" when measured, then mean milliseconds per frame for
+  /// each stage that ran.
   void print(std::FILE* to) const;
 };
 

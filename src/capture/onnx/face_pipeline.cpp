@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -140,22 +141,36 @@ status face_pipeline::create(const face_pipeline_options& options,
 
   std::unique_ptr<impl> m(new impl());
   m->options = options;
-  const std::string* loading = &det_path;
+  // Both sessions at once (start-up, model_cache.hpp); an ORT error names its model.
+  auto named = [](const std::string& path, const std::function<std::string()>& load) {
+    try {
+      return load();
+    } catch (const Ort::Exception& ex) {
+      return path + ": ONNX Runtime: " + ex.what();
+    }
+  };
+  std::string e;
   try {
     const Ort::SessionOptions so =
         make_session_options(options.intra_op_threads, options.allow_spinning);
-    std::string e =
-        m->detector.load(det_path, so, {1, k_face_detector_size, k_face_detector_size, 3},
-                         {k_detector_boxes * k_detector_coords, k_detector_boxes});
-    if (e.empty()) {
-      loading = &mesh_path;
-      e = m->mesh.load(mesh_path, so, {1, k_face_mesh_size, k_face_mesh_size, 3},
-                       {k_face_mesh_count * 3, 1});
-    }
-    if (!e.empty()) return status::error("face_pipeline: " + e);
+    e = load_in_parallel(
+        [&] {
+          return named(det_path, [&] {
+            return m->detector.load(det_path, so,
+                                    {1, k_face_detector_size, k_face_detector_size, 3},
+                                    {k_detector_boxes * k_detector_coords, k_detector_boxes});
+          });
+        },
+        [&] {
+          return named(mesh_path, [&] {
+            return m->mesh.load(mesh_path, so, {1, k_face_mesh_size, k_face_mesh_size, 3},
+                                {k_face_mesh_count * 3, 1});
+          });
+        });
   } catch (const Ort::Exception& ex) {
-    return status::error("face_pipeline: " + *loading + ": ONNX Runtime: " + ex.what());
+    return status::error("face_pipeline: ONNX Runtime: " + std::string(ex.what()));
   }
+  if (!e.empty()) return status::error("face_pipeline: " + e);
   generate_ssd_anchors(face_detection_anchor_options(), m->anchors);
   m->decode = face_detection_decode_options(options.min_detection_score);
   m->decoded.reserve(m->anchors.size());

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -365,21 +366,36 @@ status hand_pipeline::create(const hand_pipeline_options& options,
 
   std::unique_ptr<impl> m(new impl());
   m->options = options;
-  const std::string* current = &palm_path;
+  // Both sessions at once (start-up, model_cache.hpp); an ORT error names its model.
+  auto named = [](const std::string& path, const std::function<std::string()>& load) {
+    try {
+      return load();
+    } catch (const Ort::Exception& ex) {
+      return path + ": ONNX Runtime: " + ex.what();
+    }
+  };
+  std::string e;
   try {
     const Ort::SessionOptions so =
         make_session_options(options.intra_op_threads, options.allow_spinning);
-    std::string e = m->palm.load(palm_path, so, {1, k_palm_size, k_palm_size, 3},
-                                 {k_palm_boxes * k_palm_coords, k_palm_boxes});
-    if (e.empty()) {
-      current = &lm_path;
-      e = m->hand_model.load_in_order(lm_path, so, {1, k_landmark_size, k_landmark_size, 3},
-                                      {3 * k_hand_landmark_count, 1, 1, 3 * k_hand_landmark_count});
-    }
-    if (!e.empty()) return status::error("hand_pipeline: " + e);
+    e = load_in_parallel(
+        [&] {
+          return named(palm_path, [&] {
+            return m->palm.load(palm_path, so, {1, k_palm_size, k_palm_size, 3},
+                                {k_palm_boxes * k_palm_coords, k_palm_boxes});
+          });
+        },
+        [&] {
+          return named(lm_path, [&] {
+            return m->hand_model.load_in_order(
+                lm_path, so, {1, k_landmark_size, k_landmark_size, 3},
+                {3 * k_hand_landmark_count, 1, 1, 3 * k_hand_landmark_count});
+          });
+        });
   } catch (const Ort::Exception& ex) {
-    return status::error("hand_pipeline: " + *current + ": ONNX Runtime: " + ex.what());
+    return status::error("hand_pipeline: ONNX Runtime: " + std::string(ex.what()));
   }
+  if (!e.empty()) return status::error("hand_pipeline: " + e);
   generate_ssd_anchors(palm_detection_anchor_options(), m->anchors);
   m->decode = palm_detection_decode_options();
   m->decode.min_score_thresh = options.min_detection_score;

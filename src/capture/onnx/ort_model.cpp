@@ -72,7 +72,9 @@ Ort::SessionOptions make_session_options(int threads, bool allow_spinning) {
 
 std::string bound_model::open(const std::string& path, const Ort::SessionOptions& so,
                               const std::vector<int64_t>& input_shape) {
-  session = std::make_unique<Ort::Session>(ort_env(), path.c_str(), so);
+  cached_session cs = open_cached_session(ort_env(), path, so, model_cache_dir(path));
+  session = std::move(cs.session);
+  cache_use = cs.use;
   Ort::AllocatorWithDefaultOptions alloc;
   if (session->GetInputCount() != 1) return path + ": expected one input";
   input_name = session->GetInputNameAllocated(0, alloc).get();

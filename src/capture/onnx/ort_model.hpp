@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "avatarmap/capture/image_crop.hpp"
+#include "model_cache.hpp"
 
 namespace avatarmap {
 
@@ -56,6 +57,7 @@ struct bound_model {
   std::vector<std::vector<float>> outputs;
   std::vector<Ort::Value> output_values;
   Ort::Value input_value{nullptr};
+  model_cache_use cache_use = model_cache_use::off;  // where load() took the graph from
 
   // Loads `path` and binds the outputs whose element counts are `counts` (each must match
   // exactly one output). Throws Ort::Exception; returns a message on a shape mismatch.

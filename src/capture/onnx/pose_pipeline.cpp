@@ -230,15 +230,19 @@ status pose_pipeline::create(const pose_pipeline_options& options,
   try {
     const Ort::SessionOptions so =
         make_session_options(options.intra_op_threads, options.allow_spinning);
-    std::string e =
-        m->detector.load(det_path, so, {1, k_detector_size, k_detector_size, 3}, {2254 * 12, 2254});
-    if (e.empty()) {
-      std::vector<bool> found;
-      e = m->landmark.load(lm_path, so, {1, k_landmark_size, k_landmark_size, 3},
-                           {k_landmark_points * 5, 1, k_landmark_points * 3},
-                           {k_heatmap_size * k_heatmap_size * k_landmark_points}, &found);
-      m->has_heatmap = !found.empty() && found[0];
-    }
+    std::vector<bool> found;
+    // Both sessions at once (start-up, model_cache.hpp).
+    const std::string e = load_in_parallel(
+        [&] {
+          return m->detector.load(det_path, so, {1, k_detector_size, k_detector_size, 3},
+                                  {2254 * 12, 2254});
+        },
+        [&] {
+          return m->landmark.load(lm_path, so, {1, k_landmark_size, k_landmark_size, 3},
+                                  {k_landmark_points * 5, 1, k_landmark_points * 3},
+                                  {k_heatmap_size * k_heatmap_size * k_landmark_points}, &found);
+        });
+    m->has_heatmap = !found.empty() && found[0];
     if (!e.empty()) return status::error("pose_pipeline: " + e);
   } catch (const Ort::Exception& ex) {
     return status::error("pose_pipeline: ONNX Runtime: " + std::string(ex.what()));
