@@ -1,12 +1,12 @@
 // Latency of each converted MediaPipe model under ONNX Runtime, 1 and 2 threads, and the
 // share of the CPU's peak floating-point rate it reaches. Built with AVATARMAP_WITH_ONNX.
 //
-// Models: $AVATARMAP_MODELS/onnx (scripts/prepare_capture.sh); FLOPs per inference from the
-// flops.json it writes there (tools/models/count_flops.py: 2 per multiply-add of the Conv,
-// Gemm and MatMul layers). Peak: BM_fma_peak measures one core's FMA throughput (8
-// independent 8-wide accumulator chains); the share is the model's FLOP rate over
-// threads x that peak (peak_pct, percent). Inputs are random; outputs are bound once (no allocation
-// per run).
+// Models: $AVATARMAP_MODELS/onnx (scripts/prepare_capture.sh; float and int8); FLOPs per
+// inference from the flops.json it writes there (tools/models/count_flops.py: 2 per
+// multiply-add of the Conv, Gemm and MatMul layers). Peak: BM_fma_peak measures one core's
+// FMA throughput (8 independent 8-wide accumulator chains); the share is the model's FLOP rate
+// over threads x that peak (peak_pct, percent). Inputs are random; outputs are bound once (no
+// allocation per run).
 #include <benchmark/benchmark.h>
 #include <immintrin.h>
 #include <onnxruntime_cxx_api.h>
@@ -174,14 +174,17 @@ const char* const k_models[] = {
     "hand_landmark_lite",  "hand_landmark_full",  "face_detection_short_range",
     "face_landmark"};
 
+// Each model in float and, next to it, its int8 version (<name>.int8.onnx, docs/capture.md
+// "int8 models"; no FLOP counters: the peak above is a float one).
 const bool k_registered = [] {
   for (const char* n : k_models)
-    benchmark::RegisterBenchmark((std::string("BM_model/") + n).c_str(),
-                                 [n](benchmark::State& s) { BM_model(s, n); })
-        ->Arg(1)
-        ->Arg(2)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
+    for (const std::string name : {std::string(n), std::string(n) + ".int8"})
+      benchmark::RegisterBenchmark(("BM_model/" + name).c_str(),
+                                   [name](benchmark::State& s) { BM_model(s, name); })
+          ->Arg(1)
+          ->Arg(2)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
   return true;
 }();
 

@@ -10,6 +10,8 @@ const char* const k_estimator_options_help =
     "  --hands / --no-hands  estimate both hands (21 points each, image + world)\n"
     "  --face / --no-face    estimate the face mesh (468 points)\n"
     "  --hand-model lite|full  hand landmark model (default full)\n"
+    "  --precision float|int8  model precision (default float): int8 loads the int8 models\n"
+    "                        scripts/prepare_capture.sh builds (faster; docs/capture.md)\n"
     "  --mirrored            the input is mirrored (a selfie preview); sides stay the person's\n"
     "  --threads N           threads for the models (default 2; 1 is better when another\n"
     "                        process keeps a core busy)\n"
@@ -75,8 +77,9 @@ bool parse_estimator_options(args& a, bool hands_face_default, estimator_options
                              std::string& error) {
   estimator_options& o = out;
   o.source = default_models_dir();
-  std::string model = "full", hand_model = "full";
+  std::string model = "full", hand_model = "full", precision = "float";
   a.value("--model", model);
+  a.value("--precision", precision);
   a.value("--hand-model", hand_model);
   a.value("--models", o.source);
   double threads = 2, lanes = 2;
@@ -101,6 +104,11 @@ bool parse_estimator_options(args& a, bool hands_face_default, estimator_options
     error = "--hand-model is lite or full";
     return false;
   }
+  if (precision != "float" && precision != "int8") {
+    error = "--precision is float or int8";
+    return false;
+  }
+  o.precision = precision == "int8" ? model_precision::int8 : model_precision::float32;
   if (!(threads >= 1 && threads <= 64)) {
     error = "--threads must be 1..64";
     return false;

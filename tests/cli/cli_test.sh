@@ -204,6 +204,8 @@ case $case_name in
     run 2 capture in.mp4 -o out.landmarks.jsonl --model huge
     expect_in err.txt "--model is lite, full or heavy"
     run 2 capture in.mp4 -o out.landmarks.jsonl --hand-model heavy
+    run 2 capture in.mp4 -o out.landmarks.jsonl --precision fp16
+    expect_in err.txt "--precision is float or int8"
     run 2 capture in.mp4 -o out.landmarks.jsonl --loop 0
     run 1 capture missing.mp4 -o out.landmarks.jsonl
     expect_in err.txt "missing.mp4"
@@ -244,6 +246,17 @@ case $case_name in
       run 1 capture "$tfjs/pose.jpg" -o bad.landmarks.jsonl --models bad
       expect_in err.txt "pose_landmark_full.onnx"
       [ -e bad.landmarks.jsonl ] && fail "a failed capture wrote its output"
+      # int8 models missing: the error names the file and the script that builds them.
+      run 1 capture "$tfjs/pose.jpg" -o bad.landmarks.jsonl --models bad --precision int8
+      expect_in err.txt "pose_detection.int8.onnx"
+      expect_in err.txt "scripts/prepare_capture.sh"
+      [ -e bad.landmarks.jsonl ] && fail "a failed capture wrote its output"
+      # int8 models present (scripts/prepare_capture.sh builds them): the body is found.
+      if [ -f "$models/pose_landmark_full.int8.onnx" ]; then
+        run 0 capture "$tfjs/pose.jpg" -o int8.landmarks.jsonl --models "$models" --static \
+          --precision int8
+        expect_in err.txt "found: body in 1 frames"
+      fi
       # No person: a black image gives a frame with no parts.
       if command -v /usr/bin/python3 >/dev/null; then
         /usr/bin/python3 -c "

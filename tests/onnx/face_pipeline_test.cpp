@@ -183,8 +183,11 @@ TEST(face_pipeline, empty_black_and_bodiless_images) {
 
 // ---- portrait.jpg against Google's face mesh -----------------------------------------------
 
-TEST(face_pipeline, portrait_vs_mediapipe_face_mesh) {
+// portrait.jpg against the golden, float or int8 models (docs/capture.md "int8 models").
+void check_portrait(model_precision precision) {
   REQUIRE_MODELS_AND_DATA();
+  if (!test::has_model("face_landmark", precision))
+    GTEST_SKIP() << "no int8 models (scripts/prepare_capture.sh builds them)";
   loaded_image img;
   ASSERT_TRUE(load_image(test::test_data_path("motion/tfjs-models/portrait.jpg"), img));
   const nlohmann::json golden = load_json(test::test_data_path("golden/portrait_facemesh.json"));
@@ -200,6 +203,7 @@ TEST(face_pipeline, portrait_vs_mediapipe_face_mesh) {
   face_pipeline_options o;
   o.models_dir = models_dir();
   o.roi_source = face_roi_source::detector;
+  o.precision = precision;
   std::unique_ptr<face_pipeline> p;
   const status s = face_pipeline::create(o, p);
   ASSERT_TRUE(s.ok()) << s.message();
@@ -315,6 +319,9 @@ TEST(face_pipeline, portrait_vs_mediapipe_face_mesh) {
   EXPECT_LT(f.face[1].z, f.face[234].z);
   EXPECT_LT(f.face[1].z, f.face[454].z);
 }
+
+TEST(face_pipeline, portrait_vs_mediapipe_face_mesh) { check_portrait(model_precision::float32); }
+TEST(face_pipeline, portrait_vs_mediapipe_face_mesh_int8) { check_portrait(model_precision::int8); }
 
 // ---- video with the body's face points as the hint -----------------------------------------
 

@@ -26,6 +26,10 @@ bool load_image(const std::string& path, loaded_image& out) {
   return true;
 }
 
+bool has_model(const std::string& stem, model_precision precision) {
+  return std::ifstream(models_dir() + "/" + model_file_name(stem, precision)).good();
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];

@@ -22,4 +22,7 @@ bool load_image(const std::string& path, loaded_image& out);
 
 double median(std::vector<double> v);
 
+/// Whether models_dir() holds `stem` at `precision` (stem.onnx or stem.int8.onnx).
+bool has_model(const std::string& stem, model_precision precision);
+
 }  // namespace avatarmap::test

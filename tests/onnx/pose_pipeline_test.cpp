@@ -45,10 +45,14 @@ TEST(pose_pipeline, create_reports_missing_models) {
   EXPECT_FALSE(pose_pipeline::create(o, p).ok());
 }
 
-TEST(pose_pipeline, pose_jpg_vs_mediapipe_wasm_full) {
+// pose.jpg against the golden with the float models or their int8 versions (which must hold
+// the same tolerances; docs/capture.md "int8 models").
+void check_pose_jpg(model_precision precision) {
   const std::string models = models_dir();
   if (models.empty()) GTEST_SKIP() << "AVATARMAP_MODELS is not set (folder of converted models)";
   if (test::test_data_dir().empty()) GTEST_SKIP() << test::k_no_test_data;
+  if (!std::ifstream(models + "/" + model_file_name("pose_landmark_full", precision)).good())
+    GTEST_SKIP() << "no int8 models (scripts/prepare_capture.sh builds them)";
   loaded_image img;
   ASSERT_TRUE(load_image(test::test_data_path("motion/tfjs-models/pose.jpg"), img));
   std::ifstream gf(test::test_data_path("golden/pose_jpg_full.json"));
@@ -64,6 +68,7 @@ TEST(pose_pipeline, pose_jpg_vs_mediapipe_wasm_full) {
   pose_pipeline_options o;
   o.models_dir = models;
   o.complexity = pose_model_complexity::full;
+  o.precision = precision;
   std::unique_ptr<pose_pipeline> p;
   status s = pose_pipeline::create(o, p);
   ASSERT_TRUE(s.ok()) << s.message();
@@ -145,6 +150,9 @@ TEST(pose_pipeline, pose_jpg_vs_mediapipe_wasm_full) {
   EXPECT_NEAR((f.pose_world[23].x + f.pose_world[24].x) * 0.5f, 0.f, 0.02f);
   EXPECT_NEAR((f.pose_world[23].y + f.pose_world[24].y) * 0.5f, 0.f, 0.02f);
 }
+
+TEST(pose_pipeline, pose_jpg_vs_mediapipe_wasm_full) { check_pose_jpg(model_precision::float32); }
+TEST(pose_pipeline, pose_jpg_vs_mediapipe_wasm_full_int8) { check_pose_jpg(model_precision::int8); }
 
 TEST(pose_pipeline, latency) {
   const std::string models = models_dir();

@@ -5,11 +5,13 @@
 //   g++ -O2 -std=c++17 -I$ORT_INCLUDE tools/convert/ort_run.cpp \
 //       -L$ORT_LIB -l:libonnxruntime.so.1 -Wl,-rpath,$ORT_LIB -o ort_run
 //
-// Usage: ort_run MODEL.onnx OUT_DIR [--threads N] [--bench N] IN0.bin [IN1.bin ...]
+// Usage: ort_run MODEL.onnx OUT_DIR [--threads N] [--bench N] [--optimized PATH] IN0.bin [...]
 // Each INk.bin holds the k-th model input as raw little-endian float32 in the
 // model's (static) input shape.  Each output k is written to OUT_DIR/k.bin as
 // raw float32; one line per output "k name d0xd1x..." goes to stdout.  With
-// --bench N the model is run N more times and the median latency is printed.
+// --bench N the model is run N more times and the median latency is printed.  With
+// --optimized PATH the graph as ORT optimised it is saved there (to see which QDQ nodes of
+// an int8 model were fused into QLinear* kernels, docs/convert.md).
 #include <onnxruntime_cxx_api.h>
 
 #include <algorithm>
@@ -33,11 +35,13 @@ static std::vector<float> read_floats(const std::string& path, size_t count) {
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::cerr << "usage: ort_run MODEL.onnx OUT_DIR [--threads N] [--bench N] IN0.bin [...]\n";
+    std::cerr << "usage: ort_run MODEL.onnx OUT_DIR [--threads N] [--bench N] [--optimized PATH] "
+                 "IN0.bin [...]\n";
     return 2;
   }
   std::string model = argv[1], out_dir = argv[2];
   int threads = 1, bench = 0;
+  std::string optimized;
   std::vector<std::string> in_files;
   for (int i = 3; i < argc; ++i) {
     std::string a = argv[i];
@@ -45,6 +49,8 @@ int main(int argc, char** argv) {
       threads = std::atoi(argv[++i]);
     else if (a == "--bench" && i + 1 < argc)
       bench = std::atoi(argv[++i]);
+    else if (a == "--optimized" && i + 1 < argc)
+      optimized = argv[++i];
     else
       in_files.push_back(a);
   }
@@ -54,6 +60,7 @@ int main(int argc, char** argv) {
     so.SetIntraOpNumThreads(threads);
     so.SetInterOpNumThreads(1);
     so.SetGraphOptimizationLevel(GraphOptimizationLevel::ORT_ENABLE_ALL);
+    if (!optimized.empty()) so.SetOptimizedModelFilePath(optimized.c_str());
     Ort::Session session(env, model.c_str(), so);
     Ort::AllocatorWithDefaultOptions alloc;
     size_t n_in = session.GetInputCount(), n_out = session.GetOutputCount();

@@ -51,6 +51,16 @@ struct estimate_args {
   bool face = true;
 };
 
+/// Numeric precision of the ONNX models: the float conversions (<model>.onnx) or their int8
+/// versions (<model>.int8.onnx: weights int8 per channel, activations uint8 from ranges
+/// calibrated on real frames; scripts/prepare_capture.sh builds them, docs/convert.md).
+enum class model_precision : std::uint8_t { float32, int8 };
+
+/// The model file name for `precision`: `stem` + ".onnx" or `stem` + ".int8.onnx".
+inline std::string model_file_name(std::string_view stem, model_precision precision) {
+  return std::string(stem) + (precision == model_precision::int8 ? ".int8.onnx" : ".onnx");
+}
+
 /// Options given when a backend is created; a struct for the same reason.
 struct estimator_options {
   std::string source;  // replay: the *.landmarks.jsonl path; onnx: the models folder
@@ -71,6 +81,8 @@ struct estimator_options {
   /// frame side by side, and in estimate_pipelined() the body of the next frame beside them.
   /// 1: one lane, every model on all `threads` ORT threads (docs/capture.md, "Two lanes").
   int lanes = 2;
+  /// onnx: the models' precision, for every model (docs/capture.md "int8 models").
+  model_precision precision = model_precision::float32;
 };
 
 /// Where the time of the last estimate() went, milliseconds (0 for a stage that did not run).

@@ -112,6 +112,8 @@ struct face_pipeline_options {
   /// tools/convert/tflite2onnx.py).
   std::string models_dir;
   face_roi_source roi_source = face_roi_source::automatic;
+  /// float32: face_detection_short_range.onnx etc.; int8: *.int8.onnx.
+  model_precision precision = model_precision::float32;
   int intra_op_threads = 1;          // ORT intra-op threads, >= 1
   bool allow_spinning = false;       // ORT's spinning thread pool; off: better on shared cores
   float min_detection_score = 0.5f;  // detector score threshold, (0, 1)

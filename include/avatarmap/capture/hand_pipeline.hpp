@@ -119,6 +119,8 @@ struct hand_pipeline_options {
   /// are used (roi_source = pose), so that the source can change per frame.
   std::string models_dir;
   hand_model_complexity complexity = hand_model_complexity::full;
+  /// float32: palm_detection_<c>.onnx etc.; int8: palm_detection_<c>.int8.onnx etc.
+  model_precision precision = model_precision::float32;
   int max_hands = 2;  // 1 or 2
   hand_roi_source roi_source = hand_roi_source::automatic;
   /// false (the default): the images are raw camera images (not mirrored), so the person's

@@ -61,6 +61,8 @@ struct pose_pipeline_options {
   /// RefineLandmarksFromHeatmap does, at about +1 ms per frame).
   std::string models_dir;
   pose_model_complexity complexity = pose_model_complexity::full;
+  /// float32: pose_detection.onnx etc.; int8: pose_detection.int8.onnx etc.
+  model_precision precision = model_precision::float32;
   int intra_op_threads = 1;     // ORT intra-op threads, >= 1
   bool allow_spinning = false;  // ORT's spinning thread pool; off: better when cores are shared
   float min_detection_score = 0.5f;  // detector score threshold, (0, 1)

@@ -132,12 +132,13 @@ status face_pipeline::create(const face_pipeline_options& options,
   if (!(options.pose_region_scale > 0.f && options.pose_region_scale <= 100.f))
     return status::error("face_pipeline: pose_region_scale must be in (0, 100]");
   const std::string dir = options.models_dir.empty() ? "." : options.models_dir;
-  const std::string det_path = dir + "/face_detection_short_range.onnx";
-  const std::string mesh_path = dir + "/face_landmark.onnx";
+  const std::string det_path =
+      dir + "/" + model_file_name("face_detection_short_range", options.precision);
+  const std::string mesh_path = dir + "/" + model_file_name("face_landmark", options.precision);
   for (const std::string& p : {det_path, mesh_path})
     if (!std::ifstream(p).good())
       return status::error("face_pipeline: cannot open " + p +
-                           " (convert it with tools/convert/tflite2onnx.py, docs/convert.md)");
+                           missing_model_hint(options.precision));
 
   std::unique_ptr<impl> m(new impl());
   m->options = options;

@@ -356,13 +356,17 @@ status hand_pipeline::create(const hand_pipeline_options& options,
         "[0, 1]");
   const std::string dir = options.models_dir.empty() ? "." : options.models_dir;
   const std::string palm_path =
-      dir + "/palm_detection_" + complexity_name(options.complexity) + ".onnx";
+      dir + "/" +
+      model_file_name(std::string("palm_detection_") + complexity_name(options.complexity),
+                      options.precision);
   const std::string lm_path =
-      dir + "/hand_landmark_" + complexity_name(options.complexity) + ".onnx";
+      dir + "/" +
+      model_file_name(std::string("hand_landmark_") + complexity_name(options.complexity),
+                      options.precision);
   for (const std::string& p : {palm_path, lm_path})
     if (!std::ifstream(p).good())
       return status::error("hand_pipeline: cannot open " + p +
-                           " (convert it with tools/convert/tflite2onnx.py, docs/convert.md)");
+                           missing_model_hint(options.precision));
 
   std::unique_ptr<impl> m(new impl());
   m->options = options;

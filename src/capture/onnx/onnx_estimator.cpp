@@ -241,6 +241,7 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
   po.intra_op_threads = threads;
   po.allow_spinning = options.spin;
   po.complexity = static_cast<pose_model_complexity>(options.model_complexity);
+  po.precision = options.precision;
   po.static_images = options.static_images;
   std::unique_ptr<pose_pipeline> pose;
   status s = pose_pipeline::create(po, pose);
@@ -252,6 +253,7 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
     ho.models_dir = options.source;
     ho.intra_op_threads = threads;
     ho.complexity = static_cast<hand_model_complexity>(options.hand_model_complexity);
+    ho.precision = options.precision;
     ho.mirrored_input = options.mirrored_input;
     ho.allow_spinning = po.allow_spinning;
     ho.static_images = options.static_images;
@@ -262,6 +264,7 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
   if (options.face) {
     face_pipeline_options fo;
     fo.models_dir = options.source;
+    fo.precision = options.precision;
     fo.intra_op_threads = threads;
     fo.allow_spinning = po.allow_spinning;
     fo.static_images = options.static_images;

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "avatarmap/capture/estimator.hpp"
 #include "avatarmap/capture/image_crop.hpp"
 #include "model_cache.hpp"
 
@@ -24,6 +25,15 @@ inline double ms_since(std::chrono::steady_clock::time_point t0) {
 }
 
 inline float sigmoid(float x) { return 1.f / (1.f + std::exp(-x)); }
+
+/// What to do about a model file that is missing, for the pipelines' error messages: int8
+/// models are built by scripts/prepare_capture.sh, float ones converted by it.
+inline std::string missing_model_hint(model_precision precision) {
+  return precision == model_precision::int8
+             ? " (int8 models are built from the float ones by scripts/prepare_capture.sh; "
+               "docs/convert.md)"
+             : " (convert it with tools/convert/tflite2onnx.py, docs/convert.md)";
+}
 
 /// How many bound_model::run() calls are under way on this thread (0 or 1): lets a test
 /// count the heap allocations of the pipelines outside ONNX Runtime.

@@ -217,13 +217,15 @@ status pose_pipeline::create(const pose_pipeline_options& options,
       !e.empty())
     return status::error(e);
   const std::string dir = options.models_dir.empty() ? "." : options.models_dir;
-  const std::string det_path = dir + "/pose_detection.onnx";
+  const std::string det_path = dir + "/" + model_file_name("pose_detection", options.precision);
   const std::string lm_path =
-      dir + "/pose_landmark_" + complexity_name(options.complexity) + ".onnx";
+      dir + "/" +
+      model_file_name(std::string("pose_landmark_") + complexity_name(options.complexity),
+                      options.precision);
   for (const std::string& p : {det_path, lm_path})
     if (!std::ifstream(p).good())
       return status::error("pose_pipeline: cannot open " + p +
-                           " (convert it with tools/convert/tflite2onnx.py, docs/convert.md)");
+                           missing_model_hint(options.precision));
 
   std::unique_ptr<impl> m(new impl());
   m->options = options;
