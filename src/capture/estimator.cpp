@@ -8,6 +8,15 @@
 
 namespace avatarmap {
 
+bool cpu_has_vnni() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx512vnni") || __builtin_cpu_supports("avxvnni");
+#else
+  return false;
+#endif
+}
+
 status replay_estimator::open(const std::string& path, std::unique_ptr<replay_estimator>& out) {
   out.reset();
   std::unique_ptr<replay_estimator> r(new replay_estimator());

@@ -287,6 +287,7 @@ int run_capture(int argc, char** argv) {
                  part_frames[static_cast<int>(frame_part::right_hand)]);
   if (ea.face) std::fprintf(stderr, ", face %ld", part_frames[static_cast<int>(frame_part::face)]);
   std::fputc('\n', stderr);
+  if (const std::string d = est->describe(); !d.empty()) std::fprintf(stderr, "%s\n", d.c_str());
   timings.print(stderr);
   if (rss_warm > 0) {
     rss_peak = std::max(rss_peak, resident_kib());

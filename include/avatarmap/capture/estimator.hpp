@@ -54,7 +54,14 @@ struct estimate_args {
 /// Numeric precision of the ONNX models: the float conversions (<model>.onnx) or their int8
 /// versions (<model>.int8.onnx: weights int8 per channel, activations uint8 from ranges
 /// calibrated on real frames; scripts/prepare_capture.sh builds them, docs/convert.md).
+/// float32 is the default: int8 is faster but leaves Google's tolerances on some references,
+/// and on CPUs without VNNI on most (docs/capture.md "int8 models").
 enum class model_precision : std::uint8_t { float32, int8 };
+
+/// Whether this CPU has VNNI (AVX512-VNNI or AVX-VNNI): ONNX Runtime's int8 kernels then
+/// accumulate in 32 bits; without it (AVX2 only) its u8s8 kernels saturate 16-bit sums and the
+/// int8 models leave the tolerances much further (docs/capture.md).
+bool cpu_has_vnni();
 
 /// The model file name for `precision`: `stem` + ".onnx" or `stem` + ".int8.onnx".
 inline std::string model_file_name(std::string_view stem, model_precision precision) {
@@ -109,6 +116,8 @@ class estimator {
   /// Per-stage timings of the last estimate(), or nullptr for a backend without stages.
   /// After estimate_pipelined(): those of the frame it gave back.
   virtual const estimator_timings* last_timings() const { return nullptr; }
+  /// What the backend runs, in words (e.g. which models at which precision), or "".
+  virtual std::string describe() const { return {}; }
 
   /// Pipelined estimation, for files and other sources whose frames can wait: hands frame
   /// `in` over and gives back, in `out`, the oldest frame that is finished (`ready` true), or

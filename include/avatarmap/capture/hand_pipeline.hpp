@@ -152,6 +152,11 @@ struct hand_pipeline_options {
   /// moving hand leaves last frame's region; this keeps it tracked (one landmark run)
   /// instead of lost and found again from the body (two runs).
   bool follow_body_motion = true;
+  /// No work on hands that are not there: a side whose region from the body held no hand is
+  /// looked for again from the body only after this many seconds (frame times given to
+  /// process(); at 30 frames/s 0.1 s tries every third frame, at 10 frames/s or less every
+  /// frame). 0: every frame, as MediaPipe's Holistic. Not with static_images or without `t`.
+  double retry_after_miss_seconds = 0.1;
   /// How the crops sample the image (image_crop.hpp): `gl`, MediaPipe's OpenGL converter (its
   /// GPU and web graphs, which made the goldens: docs/capture.md), or `opencv`, its CPU one.
   crop_sampling sampling = crop_sampling::gl;
@@ -205,8 +210,10 @@ class hand_pipeline {
   /// units of the image width (MediaPipe's, normalize_z 0.4 included); world points are
   /// metres, rotated back to the image's axes. When two palm-detected hands claim the same
   /// side, the one whose handedness is more certain keeps it and the other takes the other
-  /// side. No allocation in the steady state (outside ORT).
-  hand_result process(const image_view& image, const landmark_frame* body, landmark_frame& out);
+  /// side. `t`: the frame's time in seconds (for retry_after_miss_seconds; negative: unknown,
+  /// every side is tried every frame). No allocation in the steady state (outside ORT).
+  hand_result process(const image_view& image, const landmark_frame* body, landmark_frame& out,
+                      double t = -1.0);
 
   /// Forgets the tracked hands: the next frame starts afresh.
   void reset();

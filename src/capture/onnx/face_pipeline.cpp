@@ -47,6 +47,7 @@ struct face_pipeline::impl {
   // Centre of the body's face region on the previous frame (follow_body_motion).
   bool has_body_center = false;
   float body_center_x = 0.f, body_center_y = 0.f;
+  double missed_at = -1.0;  // when the last search found no face (-1: it did, or none yet)
   float presence = 0.f;
   bool ran_detector = false;
   face_acquisition acquisition = face_acquisition::none;
@@ -131,6 +132,9 @@ status face_pipeline::create(const face_pipeline_options& options,
     return status::error(e);
   if (!(options.pose_region_scale > 0.f && options.pose_region_scale <= 100.f))
     return status::error("face_pipeline: pose_region_scale must be in (0, 100]");
+  if (!(options.retry_after_miss_seconds >= 0.0) ||
+      !std::isfinite(options.retry_after_miss_seconds))
+    return status::error("face_pipeline: retry_after_miss_seconds must be finite and >= 0");
   const std::string dir = options.models_dir.empty() ? "." : options.models_dir;
   const std::string det_path =
       dir + "/" + model_file_name("face_detection_short_range", options.precision);
@@ -196,8 +200,9 @@ status face_pipeline::create(const face_pipeline_options& options,
 }
 
 face_result face_pipeline::process(const image_view& image, const landmark_frame* body,
-                                   landmark_frame& out) {
+                                   landmark_frame& out, double t) {
   impl& m = *impl_;
+  const double now = std::isfinite(t) ? t : -1.0;
   m.timings = {};
   m.error.clear();
   m.ran_detector = false;
@@ -235,6 +240,13 @@ face_result face_pipeline::process(const image_view& image, const landmark_frame
     m.acquisition = face_acquisition::tracked;
     if (!m.has_roi || m.options.static_images) {
       m.has_roi = false;
+      // A search that found nothing a moment ago: wait (retry_after_miss_seconds).
+      if (!m.options.static_images && now >= 0.0 && m.missed_at >= 0.0 && now >= m.missed_at &&
+          now - m.missed_at < m.options.retry_after_miss_seconds) {
+        m.acquisition = face_acquisition::none;
+        return face_result::not_found;
+      }
+      m.missed_at = now;  // until the mesh below accepts what the search found
       bool found = false;
       if (has_body_region) {
         m.acquisition = face_acquisition::detector_region;
@@ -258,6 +270,7 @@ face_result face_pipeline::process(const image_view& image, const landmark_frame
     m.error = std::string("face_pipeline: ONNX Runtime: ") + ex.what();
     return face_result::error;
   }
+  m.missed_at = -1.0;
   out.face_count = k_face_mesh_count;
   out.set(frame_part::face, true);
   return face_result::found;
@@ -266,6 +279,7 @@ face_result face_pipeline::process(const image_view& image, const landmark_frame
 void face_pipeline::reset() {
   impl_->has_roi = false;
   impl_->has_body_center = false;
+  impl_->missed_at = -1.0;
 }
 const normalized_rect& face_pipeline::last_roi() const { return impl_->used_roi; }
 bool face_pipeline::tracking() const { return impl_->has_roi; }

@@ -95,6 +95,9 @@ struct hand_pipeline::impl {
   std::array<hand_observation, k_max_hands> hands{};
   std::array<normalized_rect, k_max_hands> next_rois{};
   int hand_count = 0;
+  // Per side (left, right): when its last region from the body held no hand (-1: never).
+  std::array<double, 2> missed_at{-1.0, -1.0};
+  double now = -1.0;  // this frame's time (process()'s t)
   bool ran_palm = false;
   hand_timings timings;
   std::string error;
@@ -201,6 +204,14 @@ struct hand_pipeline::impl {
     return sq_distance_px(h.image[0].x, h.image[0].y, w.x, w.y, image.width, image.height);
   }
 
+  // Whether `side`'s region from the body held no hand less than retry_after_miss_seconds
+  // ago (a clock that went back, or no clock, never skips).
+  bool recently_missed(body_side side) const {
+    const double at = missed_at[side == body_side::left ? 0 : 1];
+    return !options.static_images && now >= 0.0 && at >= 0.0 && now >= at &&
+           now - at < options.retry_after_miss_seconds;
+  }
+
   hand_result run(const image_view& image, const landmark_frame* body, landmark_frame& out) {
     const bool has_body = body != nullptr && body->has(frame_part::pose);
     const bool use_pose = options.roi_source == hand_roi_source::pose ||
@@ -241,7 +252,7 @@ struct hand_pipeline::impl {
           for (int i = 0; i < n; ++i)
             tracked = tracked || (candidates[i].side_known && candidates[i].side == side);
           normalized_rect r;
-          if (tracked ||
+          if (tracked || recently_missed(side) ||
               !hand_roi_from_pose(*body, side, image.width, image.height, r, options.pose_roi))
             continue;
           if (overlaps_any(r, n, image)) continue;
@@ -261,6 +272,9 @@ struct hand_pipeline::impl {
     hand_count = 0;
     for (int i = 0; i < n; ++i) {
       hand_observation& h = hands[hand_count];
+      const bool from_body = candidates[i].origin == hand_roi_origin::pose;
+      const int side_index = candidates[i].side == body_side::left ? 0 : 1;
+      if (from_body) missed_at[side_index] = now;  // until a hand is found below
       if (!landmarks(image, candidates[i].roi, h, next_rois[hand_count])) {
         if (!error.empty()) return hand_result::error;
         continue;
@@ -274,6 +288,7 @@ struct hand_pipeline::impl {
           continue;
         }
       }
+      if (from_body) missed_at[side_index] = -1.0;
       h.origin = candidates[i].origin;
       candidate_side_known[hand_count] = candidates[i].side_known;
       const body_side model_side = hand_side_from_handedness(
@@ -347,6 +362,9 @@ status hand_pipeline::create(const hand_pipeline_options& options,
     return status::error(e);
   if (!(options.max_overlap > 0.f && options.max_overlap <= 1.f))
     return status::error("hand_pipeline: max_overlap must be in (0, 1]");
+  if (!(options.retry_after_miss_seconds >= 0.0) ||
+      !std::isfinite(options.retry_after_miss_seconds))
+    return status::error("hand_pipeline: retry_after_miss_seconds must be finite and >= 0");
   if (!(options.pose_roi.scale > 0.f) || !std::isfinite(options.pose_roi.scale) ||
       !std::isfinite(options.pose_roi.shift_y) ||
       !(options.pose_roi.min_wrist_visibility >= 0.f &&
@@ -422,8 +440,9 @@ status hand_pipeline::create(const hand_pipeline_options& options,
 }
 
 hand_result hand_pipeline::process(const image_view& image, const landmark_frame* body,
-                                   landmark_frame& out) {
+                                   landmark_frame& out, double t) {
   impl& m = *impl_;
+  m.now = std::isfinite(t) ? t : -1.0;
   m.timings = {};
   m.error.clear();
   m.ran_palm = false;
@@ -452,7 +471,10 @@ hand_result hand_pipeline::process(const image_view& image, const landmark_frame
   return r;
 }
 
-void hand_pipeline::reset() { impl_->slot_count = 0; }
+void hand_pipeline::reset() {
+  impl_->slot_count = 0;
+  impl_->missed_at = {-1.0, -1.0};
+}
 int hand_pipeline::hand_count() const { return impl_->hand_count; }
 const hand_observation& hand_pipeline::hand(int i) const { return impl_->hands[i]; }
 int hand_pipeline::tracked_count() const { return impl_->slot_count; }

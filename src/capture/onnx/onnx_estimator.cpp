@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <string>
 
 #include "avatarmap/capture/face_pipeline.hpp"
 #include "avatarmap/capture/hand_pipeline.hpp"
@@ -44,8 +45,11 @@ constexpr std::uint32_t k_face_parts = 1u << static_cast<int>(frame_part::face);
 class onnx_estimator final : public estimator {
  public:
   onnx_estimator(std::unique_ptr<pose_pipeline> pose, std::unique_ptr<hand_pipeline> hands,
-                 std::unique_ptr<face_pipeline> face, bool two_lanes)
-      : pose_(std::move(pose)), hands_(std::move(hands)), face_(std::move(face)) {
+                 std::unique_ptr<face_pipeline> face, bool two_lanes, std::string description)
+      : pose_(std::move(pose)),
+        hands_(std::move(hands)),
+        face_(std::move(face)),
+        description_(std::move(description)) {
     if (two_lanes) lanes_ = std::make_unique<capture_detail::two_lanes>();
   }
 
@@ -103,6 +107,7 @@ class onnx_estimator final : public estimator {
   }
 
   int pipeline_delay() const override { return lanes_ ? 1 : 0; }
+  std::string describe() const override { return description_; }
   std::string_view name() const override { return "onnx"; }
   const estimator_timings* last_timings() const override { return &timings_; }
 
@@ -180,7 +185,7 @@ class onnx_estimator final : public estimator {
     task_error_[slot].clear();
     if (!args.hands || !hands_) return;
     const landmark_frame* body = body_frame.has(frame_part::pose) ? &body_frame : nullptr;
-    if (hands_->process(args.image, body, out) == hand_result::error) {
+    if (hands_->process(args.image, body, out, args.t) == hand_result::error) {
       task_error_[slot] = hands_->last_error();
       return;
     }
@@ -194,7 +199,7 @@ class onnx_estimator final : public estimator {
     task_error_[slot].clear();
     if (!args.face || !face_) return;
     const landmark_frame* body = body_frame.has(frame_part::pose) ? &body_frame : nullptr;
-    if (face_->process(args.image, body, out) == face_result::error) {
+    if (face_->process(args.image, body, out, args.t) == face_result::error) {
       task_error_[slot] = face_->last_error();
       return;
     }
@@ -208,6 +213,7 @@ class onnx_estimator final : public estimator {
   std::unique_ptr<hand_pipeline> hands_;
   std::unique_ptr<face_pipeline> face_;
   std::unique_ptr<capture_detail::two_lanes> lanes_;
+  std::string description_;
   estimator_timings timings_;
   // The tasks of the current batch and their errors (messages kept: no allocation once sized).
   task tasks_[3];
@@ -235,6 +241,14 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
   // Two lanes only pay when there is a second model per frame to run beside the body.
   const bool two_lanes = options.lanes == 2 && all_threads >= 2 && (options.hands || options.face);
   const int threads = two_lanes ? all_threads / 2 : all_threads;
+  std::string description =
+      options.precision == model_precision::int8
+          ? std::string("models: int8") +
+                (cpu_has_vnni() ? ""
+                                : " (this CPU has no VNNI: int8 leaves Google's tolerances "
+                                  "much further here, docs/capture.md)")
+          : std::string("models: float");
+  description += two_lanes ? "; two lanes" : "; one lane";
 
   pose_pipeline_options po;
   po.models_dir = options.source;
@@ -271,7 +285,8 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
     s = face_pipeline::create(fo, face);
     if (!s.ok()) return s;
   }
-  out.reset(new onnx_estimator(std::move(pose), std::move(hands), std::move(face), two_lanes));
+  out.reset(new onnx_estimator(std::move(pose), std::move(hands), std::move(face), two_lanes,
+                               std::move(description)));
   return {};
 }
 
