@@ -201,35 +201,28 @@ void warp_gl(const warp_args& a) {
   }
 }
 
-template <bool k_zero_border>
-void warp_gl_any(pixel_format f, const warp_args& a) {
-  switch (f) {
-    case pixel_format::rgb8:
-      return warp_gl<3, 0, 1, 2, k_zero_border>(a);
-    case pixel_format::bgr8:
-      return warp_gl<3, 2, 1, 0, k_zero_border>(a);
-    case pixel_format::rgba8:
-      return warp_gl<4, 0, 1, 2, k_zero_border>(a);
-    case pixel_format::bgra8:
-      return warp_gl<4, 2, 1, 0, k_zero_border>(a);
-    case pixel_format::gray8:
-      return warp_gl<1, 0, 0, 0, k_zero_border>(a);
-  }
+// The kernel for a sampling (k_gl: warp_gl, else warp), layout and border.
+template <bool k_gl, int k_bpp, int k_r, int k_g, int k_b, bool k_zero_border>
+void warp_kernel(const warp_args& a) {
+  if constexpr (k_gl)
+    warp_gl<k_bpp, k_r, k_g, k_b, k_zero_border>(a);
+  else
+    warp<k_bpp, k_r, k_g, k_b, k_zero_border>(a);
 }
 
-template <bool k_zero_border>
+template <bool k_gl, bool k_zero_border>
 void warp_any(pixel_format f, const warp_args& a) {
   switch (f) {
     case pixel_format::rgb8:
-      return warp<3, 0, 1, 2, k_zero_border>(a);
+      return warp_kernel<k_gl, 3, 0, 1, 2, k_zero_border>(a);
     case pixel_format::bgr8:
-      return warp<3, 2, 1, 0, k_zero_border>(a);
+      return warp_kernel<k_gl, 3, 2, 1, 0, k_zero_border>(a);
     case pixel_format::rgba8:
-      return warp<4, 0, 1, 2, k_zero_border>(a);
+      return warp_kernel<k_gl, 4, 0, 1, 2, k_zero_border>(a);
     case pixel_format::bgra8:
-      return warp<4, 2, 1, 0, k_zero_border>(a);
+      return warp_kernel<k_gl, 4, 2, 1, 0, k_zero_border>(a);
     case pixel_format::gray8:
-      return warp<1, 0, 0, 0, k_zero_border>(a);
+      return warp_kernel<k_gl, 1, 0, 0, 0, k_zero_border>(a);
   }
 }
 
@@ -396,14 +389,14 @@ bool image_crop_job::run() const {
     a.m[2] += 0.5 * (a.m[0] + a.m[1]) - 0.5;
     a.m[5] += 0.5 * (a.m[3] + a.m[4]) - 0.5;
     if (zero) {
-      warp_gl_any<true>(image.format, a);
+      warp_any<true, true>(image.format, a);
     } else {
-      warp_gl_any<false>(image.format, a);
+      warp_any<true, false>(image.format, a);
     }
   } else if (zero) {
-    warp_any<true>(image.format, a);
+    warp_any<false, true>(image.format, a);
   } else {
-    warp_any<false>(image.format, a);
+    warp_any<false, false>(image.format, a);
   }
   if (out_transform != nullptr) *out_transform = t;
   return true;

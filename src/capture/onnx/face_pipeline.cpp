@@ -147,27 +147,20 @@ status face_pipeline::create(const face_pipeline_options& options,
   std::unique_ptr<impl> m(new impl());
   m->options = options;
   // Both sessions at once (start-up, model_cache.hpp); an ORT error names its model.
-  auto named = [](const std::string& path, const std::function<std::string()>& load) {
-    try {
-      return load();
-    } catch (const Ort::Exception& ex) {
-      return path + ": ONNX Runtime: " + ex.what();
-    }
-  };
   std::string e;
   try {
     const Ort::SessionOptions so =
         make_session_options(options.intra_op_threads, options.allow_spinning);
     e = load_in_parallel(
         [&] {
-          return named(det_path, [&] {
+          return with_model_name(det_path, [&] {
             return m->detector.load(det_path, so,
                                     {1, k_face_detector_size, k_face_detector_size, 3},
                                     {k_detector_boxes * k_detector_coords, k_detector_boxes});
           });
         },
         [&] {
-          return named(mesh_path, [&] {
+          return with_model_name(mesh_path, [&] {
             return m->mesh.load(mesh_path, so, {1, k_face_mesh_size, k_face_mesh_size, 3},
                                 {k_face_mesh_count * 3, 1});
           });

@@ -389,26 +389,19 @@ status hand_pipeline::create(const hand_pipeline_options& options,
   std::unique_ptr<impl> m(new impl());
   m->options = options;
   // Both sessions at once (start-up, model_cache.hpp); an ORT error names its model.
-  auto named = [](const std::string& path, const std::function<std::string()>& load) {
-    try {
-      return load();
-    } catch (const Ort::Exception& ex) {
-      return path + ": ONNX Runtime: " + ex.what();
-    }
-  };
   std::string e;
   try {
     const Ort::SessionOptions so =
         make_session_options(options.intra_op_threads, options.allow_spinning);
     e = load_in_parallel(
         [&] {
-          return named(palm_path, [&] {
+          return with_model_name(palm_path, [&] {
             return m->palm.load(palm_path, so, {1, k_palm_size, k_palm_size, 3},
                                 {k_palm_boxes * k_palm_coords, k_palm_boxes});
           });
         },
         [&] {
-          return named(lm_path, [&] {
+          return with_model_name(lm_path, [&] {
             return m->hand_model.load_in_order(
                 lm_path, so, {1, k_landmark_size, k_landmark_size, 3},
                 {3 * k_hand_landmark_count, 1, 1, 3 * k_hand_landmark_count});

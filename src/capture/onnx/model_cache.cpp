@@ -307,4 +307,12 @@ std::string load_in_parallel(const std::function<std::string()>& first,
   return second_message;
 }
 
+std::string with_model_name(const std::string& path, const std::function<std::string()>& load) {
+  try {
+    return load();
+  } catch (const Ort::Exception& ex) {
+    return path + ": ONNX Runtime: " + ex.what();
+  }
+}
+
 }  // namespace avatarmap

@@ -66,4 +66,8 @@ cached_session open_cached_session(Ort::Env& env, const std::string& model_path,
 std::string load_in_parallel(const std::function<std::string()>& first,
                              const std::function<std::string()>& second);
 
+/// Runs `load` and turns an ONNX Runtime exception from it into a message naming `path` (so
+/// that a session created on another thread by load_in_parallel still names its model).
+std::string with_model_name(const std::string& path, const std::function<std::string()>& load);
+
 }  // namespace avatarmap
