@@ -6,12 +6,23 @@
 #include "capture/onnx/onnx_estimator.hpp"
 #endif
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <cpuid.h>
+#endif
+
 namespace avatarmap {
 
 bool cpu_has_vnni() {
 #if defined(__x86_64__) || defined(__i386__)
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx512vnni") || __builtin_cpu_supports("avxvnni");
+  // CPUID leaf 7: subleaf 0 ECX bit 11 is AVX512-VNNI, subleaf 1 EAX bit 4 is AVX-VNNI (read
+  // directly: not every compiler's __builtin_cpu_supports knows "avxvnni").
+  unsigned a = 0, b = 0, c = 0, d = 0;
+  if (!__builtin_cpu_supports("avx2") || __get_cpuid_max(0, nullptr) < 7) return false;
+  __cpuid_count(7, 0, a, b, c, d);
+  const bool avx512_vnni = (c >> 11) & 1u;
+  __cpuid_count(7, 1, a, b, c, d);
+  const bool avx_vnni = (a >> 4) & 1u;
+  return avx512_vnni || avx_vnni;
 #else
   return false;
 #endif
