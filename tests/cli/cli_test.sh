@@ -206,6 +206,8 @@ case $case_name in
     run 2 capture in.mp4 -o out.landmarks.jsonl --hand-model heavy
     run 2 capture in.mp4 -o out.landmarks.jsonl --precision fp16
     expect_in err.txt "--precision is float or int8"
+    run 2 capture in.mp4 -o out.landmarks.jsonl --lanes 3
+    expect_in err.txt "--lanes is 1 or 2"
     run 2 capture in.mp4 -o out.landmarks.jsonl --loop 0
     run 1 capture missing.mp4 -o out.landmarks.jsonl
     expect_in err.txt "missing.mp4"

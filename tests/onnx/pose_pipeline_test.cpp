@@ -8,12 +8,14 @@
 #include "avatarmap/capture/pose_pipeline.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -43,6 +45,31 @@ TEST(pose_pipeline, create_reports_missing_models) {
   EXPECT_NE(s.message().find("pose_detection.onnx"), std::string::npos) << s.message();
   o.intra_op_threads = 0;
   EXPECT_FALSE(pose_pipeline::create(o, p).ok());
+}
+
+// A corrupt model: the message names it, whichever of the two sessions (created side by side
+// on two threads) refused it.
+TEST(pose_pipeline, create_names_a_corrupt_model) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("avatarmap_pose_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "pose_detection.onnx", std::ios::binary) << "not an onnx model";
+  std::ofstream(dir / "pose_landmark_full.onnx", std::ios::binary) << "not one either";
+  pose_pipeline_options o;
+  o.models_dir = dir.string();
+  std::unique_ptr<pose_pipeline> p;
+  status s = pose_pipeline::create(o, p);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("pose_detection.onnx"), std::string::npos) << s.message();
+  const std::string good = test::models_dir() + "/pose_detection.onnx";
+  if (!test::models_dir().empty() && std::ifstream(good).good()) {
+    // A good detector and a corrupt landmark model: the message names the latter.
+    fs::copy_file(good, dir / "pose_detection.onnx", fs::copy_options::overwrite_existing);
+    s = pose_pipeline::create(o, p);
+    EXPECT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("pose_landmark_full.onnx"), std::string::npos) << s.message();
+  }
+  fs::remove_all(dir);
 }
 
 // pose.jpg against the golden with the float models or their int8 versions (which must hold

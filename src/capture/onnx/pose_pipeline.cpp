@@ -233,16 +233,20 @@ status pose_pipeline::create(const pose_pipeline_options& options,
     const Ort::SessionOptions so =
         make_session_options(options.intra_op_threads, options.allow_spinning);
     std::vector<bool> found;
-    // Both sessions at once (start-up, model_cache.hpp).
+    // Both sessions at once (start-up, model_cache.hpp); an ORT error names its model.
     const std::string e = load_in_parallel(
         [&] {
-          return m->detector.load(det_path, so, {1, k_detector_size, k_detector_size, 3},
-                                  {2254 * 12, 2254});
+          return with_model_name(det_path, [&] {
+            return m->detector.load(det_path, so, {1, k_detector_size, k_detector_size, 3},
+                                    {2254 * 12, 2254});
+          });
         },
         [&] {
-          return m->landmark.load(lm_path, so, {1, k_landmark_size, k_landmark_size, 3},
-                                  {k_landmark_points * 5, 1, k_landmark_points * 3},
-                                  {k_heatmap_size * k_heatmap_size * k_landmark_points}, &found);
+          return with_model_name(lm_path, [&] {
+            return m->landmark.load(lm_path, so, {1, k_landmark_size, k_landmark_size, 3},
+                                    {k_landmark_points * 5, 1, k_landmark_points * 3},
+                                    {k_heatmap_size * k_heatmap_size * k_landmark_points}, &found);
+          });
         });
     m->has_heatmap = !found.empty() && found[0];
     if (!e.empty()) return status::error("pose_pipeline: " + e);
