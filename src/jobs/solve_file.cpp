@@ -65,10 +65,30 @@ struct direct_source {
   void release() {}
 };
 
+// Pulls frames from the job's `source` on this thread; the same interface again.
+struct callback_source {
+  const std::function<status(landmark_frame&, bool&)>& source;
+  landmark_frame& frame_storage;
+  std::string message;
+  read_result next() {
+    bool end = false;
+    status st = source(frame_storage, end);
+    if (!st.ok()) {
+      message = st.message();
+      return read_result::error;
+    }
+    return end ? read_result::end : read_result::frame;
+  }
+  const landmark_frame& frame() const { return frame_storage; }
+  const std::string& error() const { return message; }
+  void release() {}
+};
+
 }  // namespace
 
 status solve_file_job::validate() const {
-  if (input.empty()) return status::error("solve_file_job.input is empty: give a landmark file");
+  if (input.empty() && !source)
+    return status::error("solve_file_job.input is empty: give a landmark file or a source");
   if (!sink && output.empty())
     return status::error("solve_file_job.output is empty: give a *.pose.jsonl path or a sink");
   if (status st = options.validate(); !st.ok())
@@ -104,8 +124,12 @@ status solve_file_job::run(solve_file_summary& s) const {
   if (status st = validate(); !st.ok()) return fail(job_failure::invalid_argument, st);
   const auto t0 = clock_type::now();
   landmark_reader reader;
-  status st = reader.open(input);
-  if (!st.ok()) return fail(job_failure::input_io, st);
+  status st;
+  if (!source) {
+    st = reader.open(input);
+    if (!st.ok()) return fail(job_failure::input_io, st);
+  }
+  // Frames from a source have no header: its defaults (no image size, no fps).
   const landmark_file_header& header = reader.header();
 
   solver_options solve_options = options;
@@ -219,6 +243,10 @@ status solve_file_job::run(solve_file_summary& s) const {
       const read_result r = src.next();
       if (r == read_result::end) return {};
       if (r == read_result::error) {
+        if (source) {
+          why = job_failure::invalid_argument;
+          return status::error(src.error());
+        }
         if (!skip_bad_lines) {
           why = job_failure::input_parse;
           return status::error(src.error());
@@ -291,7 +319,10 @@ status solve_file_job::run(solve_file_summary& s) const {
       }
     }
   };
-  if (threads > 1) {
+  if (source) {
+    callback_source from_source{source, state->frame, {}};
+    st = process(from_source);
+  } else if (threads > 1) {
     jobs_detail::frame_prefetcher prefetcher(reader, !skip_bad_lines);
     st = process(prefetcher);
   } else {

@@ -169,6 +169,60 @@ TEST_F(solve_file, sink_gets_exactly_the_frame_by_frame_poses_with_either_thread
   }
 }
 
+TEST_F(solve_file, a_source_of_the_files_frames_gives_the_same_poses_as_the_file) {
+  std::vector<landmark_frame> frames;
+  {
+    landmark_reader reader;
+    ASSERT_TRUE(reader.open(input).ok());
+    landmark_frame f;
+    while (reader.next(f) == read_result::frame) frames.push_back(f);
+  }
+  ASSERT_EQ(frames.size(), 60u);
+  for (pose_filter_mode mode :
+       {pose_filter_mode::offline, pose_filter_mode::live, pose_filter_mode::none}) {
+    solve_file_job from_file;
+    from_file.input = input;
+    from_file.filter_mode = mode;
+    const std::vector<proxy_pose> want = run_collecting(from_file);
+    solve_file_job from_source;
+    from_source.filter_mode = mode;
+    from_source.image_width = 1280.f;  // no header: the file's size given
+    from_source.image_height = 720.f;
+    std::size_t next = 0;
+    from_source.source = [&](landmark_frame& out, bool& end) {
+      end = next == frames.size();
+      if (!end) out = frames[next++];
+      return status{};
+    };
+    expect_same_poses(run_collecting(from_source), want, 0.f);
+  }
+}
+
+TEST(solve_file_inputs, a_source_error_ends_the_run_as_an_argument_error) {
+  solve_file_job job;
+  int calls = 0;
+  job.source = [&calls](landmark_frame& out, bool&) {
+    out.clear();
+    out.t = calls;
+    return ++calls == 3 ? status::error("frame 2 is bad") : status{};
+  };
+  int poses = 0;
+  job.sink = [&poses](const proxy_pose&) {
+    ++poses;
+    return status{};
+  };
+  job.filter_mode = pose_filter_mode::none;
+  solve_file_summary s;
+  const status st = job.run(s);
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(st.message(), "frame 2 is bad");
+  EXPECT_EQ(s.failure, job_failure::invalid_argument);
+  EXPECT_EQ(poses, 2);
+  solve_file_job none;
+  none.sink = job.sink;
+  EXPECT_NE(none.validate().message().find("or a source"), std::string::npos);
+}
+
 TEST_F(solve_file, written_file_reads_back_as_the_same_poses) {
   const std::string out = dir.file("out.pose.jsonl");
   solve_file_job job;

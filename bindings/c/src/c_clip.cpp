@@ -8,11 +8,13 @@
 
 #include "avatarmap/avatarmap.h"
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/jobs/clip_output.hpp"
 #include "avatarmap/rig/rig.hpp"
 #include "avatarmap/rig/rig_binding.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "c_avatar.hpp"
+#include "c_frames.hpp"
 #include "c_guard.hpp"
 
 namespace am = avatarmap;
@@ -141,6 +143,97 @@ AVATARMAP_C_API avm_status avm_clip_add(avm_clip* clip, const avm_pose* pose) {
     am::proxy_pose p;
     sanitized_pose(*pose, prev, p);
     clip->frames.push_back(p);  // may reallocate: `prev` is not used after this
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_clip_add_poses(avm_clip* clip, const avm_pose* poses,
+                                              int64_t count) {
+  if (clip == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  clip->last_error.clear();
+  if (count < 0) return fail(clip, AVM_ERROR_INVALID_ARGUMENT, "avm_clip_add_poses: count < 0");
+  if (count > 0 && poses == nullptr)
+    return fail(clip, AVM_ERROR_INVALID_ARGUMENT, "avm_clip_add_poses: poses is NULL");
+  return guard("avm_clip_add_poses", to_handle(clip), [&]() -> avm_status {
+    // Every time checked before anything is added: all or nothing.
+    double prev_t = clip->frames.empty() ? 0.0 : clip->frames.back().t;
+    bool have_prev = !clip->frames.empty();
+    for (int64_t i = 0; i < count; ++i) {
+      const double t = poses[i].t;
+      if (!std::isfinite(t) || (have_prev && !(t > prev_t))) {
+        const std::string msg =
+            "avm_clip_add_poses: poses[" + std::to_string(i) + "].t (" + std::to_string(t) +
+            (std::isfinite(t) ? ") must be after the previous frame's (" + std::to_string(prev_t) +
+                                    "); nothing was added"
+                              : ") must be finite; nothing was added");
+        set_error(clip, msg.c_str());
+        return AVM_ERROR_INVALID_ARGUMENT;
+      }
+      prev_t = t;
+      have_prev = true;
+    }
+    const std::size_t old_size = clip->frames.size();
+    clip->frames.reserve(old_size + static_cast<std::size_t>(count));  // may throw: unchanged
+    clip->frames.resize(old_size + static_cast<std::size_t>(count));
+    for (int64_t i = 0; i < count; ++i) {
+      const std::size_t k = old_size + static_cast<std::size_t>(i);
+      sanitized_pose(poses[i], k > 0 ? &clip->frames[k - 1] : nullptr, clip->frames[k]);
+    }
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_clip_get_poses(const avm_clip* clip, int64_t first, int64_t count,
+                                              avm_pose* out) {
+  if (clip == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  clip->last_error.clear();
+  return guard("avm_clip_get_poses", to_handle(clip), [&]() -> avm_status {
+    const auto size = static_cast<int64_t>(clip->frames.size());
+    if (first < 0 || count < 0 || first > size || count > size - first) {
+      const std::string msg = "avm_clip_get_poses: frames [" + std::to_string(first) + ", " +
+                              std::to_string(first) + " + " + std::to_string(count) +
+                              ") are not within the clip's " + std::to_string(size) + " frames";
+      return fail(clip, AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
+    }
+    if (count > 0 && out == nullptr)
+      return fail(clip, AVM_ERROR_INVALID_ARGUMENT, "avm_clip_get_poses: out is NULL");
+    for (int64_t i = 0; i < count; ++i)
+      to_c_pose(clip->frames[static_cast<std::size_t>(first + i)], out[i]);
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_clip_read(const char* path, avm_clip** out, char* err,
+                                         size_t err_size) {
+  copy_message(err, err_size, "");
+  if (out != nullptr) *out = nullptr;
+  auto report = [&](avm_status code, const char* msg) {
+    copy_message(err, err_size, msg);
+    return code;
+  };
+  if (path == nullptr || out == nullptr)
+    return report(AVM_ERROR_INVALID_ARGUMENT, "avm_clip_read: path and out must not be NULL");
+  return guard("avm_clip_read", report, [&]() -> avm_status {
+    am::pose_reader reader;
+    if (am::status st = reader.open(path); !st.ok())
+      return report(code_for(st, reader.line() > 0 ? AVM_ERROR_PARSE : AVM_ERROR_IO),
+                    st.message().c_str());
+    std::unique_ptr<avm_clip> clip(new avm_clip());
+    am::proxy_pose p;
+    for (;;) {
+      const am::read_result r = reader.next(p);
+      if (r == am::read_result::end) break;
+      if (r == am::read_result::error) return report(AVM_ERROR_PARSE, reader.error().c_str());
+      // The clip's rule (avm_clip_add): times increase.
+      if (!std::isfinite(p.t) || (!clip->frames.empty() && !(p.t > clip->frames.back().t))) {
+        const std::string msg = std::string(path) + ":" + std::to_string(reader.line()) + ": t (" +
+                                std::to_string(p.t) +
+                                ") must be finite and after the previous frame's";
+        return report(AVM_ERROR_PARSE, msg.c_str());
+      }
+      clip->frames.push_back(p);
+    }
+    *out = clip.release();
     return AVM_OK;
   });
 }

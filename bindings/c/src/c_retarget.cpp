@@ -25,6 +25,34 @@ struct avm_retargeter : avatarmap::c_api::error_slot {
   am::proxy_pose proxy;  // scratch: the C pose converted
 };
 
+namespace {
+
+// avm_retargeter_apply's work for one pose, into the handle's scratch; allocates nothing.
+void apply_one(avm_retargeter& r, const avm_pose& pose, float* out_rotations,
+               float* out_hips_translation) {
+  am::proxy_pose& p = r.proxy;
+  p.t = pose.t;
+  for (int i = 0; i < 3; ++i)
+    p.hips_position[i] = std::isfinite(pose.hips_position[i]) ? pose.hips_position[i] : 0.f;
+  for (int b = 0; b < am::k_bone_count; ++b) {
+    glm::quat q = am::load_xyzw(pose.rotations[b]);
+    const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+    p.rotations[static_cast<std::size_t>(b)] =
+        (n2 > 1e-12f && std::isfinite(n2)) ? q * (1.f / std::sqrt(n2)) : am::identity_quat();
+  }
+  r.retargeter.apply(p, r.pose);
+  const int n = r.rig.joint_count();
+  for (int j = 0; j < n; ++j)
+    am::store_xyzw(r.pose.local_rotations[static_cast<std::size_t>(j)], out_rotations + 4 * j);
+  if (out_hips_translation != nullptr) {
+    out_hips_translation[0] = r.pose.hips_translation.x;
+    out_hips_translation[1] = r.pose.hips_translation.y;
+    out_hips_translation[2] = r.pose.hips_translation.z;
+  }
+}
+
+}  // namespace
+
 extern "C" {
 
 AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const char* mapping,
@@ -101,27 +129,32 @@ AVATARMAP_C_API avm_status avm_retargeter_apply(avm_retargeter* retargeter, cons
     return AVM_ERROR_INVALID_ARGUMENT;
   }
   return guard("avm_retargeter_apply", to_handle(retargeter), [&]() -> avm_status {
-    am::proxy_pose& p = retargeter->proxy;
-    p.t = pose->t;
-    for (int i = 0; i < 3; ++i)
-      p.hips_position[i] = std::isfinite(pose->hips_position[i]) ? pose->hips_position[i] : 0.f;
-    for (int b = 0; b < am::k_bone_count; ++b) {
-      glm::quat q = am::load_xyzw(pose->rotations[b]);
-      const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
-      p.rotations[static_cast<std::size_t>(b)] =
-          (n2 > 1e-12f && std::isfinite(n2)) ? q * (1.f / std::sqrt(n2)) : am::identity_quat();
-    }
-    retargeter->retargeter.apply(p, retargeter->pose);
-    const int n = retargeter->rig.joint_count();
-    for (int j = 0; j < n; ++j)
-      am::store_xyzw(retargeter->pose.local_rotations[static_cast<std::size_t>(j)],
-                     out_rotations + 4 * j);
-    if (out_hips_translation != nullptr) {
-      out_hips_translation[0] = retargeter->pose.hips_translation.x;
-      out_hips_translation[1] = retargeter->pose.hips_translation.y;
-      out_hips_translation[2] = retargeter->pose.hips_translation.z;
-    }
+    apply_one(*retargeter, *pose, out_rotations, out_hips_translation);
     retargeter->last_error.clear();
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_retargeter_apply_poses(avm_retargeter* r, const avm_pose* poses,
+                                                      int64_t count, float* out_rotations,
+                                                      float* out_hips_translation) {
+  if (r == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  if (count < 0) {
+    set_error(r, "avm_retargeter_apply_poses: count < 0");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  if (count > 0 && (poses == nullptr || out_rotations == nullptr)) {
+    set_error(r, "avm_retargeter_apply_poses: poses and out_rotations must not be NULL");
+    return AVM_ERROR_INVALID_ARGUMENT;
+  }
+  return guard("avm_retargeter_apply_poses", to_handle(r), [&]() -> avm_status {
+    const auto floats = static_cast<std::ptrdiff_t>(4) * r->rig.joint_count();
+    for (int64_t i = 0; i < count; ++i)
+      apply_one(*r, poses[i], out_rotations + static_cast<std::ptrdiff_t>(i) * floats,
+                out_hips_translation != nullptr
+                    ? out_hips_translation + static_cast<std::ptrdiff_t>(i) * 3
+                    : nullptr);
+    r->last_error.clear();
     return AVM_OK;
   });
 }

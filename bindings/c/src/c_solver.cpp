@@ -17,6 +17,7 @@
 #include "avatarmap/time/offline_smoother.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
+#include "c_frame_block.hpp"
 #include "c_frames.hpp"
 #include "c_guard.hpp"
 #include "c_solver_options.hpp"
@@ -39,6 +40,25 @@ struct avm_solver : avatarmap::c_api::error_slot {
              const am::pose_resampler_options& r)
       : solver(s), filter(f), resampler(r) {}
 };
+
+namespace {
+
+// The solve-file job as avm_solve_file and avm_solve_frames run it, on the calling thread.
+am::solve_file_job file_job(const core_options& o) {
+  am::solve_file_job job;
+  job.options = o.solver;
+  // Non-zero options.image_width/height win over the file's header (0 = the header's).
+  job.image_width = o.solver.image_width;
+  job.image_height = o.solver.image_height;
+  job.filter_mode = o.file_filter;
+  job.offline.strength = o.file_smoothing;
+  job.filter = o.filter;
+  job.filter_channels = o.channels;
+  job.threads = 1;
+  return job;
+}
+
+}  // namespace
 
 extern "C" {
 
@@ -163,21 +183,66 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
       return report(AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
     }
     // The library's solve-file job (the CLI's `solve` runs it too), on this thread.
-    am::solve_file_job job;
+    am::solve_file_job job = file_job(o);
     job.input = in_landmarks;
     job.output = out_pose;
-    job.options = o.solver;
-    // Non-zero options.image_width/height win over the file's header (0 = the header's).
-    job.image_width = o.solver.image_width;
-    job.image_height = o.solver.image_height;
-    job.filter_mode = o.file_filter;
-    job.offline.strength = o.file_smoothing;
-    job.filter = o.filter;
-    job.filter_channels = o.channels;
-    job.threads = 1;
     am::solve_file_summary summary;
     const am::status st = job.run(summary);
     if (!st) return report(code_for(st, job_code(summary.failure)), st.message().c_str());
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_solve_frames(const avm_frame_block* frames,
+                                            const avm_solver_options* options, avm_pose* out_poses,
+                                            char* err, size_t err_size) {
+  copy_message(err, err_size, "");
+  set_create_error("");
+  auto report = [&](avm_status code, const char* msg) {
+    copy_message(err, err_size, msg);
+    return code;
+  };
+  if (frames == nullptr)
+    return report(AVM_ERROR_INVALID_ARGUMENT, "avm_solve_frames: frames is NULL");
+  if (const char* bad = check_block(*frames)) return report(AVM_ERROR_INVALID_ARGUMENT, bad);
+  if (frames->count > 0 && out_poses == nullptr)
+    return report(AVM_ERROR_INVALID_ARGUMENT, "avm_solve_frames: out_poses is NULL");
+  return guard("avm_solve_frames", report, [&]() -> avm_status {
+    core_options o;
+    std::string msg;
+    if (!read_options(options, o, msg)) {
+      set_create_error(msg.c_str());
+      return report(AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
+    }
+    // The same job as avm_solve_file, its frames pulled from the block and its poses put in
+    // out_poses (one per frame: no resampling).
+    const std::int64_t count = frames->count;
+    am::solve_file_job job = file_job(o);
+    job.input = "frames";
+    std::int64_t next = 0;
+    job.source = [&](am::landmark_frame& out, bool& end) -> am::status {
+      if (next >= count) {
+        end = true;
+        return {};
+      }
+      if (!std::isfinite(frames->t[next]))
+        return am::status::error("avm_solve_frames: frames->t[" + std::to_string(next) +
+                                 "] is not finite");
+      block_row_to_frame(*frames, next++, out);
+      return {};
+    };
+    std::int64_t written = 0;
+    job.sink = [&](const am::proxy_pose& p) -> am::status {
+      if (written >= count)  // the job gives one pose per frame; never more
+        return am::status::error("avm_solve_frames: more poses than frames");
+      to_c_pose(p, out_poses[written++]);
+      return {};
+    };
+    am::solve_file_summary summary;
+    const am::status st = job.run(summary);
+    if (!st) return report(code_for(st, job_code(summary.failure)), st.message().c_str());
+    if (written != count)
+      return report(AVM_ERROR_INTERNAL, "avm_solve_frames: fewer poses than frames");
     return AVM_OK;
   });
 }

@@ -92,8 +92,16 @@ struct solve_file_summary {
 /// The job. Fill the inputs, call run(). Thread-safety: a job may be run from any thread; the
 /// callbacks are called on the thread that called run().
 struct solve_file_job {
-  /// *.landmarks.jsonl to read ("-" = standard input).
+  /// *.landmarks.jsonl to read ("-" = standard input). With `source` set: only the name that
+  /// messages give the frames (e.g. "frames"; empty = "frames").
   std::string input;
+  /// When set, frames come from here instead of a file (frames held in memory, e.g. the C
+  /// API's avm_solve_frames): each call fills `out` with the next frame and returns ok, or
+  /// sets `end` = true when there are no more; an error it returns ends the run with that
+  /// error (failure invalid_argument: the caller's frames are its arguments). Pulled on the
+  /// thread that calls run() (`threads` does not apply); no header: the image size is
+  /// image_width/height or options.image_width/height, the output's fps 0.
+  std::function<status(landmark_frame& out, bool& end)> source;
   /// *.pose.jsonl to write ("-" = standard output), atomically: on failure an existing file is
   /// left as it was. Ignored when `sink` is set.
   std::string output;
@@ -139,7 +147,7 @@ struct solve_file_job {
   /// of order), one sentence each without a "warning:" prefix.
   std::function<void(const std::string&)> warning;
 
-  /// Checks the fields that do not need the file: input set, output or sink set, options
+  /// Checks the fields that do not need the file: input or source set, output or sink set, options
   /// valid, image size finite and >= 0 (both or neither), output_fps finite in [0, 1000],
   /// threads 1 or 2, filter_mode known, filter parameters positive, offline options valid
   /// (offline_smoother_options::validate). The message names the field.

@@ -679,6 +679,151 @@ AVATARMAP_C_API avm_status avm_live_get_stats(const avm_live* live, avm_live_sta
 AVATARMAP_C_API const char* avm_live_last_error(const avm_live* live, char* buffer,
                                                 size_t buffer_size);
 
+/* ---- arrays of frames: whole-file calls from array languages --------------------------- */
+
+/* Frames as arrays (structure of arrays), e.g. NumPy arrays handed over by pointer. Each
+ * points array holds count x N x 5 floats, (x, y, z, visibility, presence) per point as in
+ * avm_landmark, frame after frame: N = AVM_POSE_LANDMARK_COUNT (pose, pose_world),
+ * AVM_HAND_LANDMARK_COUNT (hands), AVM_FACE_IRIS_LANDMARK_COUNT (face; a 468-point face has
+ * rows 468..477 NaN: its row 468's x is NaN). A part is not seen in frame i when its first
+ * point's x is NaN (readers fill unseen parts with NaN). Any pointer but t may be NULL: that
+ * part is never seen. The caller owns every array. */
+typedef struct avm_frame_block {
+  uint32_t struct_size;    /* sizeof(avm_frame_block) as the caller knows it */
+  int64_t count;           /* frames (capacity for readers), >= 0 */
+  double* t;               /* count capture times, seconds */
+  float* pose;             /* count x 33 x 5 */
+  float* pose_world;       /* count x 33 x 5 */
+  float* left_hand;        /* count x 21 x 5 */
+  float* left_hand_world;  /* count x 21 x 5 */
+  float* right_hand;       /* count x 21 x 5 */
+  float* right_hand_world; /* count x 21 x 5 */
+  float* face;             /* count x 478 x 5 */
+} avm_frame_block;
+
+/* Reader of a *.landmarks.jsonl file (docs/file-formats.md), a block of frames at a time.
+ * Typed opaque handle; one thread at a time per handle. */
+typedef struct avm_landmark_reader avm_landmark_reader;
+
+/* Opens `path` and reads its header line, if any. On success *out is a new handle owned by
+ * the caller (free it with avm_landmark_reader_destroy()); on failure *out is NULL (when out
+ * is not NULL) and avm_last_create_error() says why, naming the file.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (path or out NULL), AVM_ERROR_IO (cannot open),
+ *   AVM_ERROR_PARSE (a bad header line), AVM_ERROR_OUT_OF_MEMORY. Thread-safe. */
+AVATARMAP_C_API avm_status avm_landmark_reader_open(const char* path, avm_landmark_reader** out);
+
+/* The header's values into each non-NULL output: the image size in pixels (0 when the file
+ * gives none) and the frame rate (0 when unknown).
+ * Failures: AVM_ERROR_INVALID_ARGUMENT when r is NULL. */
+AVATARMAP_C_API avm_status avm_landmark_reader_header(const avm_landmark_reader* r,
+                                                      int32_t* image_width, int32_t* image_height,
+                                                      double* fps);
+
+/* Reads up to block->count frames into rows 0, 1, ... of the block's arrays (NULL arrays are
+ * skipped; parts a frame lacks, and rows 468..477 of a 468-point face, are filled with NaN).
+ * *out_read = the number of frames read; 0 with AVM_OK at the end of the file. Allocates
+ * nothing per frame.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (r, block, block->t or out_read NULL, struct_size
+ *   below sizeof(avm_frame_block), count negative); AVM_ERROR_PARSE: a malformed line,
+ *   "FILE:LINE: ..." in avm_landmark_reader_last_error(); *out_read then counts the good
+ *   frames read before it, and the next call goes on after the bad line;
+ *   AVM_ERROR_IO (a read error), AVM_ERROR_INTERNAL. */
+AVATARMAP_C_API avm_status avm_landmark_reader_read(avm_landmark_reader* r,
+                                                    const avm_frame_block* block,
+                                                    int64_t* out_read);
+
+/* Message of the last failed call on `r` ("" after a successful call, or for NULL); owned by
+ * the handle, valid until the next call on it or its destruction. */
+AVATARMAP_C_API const char* avm_landmark_reader_last_error(const avm_landmark_reader* r);
+
+/* Closes the file and frees the handle; NULL does nothing. */
+AVATARMAP_C_API void avm_landmark_reader_destroy(avm_landmark_reader* r);
+
+/* Solves frames->count frames held in memory exactly as avm_solve_file() solves a file (the
+ * same library job: options->file_filter, offline by default; one pose per frame, in the
+ * block's order, no resampling) into out_poses[0 .. count) (caller-owned). The image size is
+ * options->image_width/height (0: unknown, square pixels assumed). The block's arrays are
+ * only read during the call. Allocates nothing per frame (the offline filter's window once
+ * per call). `options` NULL means the defaults. err as avm_solve_file().
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (frames or out_poses NULL with count > 0, frames->t
+ *   NULL, struct_size below sizeof(avm_frame_block), count negative, a time not finite, bad
+ *   options: the message names the frame or field), AVM_ERROR_OUT_OF_MEMORY,
+ *   AVM_ERROR_INTERNAL. Thread-safe (separate outputs). */
+AVATARMAP_C_API avm_status avm_solve_frames(const avm_frame_block* frames,
+                                            const avm_solver_options* options, avm_pose* out_poses,
+                                            char* err, size_t err_size);
+
+/* ---- clips: more than one pose at a time, and reading pose files ----------------------- */
+
+/* Reads a *.pose.jsonl file (docs/file-formats.md) into a new clip, its frames as written
+ * (times as in the file, which must increase as avm_clip_add() requires). On success *out is
+ * a new handle owned by the caller (free it with avm_clip_destroy()); on failure *out is NULL
+ * (when out is not NULL). err as avm_clip_write().
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (path or out NULL), AVM_ERROR_IO (cannot open),
+ *   AVM_ERROR_PARSE (a malformed line or a time not after the previous frame's:
+ *   "FILE:LINE: ..."), AVM_ERROR_OUT_OF_MEMORY. Thread-safe. */
+AVATARMAP_C_API avm_status avm_clip_read(const char* path, avm_clip** out, char* err,
+                                         size_t err_size);
+
+/* Copies frames [first, first + count) into out[0 .. count) (caller-owned poses; the frames
+ * as the clip holds them: sanitised as avm_clip_add() says). Allocates nothing.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (clip NULL, out NULL with count > 0, first or count
+ *   negative, the range past the clip's frames). */
+AVATARMAP_C_API avm_status avm_clip_get_poses(const avm_clip* clip, int64_t first, int64_t count,
+                                              avm_pose* out);
+
+/* Appends count poses as avm_clip_add() would each, all or nothing: on failure the clip is
+ * unchanged and avm_clip_last_error() names the first bad pose.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (clip NULL, poses NULL with count > 0, count negative,
+ *   a t not finite or not after the previous one's), AVM_ERROR_OUT_OF_MEMORY. */
+AVATARMAP_C_API avm_status avm_clip_add_poses(avm_clip* clip, const avm_pose* poses, int64_t count);
+
+/* ---- retargeting many poses ------------------------------------------------------------ */
+
+/* As avm_retargeter_apply() for each of count poses: out_rotations gets count x joint_count x
+ * 4 floats (pose after pose), out_hips_translation count x 3 (may be NULL). Allocation-free.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (retargeter NULL; poses or out_rotations NULL with
+ *   count > 0; count negative), AVM_ERROR_INTERNAL; avm_retargeter_last_error() says which. */
+AVATARMAP_C_API avm_status avm_retargeter_apply_poses(avm_retargeter* r, const avm_pose* poses,
+                                                      int64_t count, float* out_rotations,
+                                                      float* out_hips_translation);
+
+/* ---- capture of a whole file ----------------------------------------------------------- */
+
+/* What avm_capture_file() did. Set struct_size = sizeof(avm_capture_summary) before the
+ * call: fields past the caller's struct_size are not written. */
+typedef struct avm_capture_summary {
+  uint32_t struct_size;
+  int64_t frames;                                                        /* frames written */
+  int64_t body_frames, left_hand_frames, right_hand_frames, face_frames; /* frames with each */
+  int64_t frames_not_decoded; /* broken frames skipped with a warning */
+  int32_t image_width, image_height;
+  double fps;     /* the input's nominal rate; 0 unknown */
+  double seconds; /* wall-clock time of the run, start-up included */
+} avm_capture_summary;
+
+/* Called about twice a second during avm_capture_file() on its calling thread: frames done,
+ * frames expected (0 when unknown). */
+typedef void (*avm_progress_fn)(void* user, int64_t done, int64_t total);
+
+/* `avatarmap capture INPUT -o OUT` as a library call (the same library job as the CLI's
+ * `capture`): a video file, an image, a folder of images or a printf pattern ("f%04d.png")
+ * -> a *.landmarks.jsonl, written atomically (on failure an existing file is untouched).
+ * Devices and streams are not accepted (INVALID_ARGUMENT). `options` NULL = the defaults of
+ * avm_estimator_options_init() (hands and face on; threads 2 gives two lanes, threads 1 one
+ * thread). `out_summary` (struct_size set) and `progress` may be NULL; `user` is passed to
+ * `progress`. err as avm_solve_file().
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (a path NULL, a device or stream, bad options, no
+ *   models folder), AVM_ERROR_IO (the input cannot be opened or decoded, the output cannot be
+ *   written, the models are missing), AVM_ERROR_UNSUPPORTED (built without ONNX Runtime or
+ *   the video decoder), AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL. Thread-safe (separate
+ *   files). */
+AVATARMAP_C_API avm_status avm_capture_file(const char* input, const char* out_landmarks,
+                                            const avm_estimator_options* options,
+                                            avm_capture_summary* out_summary,
+                                            avm_progress_fn progress, void* user, char* err,
+                                            size_t err_size);
+
 #ifdef __cplusplus
 } /* extern "C" */
 #endif

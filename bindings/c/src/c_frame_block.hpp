@@ -1,0 +1,26 @@
+// avm_frame_block (avatarmap.h): frames as arrays, one row per frame, converted to and from the
+// library's landmark_frame. Nothing here allocates.
+#pragma once
+
+#include <cstdint>
+
+#include "avatarmap/avatarmap.h"
+#include "avatarmap/landmarks/landmark_frame.hpp"
+
+namespace avatarmap::c_api {
+
+/// Floats per landmark in a block's arrays: x, y, z, visibility, presence.
+constexpr int k_block_floats_per_point = 5;
+
+/// NULL when `block` can be used (struct_size, count >= 0, t set when count > 0), else a static
+/// message naming the bad field.
+const char* check_block(const avm_frame_block& block) noexcept;
+/// Row `i` of the block as a landmark frame: a part whose array is NULL or whose first x is
+/// NaN is absent; a face whose row 468 x is NaN has 468 points.
+void block_row_to_frame(const avm_frame_block& block, std::int64_t i, landmark_frame& out) noexcept;
+/// The frame into row `i` of the block's non-NULL arrays; parts it lacks (and rows 468..477
+/// of a 468-point face) are NaN.
+void frame_to_block_row(const landmark_frame& in, const avm_frame_block& block,
+                        std::int64_t i) noexcept;
+
+}  // namespace avatarmap::c_api
