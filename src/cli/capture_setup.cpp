@@ -1,7 +1,8 @@
 #include "cli/capture_setup.hpp"
 
 #include <cstdlib>
-#include <fstream>
+
+#include "avatarmap/jobs/capture_file.hpp"
 
 namespace avatarmap::cli {
 
@@ -178,18 +179,6 @@ void timing_totals::print(std::FILE* to) const {
   detector("face detector", sum.face_detector_ms, face_detector_frames);
 }
 
-long resident_kib() {
-  std::ifstream f("/proc/self/status");
-  std::string key;
-  while (f >> key) {
-    if (key == "VmRSS:") {
-      long v = 0;
-      f >> v;
-      return v;
-    }
-    f.ignore(1 << 12, '\n');
-  }
-  return 0;
-}
+long resident_kib() { return resident_memory_kib(); }
 
 }  // namespace avatarmap::cli

@@ -1,8 +1,35 @@
-// avm_capture_file: `avatarmap capture INPUT -o OUT` as a library call.
+// avm_capture_file: `avatarmap capture INPUT -o OUT` as a library call, the library's
+// capture_file_job (the CLI's `capture` runs it too) on the calling thread and its decoder's.
+#include <cstdint>
+#include <string>
+
 #include "avatarmap/avatarmap.h"
+#include "avatarmap/capture/capture_pipeline.hpp"
+#include "avatarmap/capture/video_source.hpp"
+#include "avatarmap/jobs/capture_file.hpp"
+#include "c_capture_options.hpp"
 #include "c_guard.hpp"
 
+namespace am = avatarmap;
 using namespace avatarmap::c_api;
+
+namespace {
+
+void fill_summary(const am::capture_file_summary& s, avm_capture_summary& out) {
+  using fp = am::frame_part;
+  out.frames = s.frames;
+  out.body_frames = s.part_frames[static_cast<int>(fp::pose)];
+  out.left_hand_frames = s.part_frames[static_cast<int>(fp::left_hand)];
+  out.right_hand_frames = s.part_frames[static_cast<int>(fp::right_hand)];
+  out.face_frames = s.part_frames[static_cast<int>(fp::face)];
+  out.frames_not_decoded = s.frames_not_decoded;
+  out.image_width = s.input.width;
+  out.image_height = s.input.height;
+  out.fps = s.input.fps;
+  out.seconds = s.seconds;
+}
+
+}  // namespace
 
 extern "C" {
 
@@ -11,9 +38,44 @@ AVATARMAP_C_API avm_status avm_capture_file(const char* input, const char* out_l
                                             avm_capture_summary* out_summary,
                                             avm_progress_fn progress, void* user, char* err,
                                             size_t err_size) {
-  (void)input, (void)out_landmarks, (void)options, (void)out_summary, (void)progress, (void)user;
-  copy_message(err, err_size, "avm_capture_file: not implemented yet in this build");
-  return AVM_ERROR_UNSUPPORTED;
+  copy_message(err, err_size, "");
+  auto report = [&](avm_status code, const char* msg) {
+    copy_message(err, err_size, msg);
+    return code;
+  };
+  if (input == nullptr || out_landmarks == nullptr)
+    return report(AVM_ERROR_INVALID_ARGUMENT,
+                  "avm_capture_file: input and out_landmarks must not be NULL");
+  if (out_summary != nullptr && out_summary->struct_size < sizeof(avm_capture_summary))
+    return report(AVM_ERROR_INVALID_ARGUMENT,
+                  "avm_capture_file: set out_summary->struct_size = sizeof(avm_capture_summary)");
+  return guard("avm_capture_file", report, [&]() -> avm_status {
+    am::capture_pipeline_options po;
+    double unused_extrapolation = 0.0;
+    std::string msg;
+    const avm_status code = read_capture_options(options, nullptr, po, unused_extrapolation, msg);
+    if (code != AVM_OK) return report(code, ("avm_capture_file: " + msg).c_str());
+    if (!am::video_source_available())
+      return report(AVM_ERROR_UNSUPPORTED,
+                    "avm_capture_file: this avatarmap library was built without FFmpeg: it "
+                    "cannot decode video or images");
+    am::capture_file_job job;
+    job.input = input;
+    job.output = out_landmarks;
+    job.options = po.estimator;
+    job.allow_live_input = false;
+    if (progress != nullptr)
+      job.progress = [&](const am::capture_file_progress& p) {
+        progress(user, p.frames, p.total_frames);
+      };
+    am::capture_file_summary s;
+    const am::status st = job.run(s);
+    if (out_summary != nullptr) fill_summary(s, *out_summary);
+    if (!st.ok()) return report(code_for(st, job_code(s.failure)), st.message().c_str());
+    if (progress != nullptr)  // the last call says where it ended
+      progress(user, s.frames, s.frames);
+    return AVM_OK;
+  });
 }
 
 }  // extern "C"

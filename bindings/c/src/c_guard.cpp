@@ -47,6 +47,7 @@ avm_status job_code(job_failure why) noexcept {
       return AVM_ERROR_IO;
     case job_failure::input_parse:
       return AVM_ERROR_PARSE;
+    case job_failure::internal:
     case job_failure::none:
       break;
   }

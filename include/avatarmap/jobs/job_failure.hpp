@@ -12,6 +12,7 @@ enum class job_failure : std::uint8_t {
   input_io,          // an input file (landmarks, avatar, mapping table) cannot be read
   input_parse,       // an input file is malformed (a landmark line, an avatar, a table)
   output_io,         // the output cannot be written (or the sink refused a pose)
+  internal,          // a stage of the library failed on valid input (the estimator on a frame)
 };
 
 }  // namespace avatarmap

@@ -790,8 +790,8 @@ AVATARMAP_C_API avm_status avm_retargeter_apply_poses(avm_retargeter* r, const a
 
 /* ---- capture of a whole file ----------------------------------------------------------- */
 
-/* What avm_capture_file() did. Set struct_size = sizeof(avm_capture_summary) before the
- * call: fields past the caller's struct_size are not written. */
+/* What avm_capture_file() did (also filled, as far as it got, when it fails). Set
+ * struct_size = sizeof(avm_capture_summary) before the call (a smaller one is refused). */
 typedef struct avm_capture_summary {
   uint32_t struct_size;
   int64_t frames;                                                        /* frames written */
@@ -802,8 +802,9 @@ typedef struct avm_capture_summary {
   double seconds; /* wall-clock time of the run, start-up included */
 } avm_capture_summary;
 
-/* Called about twice a second during avm_capture_file() on its calling thread: frames done,
- * frames expected (0 when unknown). */
+/* Called about twice a second during avm_capture_file() on its calling thread, and once at
+ * the end of a successful run (done = total = the frames written): frames done, frames
+ * expected (0 when unknown). */
 typedef void (*avm_progress_fn)(void* user, int64_t done, int64_t total);
 
 /* `avatarmap capture INPUT -o OUT` as a library call (the same library job as the CLI's
@@ -813,11 +814,12 @@ typedef void (*avm_progress_fn)(void* user, int64_t done, int64_t total);
  * avm_estimator_options_init() (hands and face on; threads 2 gives two lanes, threads 1 one
  * thread). `out_summary` (struct_size set) and `progress` may be NULL; `user` is passed to
  * `progress`. err as avm_solve_file().
- * Failures: AVM_ERROR_INVALID_ARGUMENT (a path NULL, a device or stream, bad options, no
- *   models folder), AVM_ERROR_IO (the input cannot be opened or decoded, the output cannot be
- *   written, the models are missing), AVM_ERROR_UNSUPPORTED (built without ONNX Runtime or
- *   the video decoder), AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL. Thread-safe (separate
- *   files). */
+ * Frames that cannot be decoded are skipped and counted (frames_not_decoded).
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (a path NULL, a device or stream, bad options or
+ *   out_summary->struct_size, no models folder), AVM_ERROR_IO (the input cannot be opened or
+ *   read, the output cannot be written, the models are missing), AVM_ERROR_UNSUPPORTED
+ *   (built without ONNX Runtime or FFmpeg), AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL (the
+ *   estimator failed on a frame: the message gives its time). Thread-safe (separate files). */
 AVATARMAP_C_API avm_status avm_capture_file(const char* input, const char* out_landmarks,
                                             const avm_estimator_options* options,
                                             avm_capture_summary* out_summary,
