@@ -9,7 +9,10 @@ packages=(build-essential cmake ninja-build pkg-config
           libavformat-dev libavcodec-dev libavutil-dev libswscale-dev
           libavdevice-dev ffmpeg  # devices (v4l2:, lavfi:); the ffmpeg tool streams in tests
           python3-onnx python3-numpy  # python3-onnx: the tflite -> ONNX converter (tools/convert)
-          liblo-tools)  # oscdump, oscsend: the independent OSC receiver of the VMC tests
+          liblo-tools  # oscdump, oscsend: the independent OSC receiver of the VMC tests
+          # The Python package (docs/python.md): its tests, a venv to pip-install it into,
+          # and Dask for `python3 -m avatarmap.batch`.
+          python3-pytest python3-venv python3-distributed)
 # The browser viewer (docs/viewer.md): its server library, and headless Chromium for its tests.
 packages+=(libwebsockets-dev chromium python3-pil)
 # The fuzz run and the sanitizer run (scripts/test.sh, scripts/sanitize.sh) need clang with its

@@ -1,0 +1,494 @@
+"""Landmarks and poses as NumPy arrays; reading, solving and writing whole files."""
+
+from __future__ import annotations
+
+import ctypes
+import os
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Tuple, Union
+
+import numpy as np
+
+from . import _lib
+from ._errors import InvalidArgumentError, error_for
+from ._lib import (BONE_COUNT, EXPRESSION_COUNT, FACE_POINTS, FACE_POINTS_NO_IRIS, HAND_POINTS,
+                   POSE_DTYPE, POSE_POINTS, AvmFrameBlock, AvmSolverOptions, fn, text)
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+# (field, points per frame) of Landmarks, in avm_frame_block's order.
+PARTS: Tuple[Tuple[str, int], ...] = (
+    ("pose", POSE_POINTS), ("pose_world", POSE_POINTS),
+    ("left_hand", HAND_POINTS), ("left_hand_world", HAND_POINTS),
+    ("right_hand", HAND_POINTS), ("right_hand_world", HAND_POINTS),
+    ("face", FACE_POINTS))
+
+_ERR_SIZE = 2048
+
+
+def _path(p: PathLike, what: str) -> bytes:
+    try:
+        b = os.fsencode(p)
+    except TypeError:
+        raise InvalidArgumentError("%s: expected a path (str or os.PathLike), got %s"
+                                   % (what, type(p).__name__), 1) from None
+    if b"\0" in b or not b:
+        raise InvalidArgumentError("%s: %s" % (what, "a NUL character in %r" % (p,) if b
+                                               else "an empty path"), 1)
+    return b
+
+
+def _check(status: int, message: Union[bytes, str, None]) -> None:
+    if status != _lib.OK:
+        raise error_for(status, message if isinstance(message, str) else text(message))
+
+
+# ---- data ---------------------------------------------------------------------------------
+
+
+def _nan_part(n: int, points: int) -> np.ndarray:
+    return np.full((n, points, 5), np.nan, dtype=np.float32)
+
+
+@dataclass
+class Landmarks:
+    """Frames of MediaPipe landmarks, one row per frame (structure of arrays).
+
+    ``t`` (N,) float64 capture times in seconds; ``pose``, ``pose_world`` (N, 33, 5),
+    ``left_hand``, ``left_hand_world``, ``right_hand``, ``right_hand_world`` (N, 21, 5) and
+    ``face`` (N, 478, 5) float32 rows of (x, y, z, visibility, presence): image points
+    normalised to the image's width and height (y down), world points in metres. A part not
+    seen in a frame is NaN there (its first point's x is what counts); a 468-point face has
+    rows 468..477 NaN. ``left``/``right`` are the person's sides. ``image_width`` and
+    ``image_height`` are pixels (0 unknown), ``fps`` the nominal rate (0 unknown).
+    """
+
+    t: np.ndarray
+    pose: np.ndarray
+    pose_world: np.ndarray
+    left_hand: np.ndarray
+    left_hand_world: np.ndarray
+    right_hand: np.ndarray
+    right_hand_world: np.ndarray
+    face: np.ndarray
+    image_width: int = 0
+    image_height: int = 0
+    fps: float = 0.0
+
+    def __len__(self) -> int:
+        return int(np.shape(self.t)[0])
+
+    @classmethod
+    def empty(cls, n: int, *, image_width: int = 0, image_height: int = 0,
+              fps: float = 0.0) -> "Landmarks":
+        """n frames with nothing seen (every point NaN, t zero): fill in what you have."""
+        if n < 0:
+            raise InvalidArgumentError("Landmarks.empty: n must be >= 0, got %d" % n, 1)
+        parts = {name: _nan_part(n, points) for name, points in PARTS}
+        return cls(t=np.zeros(n, dtype=np.float64), image_width=image_width,
+                   image_height=image_height, fps=fps, **parts)
+
+    def seen(self, part: str) -> np.ndarray:
+        """(N,) bool: whether `part` ("pose", "left_hand", ...) was seen in each frame."""
+        return ~np.isnan(np.asarray(getattr(self, part))[:, 0, 0])
+
+
+@dataclass
+class Poses:
+    """Proxy poses of the 55 VRM 1.0 humanoid bones (``BONE_NAMES`` order), one per frame.
+
+    ``t`` (N,) float64 seconds; ``hips_position`` (N, 3) float32 metres in VRM space (Y =
+    hips height above the soles); ``rotations`` (N, 55, 4) float32 local rotations as
+    quaternions {x, y, z, w} (identity = VRM T-pose); ``confidence`` (N, 55) 0..1;
+    ``expressions`` (N, 16) weights 0..1 (``EXPRESSION_NAMES`` order). The arrays of poses
+    returned by this package are views of one record array laid out as the C API's avm_pose
+    (``records``).
+    """
+
+    t: np.ndarray
+    hips_position: np.ndarray
+    rotations: np.ndarray
+    confidence: np.ndarray
+    expressions: np.ndarray
+    _records: Optional[np.ndarray] = field(default=None, repr=False, compare=False)
+
+    def __len__(self) -> int:
+        return int(np.shape(self.t)[0])
+
+    @classmethod
+    def from_records(cls, records: np.ndarray) -> "Poses":
+        """Poses viewing an array of dtype ``POSE_DTYPE`` (no copy)."""
+        if records.dtype != POSE_DTYPE or records.ndim != 1:
+            raise InvalidArgumentError("Poses.from_records: expected a 1-D array of "
+                                       "avatarmap.POSE_DTYPE", 1)
+        return cls(t=records["t"], hips_position=records["hips_position"],
+                   rotations=records["rotations"], confidence=records["confidence"],
+                   expressions=records["expressions"], _records=records)
+
+    @classmethod
+    def empty(cls, n: int) -> "Poses":
+        """n rest poses (identity rotations, hips at (0, 0.95, 0), confidence 0, t zero)."""
+        rec = np.zeros(n, dtype=POSE_DTYPE)
+        rec["rotations"][:, :, 3] = 1.0
+        rec["hips_position"][:, 1] = 0.95
+        return cls.from_records(rec)
+
+    @property
+    def records(self) -> np.ndarray:
+        """The poses as one array of ``POSE_DTYPE`` (avm_pose's layout): the array these
+        fields view when they still do, else a new one assembled from the fields."""
+        rec = self._records
+        if rec is not None and self._views(rec):
+            return rec
+        n = len(self)
+        rec = np.empty(n, dtype=POSE_DTYPE)
+        for name, shape in (("t", (n,)), ("hips_position", (n, 3)),
+                            ("rotations", (n, BONE_COUNT, 4)), ("confidence", (n, BONE_COUNT)),
+                            ("expressions", (n, EXPRESSION_COUNT))):
+            value = np.asarray(getattr(self, name))
+            if value.shape != shape:
+                raise InvalidArgumentError("Poses.%s: shape %s, expected %s"
+                                           % (name, value.shape, shape), 1)
+            rec[name] = value
+        return rec
+
+    def _views(self, rec: np.ndarray) -> bool:
+        for name in ("t", "hips_position", "rotations", "confidence", "expressions"):
+            a = getattr(self, name)
+            b = rec[name]
+            if not isinstance(a, np.ndarray) or a.shape != b.shape or a.strides != b.strides \
+                    or a.__array_interface__["data"][0] != b.__array_interface__["data"][0]:
+                return False
+        return True
+
+    def __getitem__(self, index: Union[int, slice]) -> "Poses":
+        """Poses of one frame (an int) or of a slice of frames, as views."""
+        rec = self.records
+        if isinstance(index, (int, np.integer)):
+            i = int(index)
+            if i < 0:
+                i += len(rec)
+            if not 0 <= i < len(rec):
+                raise IndexError("pose index %d out of range (%d poses)" % (index, len(rec)))
+            return Poses.from_records(rec[i:i + 1])
+        return Poses.from_records(rec[index])
+
+
+# ---- options ------------------------------------------------------------------------------
+
+SOLVER_OPTION_NAMES = tuple(n for n, _ in AvmSolverOptions._fields_ if n != "struct_size")
+
+
+def solver_options(options: Dict[str, Any]) -> AvmSolverOptions:
+    """avm_solver_options from keyword arguments named as its fields (file_filter also as
+    "offline" | "live" | "none"). Ranges are checked by the C API."""
+    # Room for a newer library's longer struct: *_init writes the library's own size.
+    buf = ctypes.create_string_buffer(4096)
+    o = AvmSolverOptions.from_buffer(buf)
+    o._buffer = buf  # type: ignore[attr-defined]  # keeps the memory alive
+    _check(fn("avm_solver_options_init")(o), "avm_solver_options_init failed")
+    o.struct_size = ctypes.sizeof(AvmSolverOptions)  # what this package knows
+    for name, value in options.items():
+        if name not in SOLVER_OPTION_NAMES:
+            raise TypeError("unknown solver option %r (options: %s)"
+                            % (name, ", ".join(SOLVER_OPTION_NAMES)))
+        if name == "file_filter" and isinstance(value, str):
+            if value not in _lib.FILE_FILTERS:
+                raise InvalidArgumentError(
+                    "file_filter %r: expected \"offline\", \"live\" or \"none\"" % value, 1)
+            value = _lib.FILE_FILTERS[value]
+        try:
+            setattr(o, name, value)
+        except TypeError:
+            raise InvalidArgumentError("solver option %s: expected a number or bool, got %r"
+                                       % (name, value), 1) from None
+    return o
+
+
+# ---- arrays <-> avm_frame_block -----------------------------------------------------------
+
+
+def _part_array(value: Any, n: int, name: str, points: int) -> Optional[np.ndarray]:
+    """A part as a C-contiguous float32 (n, points, 5) array (None stays None). Accepts
+    (n, points, 3) (visibility and presence 1) and, for the face, 468 points."""
+    if value is None:
+        return None
+    try:
+        a = np.asarray(value, dtype=np.float32)
+    except (TypeError, ValueError) as e:
+        raise InvalidArgumentError("landmarks.%s: not an array of numbers (%s)" % (name, e),
+                                   1) from None
+    ok_points = (points, FACE_POINTS_NO_IRIS) if name == "face" else (points,)
+    if a.ndim != 3 or a.shape[0] != n or a.shape[1] not in ok_points or a.shape[2] not in (3, 5):
+        raise InvalidArgumentError(
+            "landmarks.%s: shape %s, expected (%d, %s, 5) (or 3 columns: x, y, z)"
+            % (name, a.shape, n, " or ".join(str(p) for p in ok_points)), 1)
+    if a.shape[1] != points or a.shape[2] != 5:
+        full = np.full((n, points, 5), np.nan, dtype=np.float32)
+        full[:, :a.shape[1], :a.shape[2]] = a
+        if a.shape[2] == 3:
+            full[:, :a.shape[1], 3:] = 1.0
+        a = full
+    return np.ascontiguousarray(a)
+
+
+def frame_block(landmarks: Landmarks) -> Tuple[AvmFrameBlock, List[np.ndarray]]:
+    """An avm_frame_block over the landmarks' arrays (converted only when they are not
+    already C-contiguous float32 of the right shape) and the arrays to keep alive."""
+    try:
+        t = np.ascontiguousarray(np.asarray(landmarks.t, dtype=np.float64))
+    except (TypeError, ValueError) as e:
+        raise InvalidArgumentError("landmarks.t: not an array of numbers (%s)" % e, 1) from None
+    if t.ndim != 1:
+        raise InvalidArgumentError("landmarks.t: shape %s, expected (N,)" % (t.shape,), 1)
+    n = t.shape[0]
+    block = AvmFrameBlock()
+    block.struct_size = ctypes.sizeof(AvmFrameBlock)
+    block.count = n
+    block.t = t.ctypes.data
+    keep = [t]
+    for name, points in PARTS:
+        a = _part_array(getattr(landmarks, name, None), n, name, points)
+        if a is not None:
+            setattr(block, name, a.ctypes.data)
+            keep.append(a)
+    return block, keep
+
+
+# ---- files --------------------------------------------------------------------------------
+
+
+class _Handle:
+    """Owns a C handle; closed by close(), a `with` block or garbage collection."""
+
+    _destroy_name = ""
+
+    def __init__(self) -> None:
+        self._h = ctypes.c_void_p()
+
+    @property
+    def closed(self) -> bool:
+        return not self._h
+
+    def _handle(self) -> ctypes.c_void_p:
+        if not self._h:
+            raise InvalidArgumentError("%s is closed" % type(self).__name__, 1)
+        return self._h
+
+    def close(self) -> None:
+        """Frees the C handle (again: nothing). Waits for a call in flight on another thread
+        when the handle serialises its calls (Solver, Retargeter, Estimator)."""
+        lock = getattr(self, "_lock", None)
+        if lock is not None:
+            with lock:
+                h, self._h = self._h, ctypes.c_void_p()
+        else:
+            h, self._h = self._h, ctypes.c_void_p()
+        if h:
+            fn(self._destroy_name)(h)
+
+    def __enter__(self):  # type: ignore[no-untyped-def]
+        self._handle()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may be gone
+            pass
+
+
+class _Reader(_Handle):
+    _destroy_name = "avm_landmark_reader_destroy"
+
+
+class _Clip(_Handle):
+    _destroy_name = "avm_clip_destroy"
+
+    def __init__(self) -> None:
+        super().__init__()
+        _check(fn("avm_clip_create")(ctypes.byref(self._h)), fn("avm_last_create_error")())
+
+    def last_error(self) -> bytes:
+        return fn("avm_clip_last_error")(self._h)
+
+
+_READ_BLOCK = 8192  # frames per avm_landmark_reader_read call
+
+
+def _estimate_frames(path: bytes) -> int:
+    """A generous guess of a landmark file's frame count from its size and its first MiB's
+    lines. Arrays of this many rows are allocated uninitialised: rows never read are pages
+    never touched, so a guess too high costs address space, not memory."""
+    try:
+        size = os.path.getsize(path)
+        with open(path, "rb") as f:
+            sample = f.read(1 << 20)
+    except OSError:
+        return 0  # the reader reports the error
+    lines = max(sample.count(b"\n"), 1)
+    if len(sample) >= size:
+        return lines + 1
+    return int(size / len(sample) * lines * 1.5) + 1024
+
+
+def read_landmarks(path: PathLike) -> Landmarks:
+    """Reads a whole ``*.landmarks.jsonl`` file (docs/file-formats.md) into arrays.
+
+    Raises FileIOError (cannot open), ParseError ("FILE:LINE: ..." of the first malformed
+    line)."""
+    reader = _Reader()
+    p = _path(path, "read_landmarks")
+    _check(fn("avm_landmark_reader_open")(p, ctypes.byref(reader._h)),
+           fn("avm_last_create_error")())
+    with reader:
+        w, h, fps = ctypes.c_int32(), ctypes.c_int32(), ctypes.c_double()
+        _check(fn("avm_landmark_reader_header")(reader._h, ctypes.byref(w), ctypes.byref(h),
+                                                ctypes.byref(fps)),
+               fn("avm_landmark_reader_last_error")(reader._h))
+        # Read straight into arrays of the guessed size; past it, into further chunks that
+        # are joined at the end (the only copy).
+        chunks: List[Landmarks] = []
+        current = _uninitialised(max(_estimate_frames(p), _READ_BLOCK))
+        used = 0
+        read = ctypes.c_int64()
+        while True:
+            if used == len(current):
+                chunks.append(current)
+                current, used = _uninitialised(max(len(current) // 2, _READ_BLOCK)), 0
+            room = _slice(current, used, min(used + _READ_BLOCK, len(current)))
+            block, _keep = frame_block(room)
+            st = fn("avm_landmark_reader_read")(reader._h, ctypes.byref(block),
+                                                ctypes.byref(read))
+            if st == _lib.ERROR_END_OF_FILE:
+                break
+            _check(st, fn("avm_landmark_reader_last_error")(reader._h))
+            if read.value <= 0:
+                break
+            used += read.value
+        chunks.append(_slice(current, 0, used))
+    out = _concat(chunks)
+    out.image_width, out.image_height, out.fps = int(w.value), int(h.value), float(fps.value)
+    return out
+
+
+def _uninitialised(n: int) -> Landmarks:
+    return Landmarks(t=np.empty(n, dtype=np.float64),
+                     **{name: np.empty((n, points, 5), dtype=np.float32)
+                        for name, points in PARTS})
+
+
+def _slice(lm: Landmarks, first: int, end: int) -> Landmarks:
+    """Rows [first, end) as views (C-contiguous: rows are whole frames)."""
+    return Landmarks(t=lm.t[first:end], **{name: getattr(lm, name)[first:end]
+                                           for name, _ in PARTS})
+
+
+def _concat(chunks: List[Landmarks]) -> Landmarks:
+    if len(chunks) == 1:
+        return chunks[0]
+    return Landmarks(t=np.concatenate([c.t for c in chunks]),
+                     **{name: np.concatenate([getattr(c, name) for c in chunks])
+                        for name, _ in PARTS})
+
+
+def read_poses(path: PathLike) -> Poses:
+    """Reads a whole ``*.pose.jsonl`` file (frames as written) into arrays.
+
+    Raises FileIOError, ParseError."""
+    clip = _Clip.__new__(_Clip)
+    _Handle.__init__(clip)
+    err = ctypes.create_string_buffer(_ERR_SIZE)
+    _check(fn("avm_clip_read")(_path(path, "read_poses"), ctypes.byref(clip._h), err, _ERR_SIZE),
+           err.value)
+    with clip:
+        n = fn("avm_clip_frame_count")(clip._h)
+        rec = np.empty(n, dtype=POSE_DTYPE)
+        if n:
+            _check(fn("avm_clip_get_poses")(clip._h, 0, n, rec.ctypes.data), clip.last_error())
+    return Poses.from_records(rec)
+
+
+def solve(landmarks: Landmarks, **options: Any) -> Poses:
+    """Solves every frame into a proxy pose exactly as ``avatarmap solve`` / solve_file does
+    (one avm_solve_frames call: offline smoothing by default, one pose per frame, no
+    resampling).
+
+    ``options`` are avm_solver_options' fields by name (``mirror=True``,
+    ``file_filter="live"``, ``rotation_min_cutoff=1.2``, ...); the landmarks' image size is
+    used when ``image_width``/``image_height`` are not given. Raises InvalidArgumentError
+    (shapes, options, times not finite or not increasing)."""
+    if not isinstance(landmarks, Landmarks):
+        raise InvalidArgumentError("solve: expected avatarmap.Landmarks, got %s"
+                                   % type(landmarks).__name__, 1)
+    if "image_width" not in options and "image_height" not in options \
+            and landmarks.image_width > 0 and landmarks.image_height > 0:
+        options = dict(options, image_width=landmarks.image_width,
+                       image_height=landmarks.image_height)
+    o = solver_options(options)
+    block, _keep = frame_block(landmarks)
+    rec = np.empty(block.count, dtype=POSE_DTYPE)
+    err = ctypes.create_string_buffer(_ERR_SIZE)
+    _check(fn("avm_solve_frames")(ctypes.byref(block), o, rec.ctypes.data, err, _ERR_SIZE),
+           err.value)
+    return Poses.from_records(rec)
+
+
+def solve_file(in_landmarks: PathLike, out_pose: PathLike, **options: Any) -> None:
+    """``avatarmap solve IN -o OUT``: a ``*.landmarks.jsonl`` file into a ``*.pose.jsonl``
+    file, written atomically (avm_solve_file). Options as solve()."""
+    o = solver_options(options)
+    err = ctypes.create_string_buffer(_ERR_SIZE)
+    _check(fn("avm_solve_file")(_path(in_landmarks, "solve_file"), _path(out_pose, "solve_file"),
+                                o, err, _ERR_SIZE), err.value)
+
+
+def _text_arg(value: Optional[PathLike], what: str) -> Optional[bytes]:
+    return None if value is None else _path(value, what)
+
+
+def write_animation(poses: Poses, path: PathLike, *, fps: float = 0.0,
+                    avatar: Optional[PathLike] = None, mapping: Optional[str] = None) -> None:
+    """Writes poses as an animation file chosen by the extension: ``.vrma`` (VRM Animation),
+    ``.glb`` (the avatar at ``avatar`` animated; required), ``.bvh`` (the proxy skeleton, or
+    the avatar's rig with ``avatar``) or ``.pose.jsonl``. ``fps`` > 0 resamples; ``mapping``
+    as ``avatarmap convert --rig`` (None = auto). Written atomically.
+
+    Times must be finite and increasing (InvalidArgumentError otherwise)."""
+    if not isinstance(poses, Poses):
+        raise InvalidArgumentError("write_animation: expected avatarmap.Poses, got %s"
+                                   % type(poses).__name__, 1)
+    rec = np.ascontiguousarray(poses.records)
+    with _Clip() as clip:
+        if len(rec):
+            _check(fn("avm_clip_add_poses")(clip._h, rec.ctypes.data, len(rec)),
+                   clip.last_error())
+        _write_clip(clip, path, fps, avatar, mapping)
+
+
+def _write_clip(clip: _Clip, path: PathLike, fps: float, avatar: Optional[PathLike],
+                mapping: Optional[str]) -> None:
+    err = ctypes.create_string_buffer(_ERR_SIZE)
+    try:
+        fps_value = float(fps)
+    except (TypeError, ValueError):
+        raise InvalidArgumentError("fps: expected a number, got %r" % (fps,), 1) from None
+    _check(fn("avm_clip_write")(clip._h, _path(path, "path"), fps_value,
+                                _text_arg(avatar, "avatar"), _text_arg(mapping, "mapping"),
+                                err, _ERR_SIZE), err.value)
+
+
+def convert_file(pose_path: PathLike, out_path: PathLike, *, fps: float = 0.0,
+                 avatar: Optional[PathLike] = None, mapping: Optional[str] = None) -> None:
+    """``avatarmap convert POSE -o OUT``: read_poses + write_animation inside the library
+    (no NumPy round trip)."""
+    clip = _Clip.__new__(_Clip)
+    _Handle.__init__(clip)
+    err = ctypes.create_string_buffer(_ERR_SIZE)
+    _check(fn("avm_clip_read")(_path(pose_path, "convert_file"), ctypes.byref(clip._h), err,
+                               _ERR_SIZE), err.value)
+    with clip:
+        _write_clip(clip, out_path, fps, avatar, mapping)

@@ -1,0 +1,336 @@
+"""ctypes declarations of the avatarmap C API (bindings/c/include/avatarmap/avatarmap.h) and
+the loading of libavatarmap_c.
+
+Internal module: the public API is in ``avatarmap``. Struct mirrors here must match the
+header field for field; tests/python/test_layout.py compiles a C check against the header.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import os
+from typing import Callable, Dict, List, Optional, Tuple
+
+import numpy as np
+
+BONE_COUNT = 55
+EXPRESSION_COUNT = 16
+POSE_POINTS = 33
+HAND_POINTS = 21
+FACE_POINTS = 478  # with iris refinement; a 468-point face has rows 468..477 NaN
+FACE_POINTS_NO_IRIS = 468
+
+# avm_status
+OK = 0
+ERROR_INVALID_ARGUMENT = 1
+ERROR_IO = 2
+ERROR_PARSE = 3
+ERROR_END_OF_FILE = 4
+ERROR_UNSUPPORTED = 5
+ERROR_OUT_OF_MEMORY = 6
+ERROR_INTERNAL = 7
+
+# avm_file_filter
+FILE_FILTERS = {"offline": 0, "live": 1, "none": 2}
+
+# avm_pixel_format
+PIXEL_RGB8 = 0
+PIXEL_RGBA8 = 2
+
+_I32, _F32, _F64, _I64, _U32 = (ctypes.c_int32, ctypes.c_float, ctypes.c_double,
+                                ctypes.c_int64, ctypes.c_uint32)
+_P = ctypes.c_void_p  # opaque handles and NumPy buffers (passed as addresses)
+_FloatP = ctypes.POINTER(ctypes.c_float)
+
+
+class AvmLandmark(ctypes.Structure):
+    _fields_ = [(n, _F32) for n in ("x", "y", "z", "visibility", "presence")]
+
+
+_LandmarkP = ctypes.POINTER(AvmLandmark)
+
+
+class AvmFrame(ctypes.Structure):
+    _fields_ = [("t", _F64), ("pose", _LandmarkP), ("pose_world", _LandmarkP),
+                ("left_hand", _LandmarkP), ("left_hand_world", _LandmarkP),
+                ("right_hand", _LandmarkP), ("right_hand_world", _LandmarkP),
+                ("face", _LandmarkP), ("face_count", _I32)]
+
+
+class AvmPose(ctypes.Structure):
+    _fields_ = [("t", _F64), ("hips_position", _F32 * 3),
+                ("rotations", (_F32 * 4) * BONE_COUNT), ("confidence", _F32 * BONE_COUNT),
+                ("expressions", _F32 * EXPRESSION_COUNT)]
+
+
+# The avm_pose array as NumPy sees it: one record per pose, same offsets as the C struct
+# (align=True gives C's natural alignment; the layout test checks it against the header).
+POSE_DTYPE = np.dtype([("t", "<f8"), ("hips_position", "<f4", (3,)),
+                       ("rotations", "<f4", (BONE_COUNT, 4)),
+                       ("confidence", "<f4", (BONE_COUNT,)),
+                       ("expressions", "<f4", (EXPRESSION_COUNT,))], align=True)
+
+
+class AvmSolverOptions(ctypes.Structure):
+    # Field order as in the header; new fields are only ever appended there.
+    _fields_ = [
+        ("struct_size", _U32),
+        ("mirror", _I32), ("image_width", _F32), ("image_height", _F32),
+        ("solve_body", _I32), ("solve_hands", _I32), ("solve_face", _I32),
+        ("solve_hips_translation", _I32),
+        ("confidence_lost_below", _F32), ("confidence_found_above", _F32),
+        ("confidence_hold_seconds", _F32), ("confidence_ease_seconds", _F32),
+        ("confidence_regain_seconds", _F32),
+        ("hips_lean_share", _F32), ("forearm_twist_share", _F32),
+        ("horizontal_fov_degrees", _F32), ("rest_hips_height", _F32),
+        ("filter_rotations", _I32), ("rotation_min_cutoff", _F32), ("rotation_beta", _F32),
+        ("rotation_d_cutoff", _F32),
+        ("filter_position", _I32), ("position_min_cutoff", _F32), ("position_beta", _F32),
+        ("position_d_cutoff", _F32),
+        ("filter_expressions", _I32), ("expression_min_cutoff", _F32),
+        ("expression_beta", _F32), ("expression_d_cutoff", _F32),
+        ("max_extrapolation_seconds", _F32),
+        ("file_filter", _I32), ("file_smoothing", _F32),
+    ]
+
+
+class AvmFrameBlock(ctypes.Structure):
+    _fields_ = [("struct_size", _U32), ("count", _I64), ("t", _P), ("pose", _P),
+                ("pose_world", _P), ("left_hand", _P), ("left_hand_world", _P),
+                ("right_hand", _P), ("right_hand_world", _P), ("face", _P)]
+
+
+class AvmImage(ctypes.Structure):
+    _fields_ = [("data", _P), ("width", _I32), ("height", _I32), ("stride_bytes", _I32),
+                ("format", _I32)]
+
+
+class AvmEstimatorOptions(ctypes.Structure):
+    _fields_ = [("struct_size", _U32), ("models_dir", ctypes.c_char_p),
+                ("model_complexity", _I32), ("hands", _I32), ("face", _I32),
+                ("hand_model_complexity", _I32), ("threads", _I32), ("mirrored", _I32),
+                ("static_images", _I32)]
+
+
+class AvmLiveStats(ctypes.Structure):
+    _fields_ = [("pushed", _I64), ("processed", _I64), ("dropped", _I64), ("failed", _I64),
+                ("latency_p50_ms", _F64), ("latency_p95_ms", _F64), ("latency_max_ms", _F64),
+                ("newest_t", _F64)]
+
+
+class AvmCaptureSummary(ctypes.Structure):
+    _fields_ = [("struct_size", _U32), ("frames", _I64), ("body_frames", _I64),
+                ("left_hand_frames", _I64), ("right_hand_frames", _I64),
+                ("face_frames", _I64), ("frames_not_decoded", _I64),
+                ("image_width", _I32), ("image_height", _I32), ("fps", _F64),
+                ("seconds", _F64)]
+
+
+PROGRESS_FN = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int64, ctypes.c_int64)
+
+_S = ctypes.c_int  # avm_status
+_STR = ctypes.c_char_p
+_SIZE = ctypes.c_size_t
+_PP = ctypes.POINTER(ctypes.c_void_p)
+_IntP = ctypes.POINTER(ctypes.c_int)
+
+# name: (restype, argtypes). Functions of 0.1.0 and of issue 12; a library without one of
+# them fails only when that function is used (see fn()).
+_SIGNATURES: Dict[str, Tuple[object, List[object]]] = {
+    "avm_version": (None, [_IntP, _IntP, _IntP]),
+    "avm_version_string": (_STR, []),
+    "avm_status_string": (_STR, [_S]),
+    "avm_bone_name": (_STR, [ctypes.c_int]),
+    "avm_bone_parent": (ctypes.c_int, [ctypes.c_int]),
+    "avm_bone_from_name": (ctypes.c_int, [_STR]),
+    "avm_expression_name": (_STR, [ctypes.c_int]),
+    "avm_solver_options_init": (_S, [ctypes.POINTER(AvmSolverOptions)]),
+    "avm_solver_create": (_S, [ctypes.POINTER(AvmSolverOptions), _PP]),
+    "avm_last_create_error": (_STR, []),
+    "avm_solver_destroy": (None, [_P]),
+    "avm_solver_reset": (_S, [_P]),
+    "avm_solver_push": (_S, [_P, ctypes.POINTER(AvmFrame)]),
+    "avm_solver_get_pose": (_S, [_P, _P]),
+    "avm_solver_sample": (_S, [_P, _F64, _P]),
+    "avm_solver_last_error": (_STR, [_P]),
+    "avm_solve_file": (_S, [_STR, _STR, ctypes.POINTER(AvmSolverOptions), _P, _SIZE]),
+    "avm_set_mappings_folder": (_S, [_STR]),
+    "avm_retargeter_create": (_S, [_STR, _STR, _PP]),
+    "avm_retargeter_destroy": (None, [_P]),
+    "avm_retargeter_joint_count": (ctypes.c_int, [_P]),
+    "avm_retargeter_joint_name": (_STR, [_P, ctypes.c_int]),
+    "avm_retargeter_joint_parent": (ctypes.c_int, [_P, ctypes.c_int]),
+    "avm_retargeter_bone_joint": (ctypes.c_int, [_P, ctypes.c_int]),
+    "avm_retargeter_binding_description": (_STR, [_P]),
+    "avm_retargeter_apply": (_S, [_P, _P, _P, _P]),
+    "avm_retargeter_last_error": (_STR, [_P]),
+    "avm_clip_create": (_S, [_PP]),
+    "avm_clip_destroy": (None, [_P]),
+    "avm_clip_add": (_S, [_P, _P]),
+    "avm_clip_frame_count": (ctypes.c_int, [_P]),
+    "avm_clip_write": (_S, [_P, _STR, _F64, _STR, _STR, _P, _SIZE]),
+    "avm_clip_last_error": (_STR, [_P]),
+    "avm_estimator_options_init": (_S, [ctypes.POINTER(AvmEstimatorOptions)]),
+    "avm_estimator_create": (_S, [ctypes.POINTER(AvmEstimatorOptions),
+                                  ctypes.POINTER(AvmSolverOptions), _PP]),
+    "avm_estimator_destroy": (None, [_P]),
+    "avm_estimator_process": (_S, [_P, ctypes.POINTER(AvmImage), _F64,
+                                   ctypes.POINTER(AvmFrame), _P]),
+    "avm_estimator_last_error": (_STR, [_P]),
+    "avm_live_create": (_S, [ctypes.POINTER(AvmEstimatorOptions),
+                             ctypes.POINTER(AvmSolverOptions), _PP]),
+    "avm_live_destroy": (None, [_P]),
+    "avm_live_push": (_S, [_P, ctypes.POINTER(AvmImage), _F64]),
+    "avm_live_sample": (_S, [_P, _F64, _P]),
+    "avm_live_latest": (_S, [_P, _P]),
+    "avm_live_get_stats": (_S, [_P, ctypes.POINTER(AvmLiveStats)]),
+    "avm_live_last_error": (_STR, [_P, _P, _SIZE]),
+    # issue 12
+    "avm_landmark_reader_open": (_S, [_STR, _PP]),
+    "avm_landmark_reader_header": (_S, [_P, ctypes.POINTER(_I32), ctypes.POINTER(_I32),
+                                        ctypes.POINTER(_F64)]),
+    "avm_landmark_reader_read": (_S, [_P, ctypes.POINTER(AvmFrameBlock),
+                                      ctypes.POINTER(_I64)]),
+    "avm_landmark_reader_last_error": (_STR, [_P]),
+    "avm_landmark_reader_destroy": (None, [_P]),
+    "avm_solve_frames": (_S, [ctypes.POINTER(AvmFrameBlock), ctypes.POINTER(AvmSolverOptions),
+                              _P, _P, _SIZE]),
+    "avm_clip_read": (_S, [_STR, _PP, _P, _SIZE]),
+    "avm_clip_get_poses": (_S, [_P, _I64, _I64, _P]),
+    "avm_clip_add_poses": (_S, [_P, _P, _I64]),
+    "avm_retargeter_apply_poses": (_S, [_P, _P, _I64, _P, _P]),
+    "avm_capture_file": (_S, [_STR, _STR, ctypes.POINTER(AvmEstimatorOptions),
+                              ctypes.POINTER(AvmCaptureSummary), PROGRESS_FN, _P, _P, _SIZE]),
+}
+
+_LIBRARY_NAME = "libavatarmap_c.so"
+
+
+def _config() -> Dict[str, Optional[str]]:
+    """Paths recorded when the package was installed (the generated _config.py), or {}."""
+    try:
+        from . import _config as cfg  # type: ignore[attr-defined]
+    except ImportError:
+        return {}
+    return {k: getattr(cfg, k, None) for k in ("LIBRARY", "MODELS_DIR", "MAPPINGS_DIR")}
+
+
+def _source_root() -> Optional[str]:
+    """The repository root when the package runs from the source tree (bindings/python)."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.normpath(os.path.join(here, "..", "..", ".."))
+    if os.path.isfile(os.path.join(root, "bindings", "c", "include", "avatarmap", "avatarmap.h")):
+        return root
+    return None
+
+
+def _candidates() -> List[Tuple[str, str]]:
+    """(path, where it came from) in the order the library is looked for."""
+    out: List[Tuple[str, str]] = []
+    env = os.environ.get("AVATARMAP_C_LIBRARY")
+    if env:
+        out.append((env, "$AVATARMAP_C_LIBRARY"))
+    here = os.path.dirname(os.path.abspath(__file__))
+    out.append((os.path.join(here, _LIBRARY_NAME), "the package folder"))
+    recorded = _config().get("LIBRARY")
+    if recorded:
+        out.append((recorded, "recorded at install time"))
+    root = _source_root()
+    if root:
+        out.append((os.path.join(root, "build", "bindings", "c", _LIBRARY_NAME),
+                    "the source tree's build/"))
+    found = ctypes.util.find_library("avatarmap_c")
+    if found:
+        out.append((found, "the system's library path"))
+    return out
+
+
+def _load() -> Tuple[ctypes.CDLL, str]:
+    tried = []
+    for path, where in _candidates():
+        if "/" in path and not os.path.exists(path):
+            tried.append("%s (%s): no such file" % (path, where))
+            continue
+        try:
+            return ctypes.CDLL(path), path
+        except OSError as e:
+            tried.append("%s (%s): %s" % (path, where, e))
+    raise ImportError(
+        "avatarmap: cannot load the C library libavatarmap_c.so. Tried:\n  " +
+        "\n  ".join(tried or ["(nothing)"]) +
+        "\nBuild it (cmake --build build --target avatarmap_c) and install the package again "
+        "(pip install --no-build-isolation ./bindings/python, or cmake --install build), or "
+        "set AVATARMAP_C_LIBRARY=/path/to/libavatarmap_c.so.")
+
+
+lib, LIBRARY_PATH = _load()
+_declared: Dict[str, Callable] = {}
+
+
+def fn(name: str) -> Callable:
+    """The C function `name`, declared; UnsupportedError when the loaded library lacks it
+    (a library older than this package)."""
+    f = _declared.get(name)
+    if f is None:
+        try:
+            f = getattr(lib, name)
+        except AttributeError:
+            from ._errors import UnsupportedError
+            raise UnsupportedError(
+                "%s is not in the loaded C library %s (version %s): rebuild libavatarmap_c "
+                "from the same source as this package" % (name, LIBRARY_PATH, version()),
+                ERROR_UNSUPPORTED) from None
+        restype, argtypes = _SIGNATURES[name]
+        f.restype = restype
+        f.argtypes = argtypes
+        _declared[name] = f
+    return f
+
+
+def text(c_string: Optional[bytes]) -> str:
+    """A C string as str (bytes that are not UTF-8, e.g. in a file name, replaced)."""
+    return (c_string or b"").decode("utf-8", errors="replace")
+
+
+def version() -> str:
+    return text(fn("avm_version_string")())
+
+
+def status_name(status: int) -> str:
+    return text(fn("avm_status_string")(status))
+
+
+def models_dir_default() -> Optional[str]:
+    """The models folder to use when none is given: $AVATARMAP_MODELS/onnx, else the one
+    recorded at build/install time, else the source tree's cache."""
+    env = os.environ.get("AVATARMAP_MODELS")
+    if env:
+        return os.path.join(env, "onnx")
+    recorded = _config().get("MODELS_DIR")
+    if recorded:
+        return recorded
+    root = _source_root()
+    if root:
+        return os.path.join(root, ".cache", "avatarmap", "models", "onnx")
+    return None
+
+
+def mappings_dir_default() -> Optional[str]:
+    recorded = _config().get("MAPPINGS_DIR")
+    if recorded and os.path.isdir(recorded):
+        return recorded
+    root = _source_root()
+    if root and os.path.isdir(os.path.join(root, "mappings")):
+        return os.path.join(root, "mappings")
+    return None
+
+
+def _set_mappings_folder() -> None:
+    # $AVATARMAP_MAPPINGS, when set, wins inside the library; this is the fallback.
+    folder = mappings_dir_default()
+    if folder:
+        fn("avm_set_mappings_folder")(os.fsencode(folder))
+
+
+_set_mappings_folder()

@@ -1,0 +1,104 @@
+"""The package's mirrors of the C structs against the header itself: a small C program
+compiled against bindings/c/include/avatarmap/avatarmap.h prints every struct's size and
+every field's offset, and they must equal ctypes' and POSE_DTYPE's."""
+
+import ctypes
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+import avatarmap
+from avatarmap import _lib
+
+STRUCTS = {  # C name -> ctypes mirror
+    "avm_landmark": _lib.AvmLandmark,
+    "avm_frame": _lib.AvmFrame,
+    "avm_pose": _lib.AvmPose,
+    "avm_solver_options": _lib.AvmSolverOptions,
+    "avm_image": _lib.AvmImage,
+    "avm_estimator_options": _lib.AvmEstimatorOptions,
+    "avm_live_stats": _lib.AvmLiveStats,
+    "avm_frame_block": _lib.AvmFrameBlock,
+    "avm_capture_summary": _lib.AvmCaptureSummary,
+}
+
+
+def _header():
+    include = os.environ.get("AVATARMAP_C_INCLUDE")
+    if not include:
+        here = os.path.dirname(os.path.abspath(__file__))
+        include = os.path.join(here, "..", "..", "bindings", "c", "include")
+    header = os.path.join(include, "avatarmap", "avatarmap.h")
+    if not os.path.isfile(header):
+        pytest.skip("the C header is not found (AVATARMAP_C_INCLUDE)")
+    return include, open(header, encoding="utf-8").read()
+
+
+def _c_layout(tmp_path):
+    """{struct: (size, {field: offset})} as the C compiler sees the header."""
+    include, text = _header()
+    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    if not cc or not shutil.which(cc):
+        pytest.skip("no C compiler (CC) to check the layout against the header")
+    lines = ['#include <stdio.h>', '#include <stddef.h>', '#include "avatarmap/avatarmap.h"',
+             "int main(void) {"]
+    present = {}
+    for name, mirror in STRUCTS.items():
+        if ("struct %s {" % name) not in text:
+            continue  # not in this header yet
+        present[name] = mirror
+        lines.append('  printf("%s sizeof %%zu\\n", sizeof(%s));' % (name, name))
+        for field, _ in mirror._fields_:
+            lines.append('  printf("%s %s %%zu\\n", offsetof(%s, %s));'
+                         % (name, field, name, field))
+    lines += ["  return 0;", "}"]
+    src = tmp_path / "layout.c"
+    src.write_text("\n".join(lines) + "\n")
+    exe = tmp_path / "layout"
+    subprocess.run([cc, "-std=c99", "-I", include, str(src), "-o", str(exe)], check=True)
+    out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
+    layout = {}
+    for line in out.splitlines():
+        struct, field, value = line.split()
+        size, offsets = layout.setdefault(struct, [None, {}])
+        if field == "sizeof":
+            layout[struct][0] = int(value)
+        else:
+            offsets[field] = int(value)
+    return present, layout
+
+
+def test_ctypes_mirrors_match_the_header(tmp_path):
+    present, layout = _c_layout(tmp_path)
+    assert "avm_pose" in present and "avm_solver_options" in present
+    for name, mirror in present.items():
+        size, offsets = layout[name]
+        assert ctypes.sizeof(mirror) == size, name
+        for field, _ in mirror._fields_:
+            assert getattr(mirror, field).offset == offsets[field], (name, field)
+
+
+def test_pose_dtype_matches_the_header(tmp_path):
+    _, layout = _c_layout(tmp_path)
+    size, offsets = layout["avm_pose"]
+    assert avatarmap.POSE_DTYPE.itemsize == size == 1184
+    for field in avatarmap.POSE_DTYPE.names:
+        assert avatarmap.POSE_DTYPE.fields[field][1] == offsets[field], field
+    assert avatarmap.POSE_DTYPE["rotations"].shape == (55, 4)
+
+
+def test_poses_view_one_record_array():
+    poses = avatarmap.Poses.empty(3)
+    rec = poses.records
+    assert rec.dtype == avatarmap.POSE_DTYPE
+    poses.rotations[1, 5] = (0.0, 0.0, 0.6, 0.8)  # a view: the record changes too
+    assert np.array_equal(rec["rotations"][1, 5], np.float32([0, 0, 0.6, 0.8]))
+    assert poses.records is rec  # still views it
+    copy = avatarmap.Poses(t=poses.t.copy(), hips_position=poses.hips_position.copy(),
+                           rotations=poses.rotations.copy(), confidence=poses.confidence.copy(),
+                           expressions=poses.expressions.copy())
+    assert np.array_equal(copy.records, rec)  # assembled from plain arrays: same bytes
+    assert copy.records.tobytes() == rec.tobytes()
