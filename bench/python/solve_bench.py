@@ -98,23 +98,21 @@ def whole_file(path, cli, repeat):
              lambda: subprocess.run([cli, "solve", path, "-o", out_cli, "--quiet", "--threads",
                                      "1"], check=True, stderr=subprocess.DEVNULL)),
             ("Python read_landmarks + solve + write_animation", python_path),
-            ("Python solve_file", lambda: am.solve_file(path, out_file))]
-    results = []
+            ("Python solve_file", lambda: am.solve_file(path, out_file)),
+            ("Python solve_file to arrays (Poses, no file)", lambda: am.solve_file(path))]
+    runs = [[] for _ in rows]
     for name, fn in rows:
         fn()  # warm the page cache
-    for _ in range(repeat):
+    for _ in range(repeat):  # alternated, one run of each in turn
         for i, (name, fn) in enumerate(rows):
-            t = best(fn, 1)
-            if len(results) <= i:
-                results.append(t)
-            else:
-                results[i] = min(results[i], t)
-    print("(b) %s: %d frames (best of %d)" % (path, parts["frames"], repeat))
+            runs[i].append(best(fn, 1))
+    results = [float(np.median(r)) for r in runs]
+    print("(b) %s: %d frames (median of %d, alternated)" % (path, parts["frames"], repeat))
     base = results[0]
     for (name, _), t in zip(rows, results):
         print("  %-50s %7.3f s  %.2fx" % (name, t, t / base))
-    print("  Python path parts: read %.3f s, solve %.3f s, write %.3f s"
-          % (min(parts["read"]), min(parts["solve"]), min(parts["write"])))
+    print("  Python path parts (medians): read %.3f s, solve %.3f s, write %.3f s"
+          % tuple(float(np.median(parts[k])) for k in ("read", "solve", "write")))
     same = open(out_cli, "rb").read() == open(out_file, "rb").read()
     print("  solve_file's output identical to the CLI's: %s" % same)
     a, b = am.read_poses(out_py), am.read_poses(out_cli)

@@ -90,6 +90,7 @@ class AvmSolverOptions(ctypes.Structure):
         ("filter_expressions", _I), ("expression_min_cutoff", _F), ("expression_beta", _F),
         ("expression_d_cutoff", _F),
         ("max_extrapolation_seconds", _F),
+        ("file_filter", _I), ("file_smoothing", _F), ("file_threads", _I),
     ]
 
 

@@ -99,7 +99,9 @@ status load_motion(const std::string& in, const solve_file_job& solve, std::vect
     };
     solve_file_summary summary;
     // A progress line on a terminal.
-    return run_solve_job(job, progress_mode::automatic, summary);
+    status st = run_solve_job(job, progress_mode::automatic, summary);
+    source_fps = summary.fps;  // the landmarks' nominal rate, as `avatarmap solve` writes it
+    return st;
   }
   return status::error(in +
                        ": unknown input type (give *.landmarks.jsonl, *.pose.jsonl or *.vrma)");

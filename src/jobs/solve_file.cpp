@@ -158,6 +158,7 @@ status solve_file_job::run(solve_file_summary& s) const {
   pose_file_header ph;
   ph.present = true;
   ph.fps = output_fps > 0.0 ? output_fps : header.fps;
+  s.fps = ph.fps;
   pose_write_options wo;
   wo.write_confidence = write_confidence;
   if (!sink) {

@@ -294,6 +294,21 @@ static void test_solve_frames_matches_file(const char* path) {
     }
     avm_clip_destroy(clip);
     clip = NULL;
+    /* avm_solve_file_to_clip keeps the same job's poses: bit for bit the in-memory ones,
+     * confidence included (a pose file has none). */
+    {
+      avm_solver_options of;
+      avm_solver_options_init(&of);
+      of.file_filter = filter;
+      CHECK(avm_solve_file_to_clip(path, &of, &clip, err, sizeof err) == AVM_OK && clip != NULL);
+      if (clip != NULL) {
+        CHECK(avm_clip_frame_count(clip) == (int)all.count);
+        CHECK(avm_clip_get_poses(clip, 0, all.count, file) == AVM_OK);
+        CHECK(memcmp(mem, file, (size_t)all.count * sizeof(avm_pose)) == 0);
+        avm_clip_destroy(clip);
+        clip = NULL;
+      }
+    }
   }
   /* Not a trivial match: the poses move. */
   for (i = 1; i < all.count; ++i)
@@ -319,6 +334,23 @@ static void test_solve_frames_matches_file(const char* path) {
   free(mem);
   free(file);
   free_block(&all);
+}
+
+static void test_solve_file_to_clip_errors(void) {
+  avm_clip* clip = (avm_clip*)&clip; /* not NULL: the call must set it */
+  avm_solver_options o;
+  char err[512];
+  CHECK(avm_solve_file_to_clip("no_such_dir/none.landmarks.jsonl", NULL, &clip, err, sizeof err) ==
+        AVM_ERROR_IO);
+  CHECK(clip == NULL && strstr(err, "none.landmarks.jsonl") != NULL);
+  CHECK(avm_solve_file_to_clip(NULL, NULL, &clip, err, sizeof err) == AVM_ERROR_INVALID_ARGUMENT);
+  CHECK(avm_solve_file_to_clip("x.landmarks.jsonl", NULL, NULL, err, sizeof err) ==
+        AVM_ERROR_INVALID_ARGUMENT);
+  avm_solver_options_init(&o);
+  o.file_smoothing = -1.f;
+  CHECK(avm_solve_file_to_clip("x.landmarks.jsonl", &o, &clip, err, sizeof err) ==
+        AVM_ERROR_INVALID_ARGUMENT);
+  CHECK(clip == NULL && strstr(err, "file_smoothing") != NULL);
 }
 
 static void test_solve_frames_errors(void) {
@@ -521,6 +553,7 @@ int main(int argc, char** argv) {
     printf("no synthetic recording given (argv[1]): the hand-written file only\n");
   }
   test_solve_frames_errors();
+  test_solve_file_to_clip_errors();
   test_clip_poses();
   test_apply_poses();
   printf("%d passed, %d failed\n", g_passed, g_failed);

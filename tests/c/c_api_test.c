@@ -526,6 +526,20 @@ static int count_lines(const char* path, int* has_hips) {
   return n;
 }
 
+/* The whole file as a NUL-terminated string (malloc'd), or NULL. */
+static char* read_text(const char* path) {
+  FILE* fp = fopen(path, "rb");
+  char* buf = NULL;
+  long n;
+  if (fp == NULL) return NULL;
+  if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0) {
+    buf = (char*)malloc((size_t)n + 1);
+    if (buf != NULL) buf[fread(buf, 1, (size_t)n, fp)] = '\0';
+  }
+  fclose(fp);
+  return buf;
+}
+
 static void test_solve_file(void) {
   const char* in = "c_api_test_input.landmarks.jsonl";
   const char* out = "c_api_test_output.pose.jsonl";
@@ -569,6 +583,24 @@ static void test_solve_file(void) {
   o.file_filter = AVM_FILE_FILTER_NONE;
   CHECK_STATUS(avm_solve_file(in, out, &o, err, sizeof err), AVM_OK);
   CHECK(count_lines(out, &has_hips) == lines);
+
+  /* file_threads: 2 (parse ahead) by default; 1 writes the same bytes; others are refused. */
+  avm_solver_options_init(&o);
+  CHECK(o.file_threads == 2);
+  CHECK_STATUS(avm_solve_file(in, out, &o, err, sizeof err), AVM_OK);
+  {
+    char* two = read_text(out);
+    char* one;
+    o.file_threads = 1;
+    CHECK_STATUS(avm_solve_file(in, out, &o, err, sizeof err), AVM_OK);
+    one = read_text(out);
+    CHECK(one != NULL && two != NULL && strlen(one) > 100 && strcmp(one, two) == 0);
+    free(one);
+    free(two);
+  }
+  o.file_threads = 3;
+  CHECK_STATUS(avm_solve_file(in, out, &o, err, sizeof err), AVM_ERROR_INVALID_ARGUMENT);
+  CHECK(strstr(err, "file_threads") != NULL);
 
   /* A missing input: an I/O error with a message; the output is untouched. */
   CHECK_STATUS(avm_solve_file("does/not/exist.landmarks.jsonl", out, NULL, err, sizeof err),

@@ -8,7 +8,7 @@ endif()
 foreach(fn avm_version avm_solver_create avm_solver_push avm_solver_sample avm_solve_file
            avm_bone_name avm_last_create_error avm_landmark_reader_open avm_landmark_reader_header
            avm_landmark_reader_read avm_landmark_reader_last_error avm_landmark_reader_destroy
-           avm_solve_frames avm_clip_read avm_clip_get_poses avm_clip_add_poses
+           avm_solve_frames avm_solve_file_to_clip avm_clip_read avm_clip_get_poses avm_clip_add_poses
            avm_retargeter_apply_poses avm_capture_file)
   if(NOT symbols MATCHES " ${fn}\n")
     message(FATAL_ERROR "${LIB} does not export ${fn}")

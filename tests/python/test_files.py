@@ -62,12 +62,28 @@ def test_convert_file_equals_cli_convert(pose_file, cli, tmp_path, ext, fps):
     cli("convert", pose_file, "-o", ref, *(("--fps", fps) if fps else ()))
     mine = tmp_path / ("py" + ext)
     am.convert_file(pose_file, mine, fps=fps)
-    a, b = mine.read_bytes(), ref.read_bytes()
-    if ext == ".pose.jsonl":
-        # A clip has no nominal rate: the header lacks the input's "fps" the CLI copies.
-        assert a.split(b"\n", 1)[0] == b'{"format":"avatarmap.pose","version":1}'
-        a, b = a.split(b"\n", 1)[1], b.split(b"\n", 1)[1]
-    assert a == b
+    # .pose.jsonl at fps 0 too: the clip keeps the input's nominal rate for the header.
+    assert mine.read_bytes() == ref.read_bytes()
+
+
+@pytest.mark.parametrize("ext", [".vrma", ".bvh", ".pose.jsonl"])
+def test_convert_file_of_landmarks_equals_cli_convert(synth_file, cli, tmp_path, ext):
+    """convert_file(LANDMARKS) solves in memory (avm_solve_file_to_clip) and writes the bytes
+    of `avatarmap convert LANDMARKS -o OUT` (CLI default 30 frames/s; .pose.jsonl: its frames,
+    header included), on one thread or two."""
+    ref = tmp_path / ("cli" + ext)
+    cli("convert", synth_file, "-o", ref)
+    fps = 0 if ext == ".pose.jsonl" else 30
+    for threads in (1, 2):
+        mine = tmp_path / ("py%d%s" % (threads, ext))
+        n = am.convert_file(synth_file, mine, fps=fps, file_threads=threads)
+        assert n == len(am.read_landmarks(synth_file))
+        assert mine.read_bytes() == ref.read_bytes()
+    with pytest.raises(am.InvalidArgumentError, match="file_threads"):
+        am.convert_file(synth_file, tmp_path / "x.vrma", file_threads=3)
+    with pytest.raises(am.InvalidArgumentError, match="landmarks.jsonl input only"):
+        am.convert_file(ref if ext == ".pose.jsonl" else tmp_path / "py1.pose.jsonl",
+                        tmp_path / "y.vrma", mirror=True)
 
 
 @pytest.mark.parametrize("ext", [".vrma", ".bvh"])

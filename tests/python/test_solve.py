@@ -83,6 +83,19 @@ def test_solve_file_equals_solve(synth_file, tmp_path):
         np.testing.assert_array_equal(getattr(back, name), getattr(poses, name), err_msg=name)
 
 
+@pytest.mark.parametrize("file_filter", ["offline", "live", "none"])
+def test_solve_file_without_output_returns_the_poses_of_solve(synth_file, file_filter):
+    """solve_file(IN) (avm_solve_file_to_clip: the file parsed on a second thread) gives
+    solve(read_landmarks(IN))'s poses bit for bit, confidence included."""
+    kept = am.solve_file(synth_file, file_filter=file_filter)
+    poses = am.solve(am.read_landmarks(synth_file), file_filter=file_filter)
+    assert len(kept) == len(poses) > 0
+    for name in ("t", "hips_position", "rotations", "confidence", "expressions"):
+        np.testing.assert_array_equal(getattr(kept, name), getattr(poses, name), err_msg=name)
+    with pytest.raises(am.FileIOError, match="nothing.landmarks.jsonl"):
+        am.solve_file(str(synth_file) + ".nothing.landmarks.jsonl")
+
+
 def test_live_filter_equals_the_per_frame_solver(synth_file):
     """file_filter="live" is avm_solver_push's filtering: solve() over the arrays equals a
     Solver pushed frame by frame (another C path: avm_frame, one call per frame)."""

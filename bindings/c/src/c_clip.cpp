@@ -1,5 +1,7 @@
 // The C API's clip handle (avm_clip_*): poses collected in memory, then written as a file by
 // the library's clip-output job (the CLI's `convert` runs it too).
+#include "c_clip.hpp"
+
 #include <cmath>
 #include <cstddef>
 #include <memory>
@@ -19,10 +21,6 @@
 
 namespace am = avatarmap;
 using namespace avatarmap::c_api;
-
-struct avm_clip : avatarmap::c_api::error_slot {
-  std::vector<am::proxy_pose> frames;
-};
 
 namespace {
 
@@ -62,12 +60,14 @@ void sanitized_pose(const avm_pose& in, const am::proxy_pose* prev, am::proxy_po
 // Writes `frames` to `path` with the library's clip-output job (the CLI's `convert` runs it
 // too): the job's checks first, then the avatar (loaded and bound only when the format uses
 // it), then the write. On failure returns the status and sets `msg`.
-avm_status write_clip(const std::vector<am::proxy_pose>& frames, const std::string& path,
-                      double fps, const char* avatar_path, const char* mapping, std::string& msg) {
+avm_status write_clip(const std::vector<am::proxy_pose>& frames, double source_fps,
+                      const std::string& path, double fps, const char* avatar_path,
+                      const char* mapping, std::string& msg) {
   am::clip_output_job job;
   job.path = path;
   job.frames = &frames;
   job.fps = fps;
+  job.source_fps = source_fps;
   job.avatar_path = avatar_path != nullptr ? avatar_path : "";
   if (am::status st = job.validate(); !st.ok()) {
     msg = st.message();
@@ -219,6 +219,7 @@ AVATARMAP_C_API avm_status avm_clip_read(const char* path, avm_clip** out, char*
       return report(code_for(st, reader.line() > 0 ? AVM_ERROR_PARSE : AVM_ERROR_IO),
                     st.message().c_str());
     std::unique_ptr<avm_clip> clip(new avm_clip());
+    clip->source_fps = reader.header().fps;
     am::proxy_pose p;
     for (;;) {
       const am::read_result r = reader.next(p);
@@ -257,7 +258,8 @@ AVATARMAP_C_API avm_status avm_clip_write(avm_clip* clip, const char* path, doub
     return report(AVM_ERROR_INVALID_ARGUMENT, "avm_clip_write: clip and path must not be NULL");
   return guard("avm_clip_write", report, [&]() -> avm_status {
     std::string msg;
-    const avm_status code = write_clip(clip->frames, path, fps, avatar_path, mapping, msg);
+    const avm_status code =
+        write_clip(clip->frames, clip->source_fps, path, fps, avatar_path, mapping, msg);
     if (code != AVM_OK) return report(code, msg.c_str());
     return AVM_OK;
   });

@@ -1,5 +1,6 @@
 // The C API's landmark-file reader (avm_landmark_reader_*): the library's landmark_reader,
-// frames copied into a caller's frame block.
+// parsing ahead on a second thread (the frame_prefetcher of `avatarmap solve`) while the caller
+// copies frames into its frame blocks.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -9,13 +10,17 @@
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "c_frame_block.hpp"
 #include "c_guard.hpp"
+#include "jobs/frame_prefetcher.hpp"
 
 namespace am = avatarmap;
 using namespace avatarmap::c_api;
 
 struct avm_landmark_reader : avatarmap::c_api::error_slot {
   am::landmark_reader reader;
-  am::landmark_frame frame;  // scratch: the frame read (~20 kB: the handle is on the heap)
+  // Parses `reader` ahead on its own thread, from the first read on (a malformed line is
+  // handed over as an error and reading goes on); stopped and joined by the destructor.
+  std::unique_ptr<am::jobs_detail::frame_prefetcher> ahead;
+  bool ended = false;  // the prefetcher gave the end: it must not be asked again
 };
 
 extern "C" {
@@ -67,15 +72,22 @@ AVATARMAP_C_API avm_status avm_landmark_reader_read(avm_landmark_reader* r,
   if (block->t == nullptr)
     return fail(r, AVM_ERROR_INVALID_ARGUMENT, "avm_landmark_reader_read: block->t is NULL");
   return guard("avm_landmark_reader_read", to_handle(r), [&]() -> avm_status {
+    if (!r->ahead) r->ahead = std::make_unique<am::jobs_detail::frame_prefetcher>(r->reader, false);
     int64_t n = 0;
-    for (; n < block->count; ++n) {
-      const am::read_result res = r->reader.next(r->frame);
-      if (res == am::read_result::end) break;
+    for (; n < block->count && !r->ended; ++n) {
+      const am::read_result res = r->ahead->next();
+      if (res == am::read_result::end) {
+        r->ended = true;
+        break;
+      }
       if (res == am::read_result::error) {
         *out_read = n;
-        return fail(r, AVM_ERROR_PARSE, r->reader.error().c_str());
+        fail(r, AVM_ERROR_PARSE, r->ahead->error().c_str());
+        r->ahead->release();
+        return AVM_ERROR_PARSE;
       }
-      frame_to_block_row(r->frame, *block, n);
+      frame_to_block_row(r->ahead->frame(), *block, n);
+      r->ahead->release();
     }
     *out_read = n;
     return AVM_OK;

@@ -17,6 +17,7 @@
 #include "avatarmap/time/offline_smoother.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
+#include "c_clip.hpp"
 #include "c_frame_block.hpp"
 #include "c_frames.hpp"
 #include "c_guard.hpp"
@@ -43,7 +44,9 @@ struct avm_solver : avatarmap::c_api::error_slot {
 
 namespace {
 
-// The solve-file job as avm_solve_file and avm_solve_frames run it, on the calling thread.
+// The solve-file job as avm_solve_file and avm_solve_frames run it: with file_threads 2 (the
+// default) a file is parsed ahead on a second thread of the job's own, as `avatarmap solve`
+// does (frames from memory are pulled on the calling thread whatever `threads` says).
 am::solve_file_job file_job(const core_options& o) {
   am::solve_file_job job;
   job.options = o.solver;
@@ -54,7 +57,7 @@ am::solve_file_job file_job(const core_options& o) {
   job.offline.strength = o.file_smoothing;
   job.filter = o.filter;
   job.filter_channels = o.channels;
-  job.threads = 1;
+  job.threads = o.file_threads;
   return job;
 }
 
@@ -182,13 +185,50 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
       set_create_error(msg.c_str());
       return report(AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
     }
-    // The library's solve-file job (the CLI's `solve` runs it too), on this thread.
+    // The library's solve-file job (the CLI's `solve` runs it too).
     am::solve_file_job job = file_job(o);
     job.input = in_landmarks;
     job.output = out_pose;
     am::solve_file_summary summary;
     const am::status st = job.run(summary);
     if (!st) return report(code_for(st, job_code(summary.failure)), st.message().c_str());
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_solve_file_to_clip(const char* in_landmarks,
+                                                  const avm_solver_options* options, avm_clip** out,
+                                                  char* err, size_t err_size) {
+  copy_message(err, err_size, "");
+  set_create_error("");
+  if (out != nullptr) *out = nullptr;
+  auto report = [&](avm_status code, const char* msg) {
+    copy_message(err, err_size, msg);
+    return code;
+  };
+  if (in_landmarks == nullptr || out == nullptr)
+    return report(AVM_ERROR_INVALID_ARGUMENT,
+                  "avm_solve_file_to_clip: in_landmarks and out must not be NULL");
+  return guard("avm_solve_file_to_clip", report, [&]() -> avm_status {
+    core_options o;
+    std::string msg;
+    if (!read_options(options, o, msg)) {
+      set_create_error(msg.c_str());
+      return report(AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
+    }
+    // avm_solve_file's job with the poses kept in the clip instead of written.
+    std::unique_ptr<avm_clip> clip(new avm_clip());
+    am::solve_file_job job = file_job(o);
+    job.input = in_landmarks;
+    job.sink = [&clip](const am::proxy_pose& p) {
+      clip->frames.push_back(p);
+      return am::status{};
+    };
+    am::solve_file_summary summary;
+    const am::status st = job.run(summary);
+    if (!st) return report(code_for(st, job_code(summary.failure)), st.message().c_str());
+    clip->source_fps = summary.fps;  // a .pose.jsonl written from it has avm_solve_file's header
+    *out = clip.release();
     return AVM_OK;
   });
 }

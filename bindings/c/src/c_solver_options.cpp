@@ -55,6 +55,7 @@ avm_solver_options default_options() {
   o.max_extrapolation_seconds = static_cast<float>(r.max_extrapolation_seconds);
   o.file_filter = AVM_FILE_FILTER_OFFLINE;
   o.file_smoothing = am::offline_smoother_options{}.strength;
+  o.file_threads = 2;
   return o;
 }
 
@@ -158,6 +159,12 @@ bool read_options(const avm_solver_options* in, core_options& out, std::string& 
     return false;
   }
   out.file_smoothing = o.file_smoothing;
+  if (o.file_threads != 1 && o.file_threads != 2) {
+    msg = "avm_solver_options.file_threads is " + std::to_string(o.file_threads) +
+          ": use 1 (the calling thread only) or 2 (parse ahead on a second thread; default)";
+    return false;
+  }
+  out.file_threads = o.file_threads;
   return true;
 }
 

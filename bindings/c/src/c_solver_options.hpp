@@ -21,6 +21,7 @@ struct core_options {
   avatarmap::pose_filter_mode file_filter =
       avatarmap::pose_filter_mode::offline;  // avm_solve_file only
   float file_smoothing = 1.f;
+  int file_threads = 2;  // avm_solve_file, avm_solve_file_to_clip
 };
 
 /// The defaults, as avm_solver_options_init() gives them.

@@ -405,10 +405,14 @@ def read_poses(path: PathLike) -> Poses:
     _check(fn("avm_clip_read")(_path(path, "read_poses"), ctypes.byref(clip._h), err, _ERR_SIZE),
            err.value)
     with clip:
-        n = fn("avm_clip_frame_count")(clip._h)
-        rec = np.empty(n, dtype=POSE_DTYPE)
-        if n:
-            _check(fn("avm_clip_get_poses")(clip._h, 0, n, rec.ctypes.data), clip.last_error())
+        return _clip_poses(clip)
+
+
+def _clip_poses(clip: "_Clip") -> Poses:
+    n = fn("avm_clip_frame_count")(clip._h)
+    rec = np.empty(n, dtype=POSE_DTYPE)
+    if n:
+        _check(fn("avm_clip_get_poses")(clip._h, 0, n, rec.ctypes.data), clip.last_error())
     return Poses.from_records(rec)
 
 
@@ -437,13 +441,26 @@ def solve(landmarks: Landmarks, **options: Any) -> Poses:
     return Poses.from_records(rec)
 
 
-def solve_file(in_landmarks: PathLike, out_pose: PathLike, **options: Any) -> None:
+def solve_file(in_landmarks: PathLike, out_pose: Optional[PathLike] = None,
+               **options: Any) -> Optional[Poses]:
     """``avatarmap solve IN -o OUT``: a ``*.landmarks.jsonl`` file into a ``*.pose.jsonl``
-    file, written atomically (avm_solve_file). Options as solve()."""
+    file, written atomically (avm_solve_file), and None. Without ``out_pose`` the same poses
+    come back as Poses instead, confidence included (avm_solve_file_to_clip): the fastest way
+    from a file to arrays, parsing ahead on a second thread as the CLI does. Options as
+    solve()."""
     o = solver_options(options)
     err = ctypes.create_string_buffer(_ERR_SIZE)
-    _check(fn("avm_solve_file")(_path(in_landmarks, "solve_file"), _path(out_pose, "solve_file"),
-                                o, err, _ERR_SIZE), err.value)
+    src = _path(in_landmarks, "solve_file")
+    if out_pose is not None:
+        _check(fn("avm_solve_file")(src, _path(out_pose, "solve_file"), o, err, _ERR_SIZE),
+               err.value)
+        return None
+    clip = _Clip.__new__(_Clip)
+    _Handle.__init__(clip)
+    _check(fn("avm_solve_file_to_clip")(src, o, ctypes.byref(clip._h), err, _ERR_SIZE),
+           err.value)
+    with clip:
+        return _clip_poses(clip)
 
 
 def _text_arg(value: Optional[PathLike], what: str) -> Optional[bytes]:
@@ -481,14 +498,27 @@ def _write_clip(clip: _Clip, path: PathLike, fps: float, avatar: Optional[PathLi
                                 err, _ERR_SIZE), err.value)
 
 
-def convert_file(pose_path: PathLike, out_path: PathLike, *, fps: float = 0.0,
-                 avatar: Optional[PathLike] = None, mapping: Optional[str] = None) -> None:
-    """``avatarmap convert POSE -o OUT``: read_poses + write_animation inside the library
-    (no NumPy round trip)."""
+def convert_file(in_path: PathLike, out_path: PathLike, *, fps: float = 0.0,
+                 avatar: Optional[PathLike] = None, mapping: Optional[str] = None,
+                 **options: Any) -> int:
+    """``avatarmap convert IN -o OUT`` inside the library (no NumPy round trip); returns the
+    number of frames converted (before any resampling to ``fps``). IN is a
+    ``*.pose.jsonl`` (read as written: avm_clip_read) or a ``*.landmarks.jsonl``, solved first
+    as solve_file(IN) solves it, with ``options`` as solve()'s (avm_solve_file_to_clip; the
+    bytes of ``avatarmap convert`` of the landmarks). Written atomically."""
+    src = _path(in_path, "convert_file")
     clip = _Clip.__new__(_Clip)
     _Handle.__init__(clip)
     err = ctypes.create_string_buffer(_ERR_SIZE)
-    _check(fn("avm_clip_read")(_path(pose_path, "convert_file"), ctypes.byref(clip._h), err,
-                               _ERR_SIZE), err.value)
+    if os.fsdecode(os.fspath(in_path)).lower().endswith(".landmarks.jsonl"):
+        _check(fn("avm_solve_file_to_clip")(src, solver_options(options), ctypes.byref(clip._h),
+                                            err, _ERR_SIZE), err.value)
+    else:
+        if options:
+            raise InvalidArgumentError("convert_file: solver options (%s) apply to a "
+                                       "*.landmarks.jsonl input only" % ", ".join(sorted(options)),
+                                       1)
+        _check(fn("avm_clip_read")(src, ctypes.byref(clip._h), err, _ERR_SIZE), err.value)
     with clip:
         _write_clip(clip, out_path, fps, avatar, mapping)
+        return int(fn("avm_clip_frame_count")(clip._h))

@@ -91,7 +91,7 @@ class AvmSolverOptions(ctypes.Structure):
         ("filter_expressions", _I32), ("expression_min_cutoff", _F32),
         ("expression_beta", _F32), ("expression_d_cutoff", _F32),
         ("max_extrapolation_seconds", _F32),
-        ("file_filter", _I32), ("file_smoothing", _F32),
+        ("file_filter", _I32), ("file_smoothing", _F32), ("file_threads", _I32),
     ]
 
 
@@ -155,6 +155,7 @@ _SIGNATURES: Dict[str, Tuple[object, List[object]]] = {
     "avm_solver_sample": (_S, [_P, _F64, _P]),
     "avm_solver_last_error": (_STR, [_P]),
     "avm_solve_file": (_S, [_STR, _STR, ctypes.POINTER(AvmSolverOptions), _P, _SIZE]),
+    "avm_solve_file_to_clip": (_S, [_STR, ctypes.POINTER(AvmSolverOptions), _PP, _P, _SIZE]),
     "avm_set_mappings_folder": (_S, [_STR]),
     "avm_retargeter_create": (_S, [_STR, _STR, _PP]),
     "avm_retargeter_destroy": (None, [_P]),

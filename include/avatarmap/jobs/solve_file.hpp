@@ -73,7 +73,8 @@ struct solve_file_summary {
   long face_iris_frames = 0;                  // frames with a 478-point face
   double t_first = 0.0;                       // first and last solved frame's time (seconds)
   double t_last = 0.0;
-  double seconds = 0.0;     // wall-clock time of the run
+  double seconds = 0.0;  // wall-clock time of the run
+  double fps = 0.0;  // the nominal rate of the output (its header's): output_fps, else the input's
   float image_width = 0.f;  // the image size solved with (pixels; 0 = unknown)
   float image_height = 0.f;
   bool image_size_assumed = false;  // neither the job nor the file gave one: square pixels

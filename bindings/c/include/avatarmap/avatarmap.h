@@ -286,6 +286,12 @@ typedef struct avm_solver_options {
   int32_t file_filter;  /* avm_file_filter; AVM_FILE_FILTER_OFFLINE */
   float file_smoothing; /* offline: scale on the smoothing time constants, finite, [0, 10]
                            (0 = fill gaps only); 1 */
+  /* -- added in 0.1.0 after file_smoothing (a caller whose struct_size ends before it gets
+   *    the default) -- */
+  int32_t file_threads; /* threads of avm_solve_file / avm_solve_file_to_clip: 2 parses the
+                           file ahead on a second thread (the default, as `avatarmap solve`);
+                           1 does everything on the calling thread (one task per core, e.g.
+                           a batch's workers) */
 } avm_solver_options;
 
 /* What avm_solve_file does after solving each frame. */
@@ -383,7 +389,9 @@ AVATARMAP_C_API const char* avm_solver_last_error(const avm_solver* solver);
  * written there: "" on success, else what failed and where ("FILE:LINE: ...").
  * Failures: AVM_ERROR_INVALID_ARGUMENT (a path NULL, bad options), AVM_ERROR_IO (cannot
  *   open, write or rename), AVM_ERROR_PARSE (a malformed line: the first one stops the
- *   run), AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL. Thread-safe (separate files). */
+ *   run), AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL. Thread-safe (separate files). The
+ * file is parsed ahead on a second thread of the call's own, as `avatarmap solve` does
+ * (options->file_threads 1: all on the calling thread). */
 AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* out_pose,
                                           const avm_solver_options* options, char* err,
                                           size_t err_size);
@@ -753,10 +761,21 @@ AVATARMAP_C_API avm_status avm_solve_frames(const avm_frame_block* frames,
                                             const avm_solver_options* options, avm_pose* out_poses,
                                             char* err, size_t err_size);
 
+/* Solves a whole *.landmarks.jsonl file as avm_solve_file() does (the same job, options and
+ * poses, the file parsed ahead on a second thread) but keeps the poses, with their per-bone
+ * confidence, in a new clip instead of writing them: read them with avm_clip_get_poses(), or
+ * write them with avm_clip_write(). About 1.2 kB of memory per frame. On success *out is a new
+ * handle owned by the caller (free it with avm_clip_destroy()); on failure *out is NULL (when
+ * out is not NULL). err and failures as avm_solve_file(). Thread-safe (separate files). */
+AVATARMAP_C_API avm_status avm_solve_file_to_clip(const char* in_landmarks,
+                                                  const avm_solver_options* options, avm_clip** out,
+                                                  char* err, size_t err_size);
+
 /* ---- clips: more than one pose at a time, and reading pose files ----------------------- */
 
 /* Reads a *.pose.jsonl file (docs/file-formats.md) into a new clip, its frames as written
- * (times as in the file, which must increase as avm_clip_add() requires). On success *out is
+ * (times as in the file, which must increase as avm_clip_add() requires) and the header's
+ * nominal rate (a .pose.jsonl written from the clip at fps 0 keeps it). On success *out is
  * a new handle owned by the caller (free it with avm_clip_destroy()); on failure *out is NULL
  * (when out is not NULL). err as avm_clip_write().
  * Failures: AVM_ERROR_INVALID_ARGUMENT (path or out NULL), AVM_ERROR_IO (cannot open),
