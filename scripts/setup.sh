@@ -12,7 +12,7 @@ packages=(build-essential cmake ninja-build pkg-config
           liblo-tools  # oscdump, oscsend: the independent OSC receiver of the VMC tests
           # The Python package (docs/python.md): its tests, a venv to pip-install it into,
           # and Dask for `python3 -m avatarmap.batch`.
-          python3-pytest python3-venv python3-distributed)
+          python3-pytest python3-venv python3-pip python3-wheel python3-distributed)
 # The browser viewer (docs/viewer.md): its server library, and headless Chromium for its tests.
 packages+=(libwebsockets-dev chromium python3-pil)
 # The fuzz run and the sanitizer run (scripts/test.sh, scripts/sanitize.sh) need clang with its
