@@ -60,9 +60,11 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/tool
 #    flags (an uninstrumented program cannot link the instrumented library) and rebuild the
 #    core; they test packaging, not memory safety, and the normal run covers them.
 #  - convert.tflite2onnx_selftest: Python and numpy only, no avatarmap code.
+#  - python.install_*: they install the Python package with pip and cmake --install (packaging,
+#    as package_*); the package's own tests (python.test_*) run below against this build.
 # Run apart, below: the tests that load the C library into CPython ($python_tests).
-python_tests='^(c_api_python_.*|cli\.hostile_time_test)$'
-excluded='^(package_.*|convert\.tflite2onnx_selftest)$'
+python_tests='^(c_api_python_.*|cli\.hostile_time_test|python\.test_.*)$'
+excluded='^(package_.*|convert\.tflite2onnx_selftest|python\.install_.*)$'
 cd "$build"
 ctest --output-on-failure -j "$jobs" -E "$excluded|$python_tests" || failed+=(tests)
 
