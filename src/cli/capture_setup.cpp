@@ -144,14 +144,7 @@ status make_capture_pipeline(const capture_pipeline_options& options,
 }
 
 void timing_totals::add(const estimator_timings& t) {
-  sum.total_ms += t.total_ms;
-  sum.pose_detector_ms += t.pose_detector_ms;
-  sum.pose_landmark_ms += t.pose_landmark_ms;
-  sum.palm_detector_ms += t.palm_detector_ms;
-  sum.hand_landmark_ms += t.hand_landmark_ms;
-  sum.face_detector_ms += t.face_detector_ms;
-  sum.face_mesh_ms += t.face_mesh_ms;
-  sum.detector_runs += t.detector_runs;
+  sum += t;
   pose_detector_frames += t.pose_detector_ms > 0;
   palm_frames += t.palm_detector_ms > 0;
   face_detector_frames += t.face_detector_ms > 0;

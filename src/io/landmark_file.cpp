@@ -55,31 +55,8 @@ int part_from_key(std::string_view key) {
 // Points of part `p` (const or not) and their capacity.
 template <class Frame>
 auto part_storage(Frame& f, frame_part p, int& out_capacity) -> decltype(f.pose.data()) {
-  switch (p) {
-    case frame_part::pose:
-      out_capacity = k_pose_landmark_count;
-      return f.pose.data();
-    case frame_part::pose_world:
-      out_capacity = k_pose_landmark_count;
-      return f.pose_world.data();
-    case frame_part::left_hand:
-      out_capacity = k_hand_landmark_count;
-      return f.left_hand.data();
-    case frame_part::left_hand_world:
-      out_capacity = k_hand_landmark_count;
-      return f.left_hand_world.data();
-    case frame_part::right_hand:
-      out_capacity = k_hand_landmark_count;
-      return f.right_hand.data();
-    case frame_part::right_hand_world:
-      out_capacity = k_hand_landmark_count;
-      return f.right_hand_world.data();
-    case frame_part::face:
-      out_capacity = k_face_mesh_iris_count;
-      return f.face.data();
-  }
-  out_capacity = 0;
-  return nullptr;
+  out_capacity = frame_part_capacity(p);
+  return f.points(p);
 }
 
 // Prefixes a cursor error with where in the frame it happened.

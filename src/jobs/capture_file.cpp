@@ -48,15 +48,7 @@ void lower_this_thread_priority() {
 }
 
 void add_timings(const estimator_timings& t, capture_file_summary& s) {
-  estimator_timings& sum = s.timing_sum;
-  sum.total_ms += t.total_ms;
-  sum.pose_detector_ms += t.pose_detector_ms;
-  sum.pose_landmark_ms += t.pose_landmark_ms;
-  sum.palm_detector_ms += t.palm_detector_ms;
-  sum.hand_landmark_ms += t.hand_landmark_ms;
-  sum.face_detector_ms += t.face_detector_ms;
-  sum.face_mesh_ms += t.face_mesh_ms;
-  sum.detector_runs += t.detector_runs;
+  s.timing_sum += t;
   s.pose_detector_frames += t.pose_detector_ms > 0;
   s.palm_frames += t.palm_detector_ms > 0;
   s.face_detector_frames += t.face_detector_ms > 0;

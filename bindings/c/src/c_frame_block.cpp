@@ -27,30 +27,6 @@ constexpr block_part k_parts[] = {
     {frame_part::face, &avm_frame_block::face, AVM_FACE_IRIS_LANDMARK_COUNT},
 };
 
-landmark* frame_points(landmark_frame& f, frame_part p) {
-  switch (p) {
-    case frame_part::pose:
-      return f.pose.data();
-    case frame_part::pose_world:
-      return f.pose_world.data();
-    case frame_part::left_hand:
-      return f.left_hand.data();
-    case frame_part::left_hand_world:
-      return f.left_hand_world.data();
-    case frame_part::right_hand:
-      return f.right_hand.data();
-    case frame_part::right_hand_world:
-      return f.right_hand_world.data();
-    case frame_part::face:
-      break;
-  }
-  return f.face.data();
-}
-
-const landmark* frame_points(const landmark_frame& f, frame_part p) {
-  return frame_points(const_cast<landmark_frame&>(f), p);
-}
-
 // Start of frame i's rows in a part's array (i checked by the caller against count).
 float* row(float* array, int points, std::int64_t i) {
   return array + static_cast<std::ptrdiff_t>(i) * points * k_stride;
@@ -80,7 +56,7 @@ void block_row_to_frame(const avm_frame_block& block, std::int64_t i,
     if (bp.part == frame_part::face)
       n = std::isnan(src[AVM_FACE_LANDMARK_COUNT * k_stride]) ? AVM_FACE_LANDMARK_COUNT
                                                               : AVM_FACE_IRIS_LANDMARK_COUNT;
-    landmark* dst = frame_points(out, bp.part);
+    landmark* dst = out.points(bp.part);
     for (int k = 0; k < n; ++k, src += k_stride) dst[k] = {src[0], src[1], src[2], src[3], src[4]};
     out.set(bp.part, true);
     if (bp.part == frame_part::face) out.face_count = n;
@@ -99,7 +75,7 @@ void frame_to_block_row(const landmark_frame& in, const avm_frame_block& block,
     if (bp.part == frame_part::face && n > 0)
       n = in.face_count == AVM_FACE_LANDMARK_COUNT ? AVM_FACE_LANDMARK_COUNT
                                                    : AVM_FACE_IRIS_LANDMARK_COUNT;
-    const landmark* src = frame_points(in, bp.part);
+    const landmark* src = in.points(bp.part);
     int k = 0;
     for (; k < n; ++k, dst += k_stride) {
       dst[0] = src[k].x;

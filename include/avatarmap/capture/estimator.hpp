@@ -102,6 +102,19 @@ struct estimator_timings {
   double face_detector_ms = 0.0;
   double face_mesh_ms = 0.0;
   int detector_runs = 0;  // detectors (pose, palm, face) run for this frame
+
+  /// Adds another frame's timings (sums over frames).
+  estimator_timings& operator+=(const estimator_timings& t) {
+    total_ms += t.total_ms;
+    pose_detector_ms += t.pose_detector_ms;
+    pose_landmark_ms += t.pose_landmark_ms;
+    palm_detector_ms += t.palm_detector_ms;
+    hand_landmark_ms += t.hand_landmark_ms;
+    face_detector_ms += t.face_detector_ms;
+    face_mesh_ms += t.face_mesh_ms;
+    detector_runs += t.detector_runs;
+    return *this;
+  }
 };
 
 class estimator {

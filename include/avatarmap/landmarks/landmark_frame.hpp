@@ -42,6 +42,20 @@ constexpr const char* frame_part_key(frame_part p) {
   return k_keys[static_cast<int>(p)];
 }
 
+/// Points a part's storage in landmark_frame holds: 33 (body), 21 (a hand) or 478 (the face
+/// mesh with iris; a 468-point face uses the first 468).
+constexpr int frame_part_capacity(frame_part p) {
+  switch (p) {
+    case frame_part::pose:
+    case frame_part::pose_world:
+      return k_pose_landmark_count;
+    case frame_part::face:
+      return k_face_mesh_iris_count;
+    default:
+      return k_hand_landmark_count;
+  }
+}
+
 struct landmark_frame {
   double t = 0.0;           // capture time in seconds
   std::uint32_t parts = 0;  // bit (1 << frame_part) set for each part present
@@ -55,6 +69,29 @@ struct landmark_frame {
   std::array<landmark, k_face_mesh_iris_count> face{};
 
   bool has(frame_part p) const { return (parts >> static_cast<int>(p)) & 1u; }
+  /// The storage of part `p` (frame_part_capacity(p) points; meaningful when has(p)).
+  landmark* points(frame_part p) {
+    switch (p) {
+      case frame_part::pose:
+        return pose.data();
+      case frame_part::pose_world:
+        return pose_world.data();
+      case frame_part::left_hand:
+        return left_hand.data();
+      case frame_part::left_hand_world:
+        return left_hand_world.data();
+      case frame_part::right_hand:
+        return right_hand.data();
+      case frame_part::right_hand_world:
+        return right_hand_world.data();
+      case frame_part::face:
+        break;
+    }
+    return face.data();
+  }
+  const landmark* points(frame_part p) const {
+    return const_cast<landmark_frame*>(this)->points(p);
+  }
   void set(frame_part p, bool present) {
     std::uint32_t bit = 1u << static_cast<int>(p);
     parts = present ? (parts | bit) : (parts & ~bit);

@@ -119,17 +119,7 @@ constexpr bool is_world_part(frame_part p) {
          p == frame_part::right_hand_world;
 }
 // Capacity (points) of a part's storage in landmark_frame.
-constexpr int part_capacity(frame_part p) {
-  switch (p) {
-    case frame_part::pose:
-    case frame_part::pose_world:
-      return k_pose_landmark_count;
-    case frame_part::face:
-      return k_face_mesh_iris_count;
-    default:
-      return k_hand_landmark_count;
-  }
-}
+constexpr int part_capacity(frame_part p) { return frame_part_capacity(p); }
 constexpr int part_offset(frame_part p) {
   int o = 0;
   for (int q = 0; q < static_cast<int>(p); ++q) o += part_capacity(static_cast<frame_part>(q));
@@ -220,28 +210,8 @@ class landmark_filter {
   }
 
  private:
-  static landmark* points(landmark_frame& f, frame_part p) {
-    switch (p) {
-      case frame_part::pose:
-        return f.pose.data();
-      case frame_part::pose_world:
-        return f.pose_world.data();
-      case frame_part::left_hand:
-        return f.left_hand.data();
-      case frame_part::left_hand_world:
-        return f.left_hand_world.data();
-      case frame_part::right_hand:
-        return f.right_hand.data();
-      case frame_part::right_hand_world:
-        return f.right_hand_world.data();
-      case frame_part::face:
-        return f.face.data();
-    }
-    return nullptr;
-  }
-  static const landmark* points(const landmark_frame& f, frame_part p) {
-    return points(const_cast<landmark_frame&>(f), p);
-  }
+  static landmark* points(landmark_frame& f, frame_part p) { return f.points(p); }
+  static const landmark* points(const landmark_frame& f, frame_part p) { return f.points(p); }
   one_euro_filter_vec3& filter(frame_part p, int i) noexcept {
     return filters_[detail::part_offset(p) + i];
   }
