@@ -91,6 +91,18 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  /* A build without ONNX Runtime (the sanitizer build) has nothing to capture with. */
+  {
+    char probe[512];
+    avm_estimator_options_init(&o);
+    o.models_dir = models_dir;
+    if (avm_capture_file(image, c_out, &o, NULL, NULL, NULL, probe, sizeof probe) ==
+        AVM_ERROR_UNSUPPORTED) {
+      printf("skipped: %s\n", probe);
+      return SKIP;
+    }
+  }
+
   /* The CLI's capture of the video, then the C API's. */
   remove(cli_out);
   snprintf(command, sizeof command, "\"%s\" capture \"%s\" -o %s --hands --face --quiet", argv[1],
