@@ -58,7 +58,8 @@ class AvmLiveStats(ctypes.Structure):
 def declare_capture(lib):
     p = ctypes.c_void_p
     sigs = {
-        "avm_estimator_options_init": (ctypes.c_int, [ctypes.POINTER(AvmEstimatorOptions)]),
+        "avm_estimator_options_init_sized": (ctypes.c_int, [ctypes.POINTER(AvmEstimatorOptions),
+                                                            ctypes.c_size_t]),
         "avm_estimator_create": (ctypes.c_int, [ctypes.POINTER(AvmEstimatorOptions),
                                                 ctypes.POINTER(AvmSolverOptions),
                                                 ctypes.POINTER(p)]),
@@ -162,7 +163,7 @@ def main():
     declare_capture(lib)
     arm = lib.avm_bone_from_name(b"leftUpperArm")
     opts = AvmEstimatorOptions()
-    lib.avm_estimator_options_init(ctypes.byref(opts))
+    lib.avm_estimator_options_init_sized(ctypes.byref(opts), ctypes.sizeof(opts))
     models = args.models.encode() if args.models else None
     opts.models_dir = models
     opts.hands = 0 if args.no_hands else 1

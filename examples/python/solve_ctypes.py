@@ -118,7 +118,8 @@ def load_library(path):
         "avm_status_string": (ctypes.c_char_p, [ctypes.c_int]),
         "avm_bone_name": (ctypes.c_char_p, [ctypes.c_int]),
         "avm_bone_from_name": (ctypes.c_int, [ctypes.c_char_p]),
-        "avm_solver_options_init": (ctypes.c_int, [ctypes.POINTER(AvmSolverOptions)]),
+        "avm_solver_options_init_sized": (ctypes.c_int, [ctypes.POINTER(AvmSolverOptions),
+                                                         ctypes.c_size_t]),
         "avm_solver_create": (ctypes.c_int, [ctypes.POINTER(AvmSolverOptions),
                                              ctypes.POINTER(solver_p)]),
         "avm_last_create_error": (ctypes.c_char_p, []),
@@ -378,8 +379,10 @@ def main(argv):
     solver = retargeter = clip = None
     try:
         options = AvmSolverOptions()
-        if lib.avm_solver_options_init(ctypes.byref(options)) != AVM_OK:
-            raise AvmError("avm_solver_options_init failed")
+        # Sized: the library writes no more than this mirror of the struct holds.
+        if lib.avm_solver_options_init_sized(ctypes.byref(options),
+                                             ctypes.sizeof(options)) != AVM_OK:
+            raise AvmError("avm_solver_options_init_sized failed")
         options.struct_size = ctypes.sizeof(AvmSolverOptions)  # what this script knows
         options.mirror = 1 if args.mirror else 0
         if args.landmarks:

@@ -275,6 +275,55 @@ static void test_struct_size_evolution(void) {
   n.known.struct_size = (uint32_t)sizeof n;
   CHECK_STATUS(avm_solver_create(&n.known, &s), AVM_OK);
   avm_solver_destroy(s);
+  s = NULL;
+}
+
+/* Initialising never writes past the caller's struct: an older caller's (shorter) struct is
+ * filled up to its size only, a newer caller's fields past this library's are left alone. */
+static void test_sized_init(void) {
+  const size_t older = offsetof(avm_solver_options, filter_rotations);
+  union {
+    avm_solver_options o;
+    unsigned char bytes[sizeof(avm_solver_options) + 32];
+  } u;
+  avm_estimator_options eo;
+  avm_solver* s = NULL;
+  size_t i;
+  int untouched = 1;
+
+  memset(&u, 0xab, sizeof u);
+  CHECK_STATUS(avm_solver_options_init_sized(&u.o, older), AVM_OK);
+  CHECK(u.o.struct_size == (uint32_t)older);
+  CHECK(u.o.solve_body == 1 && u.o.confidence_found_above == 0.5f);
+  for (i = older; i < sizeof u.bytes; ++i) untouched &= u.bytes[i] == 0xab;
+  CHECK(untouched);
+  CHECK_STATUS(avm_solver_create(&u.o, &s), AVM_OK); /* the rest are the library's defaults */
+  avm_solver_destroy(s);
+  s = NULL;
+
+  memset(&u, 0xab, sizeof u);
+  CHECK_STATUS(avm_solver_options_init_sized(&u.o, sizeof u.bytes), AVM_OK);
+  CHECK(u.o.struct_size == (uint32_t)sizeof u.bytes && u.o.file_threads == 2);
+  untouched = 1;
+  for (i = sizeof(avm_solver_options); i < sizeof u.bytes; ++i) untouched &= u.bytes[i] == 0xab;
+  CHECK(untouched);
+
+  /* The macro is the sized form with this header's struct. */
+  memset(&u, 0, sizeof u);
+  CHECK_STATUS(avm_solver_options_init(&u.o), AVM_OK);
+  CHECK(u.o.struct_size == (uint32_t)sizeof(avm_solver_options));
+  CHECK_STATUS((avm_solver_options_init)(&u.o), AVM_OK); /* the function, for old binaries */
+  CHECK(u.o.struct_size == (uint32_t)sizeof(avm_solver_options));
+
+  CHECK_STATUS(avm_solver_options_init_sized(NULL, sizeof u.o), AVM_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(avm_solver_options_init_sized(&u.o, 4), AVM_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(avm_solver_options_init_sized(&u.o, 4097), AVM_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(avm_solver_options_init_sized(&u.o, 10), AVM_ERROR_INVALID_ARGUMENT);
+
+  CHECK_STATUS(avm_estimator_options_init(&eo), AVM_OK);
+  CHECK(eo.struct_size == (uint32_t)sizeof eo && eo.hands == 1 && eo.threads == 2);
+  CHECK_STATUS(avm_estimator_options_init_sized(&eo, 4), AVM_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(avm_estimator_options_init_sized(NULL, sizeof eo), AVM_ERROR_INVALID_ARGUMENT);
 }
 
 static void test_bad_frames(void) {
@@ -652,6 +701,7 @@ int main(void) {
   test_null_arguments();
   test_invalid_options();
   test_struct_size_evolution();
+  test_sized_init();
   test_bad_frames();
   test_rest_pose();
   test_nan_frame();

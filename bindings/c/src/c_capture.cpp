@@ -1,6 +1,10 @@
 // The C API's estimator handle (avm_estimator_*): images -> landmarks -> solved, live-filtered
 // poses, the library's capture_pipeline on the caller's thread.
+#include <algorithm>
 #include <array>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <memory>
 #include <string>
 
@@ -24,10 +28,21 @@ struct avm_estimator : avatarmap::c_api::error_slot {
 
 extern "C" {
 
-AVATARMAP_C_API avm_status avm_estimator_options_init(avm_estimator_options* options) {
-  if (options == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
-  return guard("avm_estimator_options_init", silently, [&]() -> avm_status {
-    *options = default_estimator_options();
+// (The name in parentheses: the header also defines avm_estimator_options_init as a macro.)
+AVATARMAP_C_API avm_status(avm_estimator_options_init)(avm_estimator_options* options) {
+  return avm_estimator_options_init_sized(options, sizeof(avm_estimator_options));
+}
+
+AVATARMAP_C_API avm_status avm_estimator_options_init_sized(avm_estimator_options* options,
+                                                            size_t size) {
+  if (options == nullptr || size < offsetof(avm_estimator_options, models_dir) + sizeof(void*) ||
+      size > 4096 || size % 4 != 0)
+    return AVM_ERROR_INVALID_ARGUMENT;
+  return guard("avm_estimator_options_init_sized", silently, [&]() -> avm_status {
+    const avm_estimator_options d = default_estimator_options();
+    // Only the caller's bytes, and of those only the fields this library knows.
+    std::memcpy(options, &d, std::min(size, sizeof d));
+    options->struct_size = static_cast<std::uint32_t>(size);
     return AVM_OK;
   });
 }

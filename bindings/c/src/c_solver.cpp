@@ -65,10 +65,19 @@ am::solve_file_job file_job(const core_options& o) {
 
 extern "C" {
 
-AVATARMAP_C_API avm_status avm_solver_options_init(avm_solver_options* options) {
-  if (options == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
-  return guard("avm_solver_options_init", silently, [&]() -> avm_status {
-    *options = default_options();
+// (The name in parentheses: the header also defines avm_solver_options_init as a macro.)
+AVATARMAP_C_API avm_status(avm_solver_options_init)(avm_solver_options* options) {
+  return avm_solver_options_init_sized(options, sizeof(avm_solver_options));
+}
+
+AVATARMAP_C_API avm_status avm_solver_options_init_sized(avm_solver_options* options, size_t size) {
+  if (options == nullptr || size < 8 || size > 4096 || size % 4 != 0)
+    return AVM_ERROR_INVALID_ARGUMENT;
+  return guard("avm_solver_options_init_sized", silently, [&]() -> avm_status {
+    const avm_solver_options d = default_options();
+    // Only the caller's bytes, and of those only the fields this library knows.
+    std::memcpy(options, &d, std::min(size, sizeof d));
+    options->struct_size = static_cast<std::uint32_t>(size);
     return AVM_OK;
   });
 }

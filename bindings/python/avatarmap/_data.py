@@ -186,7 +186,9 @@ def solver_options(options: Dict[str, Any]) -> AvmSolverOptions:
     buf = ctypes.create_string_buffer(4096)
     o = AvmSolverOptions.from_buffer(buf)
     o._buffer = buf  # type: ignore[attr-defined]  # keeps the memory alive
-    _check(fn("avm_solver_options_init")(o), "avm_solver_options_init failed")
+    # Sized: the library writes no more than this mirror of the struct holds.
+    _check(fn("avm_solver_options_init_sized")(o, ctypes.sizeof(o)),
+           "avm_solver_options_init_sized failed")
     o.struct_size = ctypes.sizeof(AvmSolverOptions)  # what this package knows
     for name, value in options.items():
         if name not in SOLVER_OPTION_NAMES:

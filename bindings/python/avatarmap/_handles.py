@@ -202,7 +202,8 @@ def _estimator_options(models: Optional[PathLike], hands: bool, face: bool, thre
     buf = ctypes.create_string_buffer(4096)  # room for a newer library's struct
     o = AvmEstimatorOptions.from_buffer(buf)
     o._buffer = buf  # type: ignore[attr-defined]
-    _check(fn("avm_estimator_options_init")(o), "avm_estimator_options_init failed")
+    _check(fn("avm_estimator_options_init_sized")(o, ctypes.sizeof(o)),
+           "avm_estimator_options_init_sized failed")
     o.struct_size = ctypes.sizeof(AvmEstimatorOptions)
     folder = models if models is not None else _lib.models_dir_default()
     if folder is not None:

@@ -235,7 +235,12 @@ typedef struct avm_pose {
  * fields: it sets struct_size, which lets a library built with more fields than the caller
  * knows fill the rest with defaults, and lets this library read only the fields it knows
  * from a caller compiled against a newer header. Booleans are int32_t, 0 or non-zero.
- * Ranges are checked by avm_solver_create() / avm_solve_file(). */
+ * Ranges are checked by avm_solver_create() / avm_solve_file().
+ * Writing the defaults never goes past the caller's struct: avm_solver_options_init() is a
+ * macro passing sizeof(avm_solver_options) as this header knows it to
+ * avm_solver_options_init_sized(), so a program built against an older, shorter struct keeps
+ * working with a newer library. Bindings that mirror the struct (ctypes, cffi, P/Invoke) call
+ * avm_solver_options_init_sized() with their mirror's size. */
 typedef struct avm_solver_options {
   uint32_t struct_size; /* sizeof(avm_solver_options) as the caller knows it */
 
@@ -307,9 +312,20 @@ typedef enum avm_file_filter {
   AVM_FILE_FILTER_NONE = 2
 } avm_file_filter;
 
-/* Fills `options` with the defaults and sets options->struct_size. Returns
- * AVM_ERROR_INVALID_ARGUMENT when `options` is NULL. Thread-safe. */
+/* Fills the first `size` bytes of `options` with the defaults (size = the caller's
+ * sizeof(avm_solver_options); bytes past this library's struct are left as they are) and sets
+ * options->struct_size = size. Returns AVM_ERROR_INVALID_ARGUMENT when `options` is NULL or
+ * size is below 8, above 4096 or not a multiple of 4. Thread-safe. */
+AVATARMAP_C_API avm_status avm_solver_options_init_sized(avm_solver_options* options, size_t size);
+
+/* Fills `options` with the defaults and sets options->struct_size, writing
+ * sizeof(avm_solver_options) bytes of this library's struct (the function, for binaries built
+ * before the macro below). Returns AVM_ERROR_INVALID_ARGUMENT when `options` is NULL.
+ * Thread-safe. */
 AVATARMAP_C_API avm_status avm_solver_options_init(avm_solver_options* options);
+/* What C and C++ callers get: the sized form with the struct as they were compiled with. */
+#define avm_solver_options_init(options) \
+  avm_solver_options_init_sized((options), sizeof(avm_solver_options))
 
 /* ---- solver -------------------------------------------------------------------------- */
 
@@ -583,8 +599,17 @@ typedef struct avm_estimator_options {
   int32_t static_images;         /* detect on every image (unrelated stills); default 0 */
 } avm_estimator_options;
 
-/* Fills *options with the defaults above. AVM_ERROR_INVALID_ARGUMENT when options is NULL. */
+/* Fills the first `size` bytes of *options with the defaults above and sets struct_size =
+ * size, as avm_solver_options_init_sized() (size at least 16, at most 4096, a multiple of 4).
+ * AVM_ERROR_INVALID_ARGUMENT when options is NULL or size is out of range. */
+AVATARMAP_C_API avm_status avm_estimator_options_init_sized(avm_estimator_options* options,
+                                                            size_t size);
+/* Fills *options with the defaults above (sizeof(avm_estimator_options) of this library).
+ * AVM_ERROR_INVALID_ARGUMENT when options is NULL. C and C++ callers get the macro below: the
+ * sized form with the struct as they were compiled with. */
 AVATARMAP_C_API avm_status avm_estimator_options_init(avm_estimator_options* options);
+#define avm_estimator_options_init(options) \
+  avm_estimator_options_init_sized((options), sizeof(avm_estimator_options))
 
 /* An estimator: images in capture order -> landmarks -> solved, live-filtered poses (the
  * same steps as `avatarmap live`). Opaque; created by avm_estimator_create(). */
