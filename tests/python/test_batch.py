@@ -194,3 +194,19 @@ def test_existing_scheduler_two_worker_processes_one_killed_mid_batch(tmp_path):
                 p.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 p.kill()
+
+
+def test_glb_with_an_avatar_equals_cli_convert(tmp_path):
+    data = os.environ.get("AVATARMAP_TEST_DATA")
+    avatar = os.path.join(data or "", "avatars", "vrm1_spec_53bones.vrm")
+    if not data or not os.path.isfile(avatar):
+        pytest.skip("AVATARMAP_TEST_DATA is not set: no avatar to drive")
+    src = tmp_path / "wave.landmarks.jsonl"
+    synth(src, 3, 8)
+    r = run_batch([str(src), "-o", str(tmp_path / "out"), "--to", "glb", "--avatar", avatar,
+                   "--rig", "auto", "--workers", "1"])
+    assert r.returncode == 0, r.stdout + r.stderr
+    ref = tmp_path / "ref.glb"
+    subprocess.run([cli(), "convert", str(src), "-o", str(ref), "--avatar", avatar, "--quiet"],
+                   check=True)
+    assert read(tmp_path / "out" / "wave.glb") == read(ref)

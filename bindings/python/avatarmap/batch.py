@@ -236,8 +236,9 @@ def _parse(argv: Optional[Sequence[str]]) -> argparse.Namespace:
                          "--avatar); bvh: the proxy skeleton, or the avatar's rig with "
                          "--avatar; pose: *.pose.jsonl")
     ap.add_argument("--avatar", help="the avatar (.vrm, .glb, .gltf) for --to glb or bvh")
-    ap.add_argument("--mapping", help="how the avatar's joints map to the proxy: auto "
-                                      "(default), a table's name or FILE.json")
+    ap.add_argument("--rig", "--mapping", dest="mapping", metavar="auto|NAME|FILE.json",
+                    help="how the avatar's joints map to the proxy, as `avatarmap convert "
+                         "--rig`: auto (default), a shipped table's name or FILE.json")
     ap.add_argument("--fps", type=float, default=None,
                     help="output frame rate (default 30 as `avatarmap convert`; --to pose: "
                          "the frames' own times)")
