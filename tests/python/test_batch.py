@@ -69,6 +69,12 @@ def test_plan_names_outputs_and_refuses_what_it_cannot_read(tmp_path):
     assert "also" in reasons["take.mp4"]  # both takes would write out/take.vrma
     assert "not a video" in reasons["notes.txt"]
     assert reasons["missing.mp4"] == "no such file"
+    # OUTDIR read back as input with --to pose: its *.pose.jsonl are their own outputs.
+    (tmp_path / "a" / "take.pose.jsonl").write_text("x")  # take.landmarks.jsonl's, done
+    tasks, bad = batch.plan([str(tmp_path / "a")], str(tmp_path / "a"), "pose")
+    assert [os.path.basename(t.input) for t in tasks] == ["take.landmarks.jsonl"]
+    assert [(os.path.basename(r.input), r.status) for r in bad] == [
+        ("clip.pose.jsonl", "skipped"), ("take.pose.jsonl", "skipped")]
 
 
 def test_local_cluster_converts_reports_a_corrupt_file_and_resumes(tmp_path):

@@ -79,7 +79,8 @@ def input_kind(path: str) -> Optional[Tuple[str, str]]:
 def plan(inputs: Sequence[str], outdir: str, to: str) -> Tuple[List[Task], List[Result]]:
     """Tasks for the inputs (folders give the files in them that we read, sorted), and the
     inputs that cannot be tasks (missing, unknown type, two inputs onto one output) as failed
-    results."""
+    results; a *.pose.jsonl that is its own output (OUTDIR read as input with --to pose) is
+    skipped."""
     tasks: List[Task] = []
     bad: List[Result] = []
     by_output: Dict[str, Task] = {}
@@ -107,14 +108,14 @@ def plan(inputs: Sequence[str], outdir: str, to: str) -> Tuple[List[Task], List[
                                          "(by its name)"))
                 continue
             out = os.path.join(outdir, kind[1] + suffix)
+            if os.path.abspath(out) == path:  # a *.pose.jsonl in OUTDIR itself, --to pose
+                bad.append(Result(path, out, status="skipped"))
+                continue
             if out in by_output:
                 if by_output[out].input != path:
                     bad.append(Result(path, status="failed",
                                       reason="its output %s is also %s's; rename one" %
                                              (out, by_output[out].input)))
-                continue
-            if kind[0] == "poses" and to == "pose" and os.path.abspath(out) == path:
-                bad.append(Result(path, status="failed", reason="it is its own output"))
                 continue
             task = Task(path, kind[0], out)
             by_output[out] = task
