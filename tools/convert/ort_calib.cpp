@@ -113,14 +113,17 @@ int main(int argc, char** argv) {
     std::vector<stats> st(names.size());
     std::vector<float> input(count);
     const Ort::MemoryInfo mem = Ort::MemoryInfo::CreateCpu(OrtArenaAllocator, OrtMemTypeDefault);
+    // Crop k of the input file as the model's input tensor (over `input`).
+    auto read_crop = [&](size_t k) {
+      in.seekg(static_cast<std::streamoff>(k * count * sizeof(float)));
+      in.read(reinterpret_cast<char*>(input.data()),
+              static_cast<std::streamsize>(count * sizeof(float)));
+      return Ort::Value::CreateTensor<float>(mem, input.data(), count, shape.data(), shape.size());
+    };
     if (outputs_only) {
       std::ofstream out(argv[3], std::ios::binary | std::ios::trunc);
       for (size_t k = 0; k < n; ++k) {
-        in.seekg(static_cast<std::streamoff>(k * count * sizeof(float)));
-        in.read(reinterpret_cast<char*>(input.data()),
-                static_cast<std::streamsize>(count * sizeof(float)));
-        Ort::Value x =
-            Ort::Value::CreateTensor<float>(mem, input.data(), count, shape.data(), shape.size());
+        Ort::Value x = read_crop(k);
         for (Ort::Value& v :
              session.Run(Ort::RunOptions{nullptr}, &in_c, &x, 1, out_c.data(), out_c.size()))
           out.write(reinterpret_cast<const char*>(v.GetTensorData<float>()),
@@ -135,11 +138,7 @@ int main(int argc, char** argv) {
     }
     for (int pass = 0; pass < 2; ++pass) {
       for (size_t k = 0; k < n; ++k) {
-        in.seekg(static_cast<std::streamoff>(k * count * sizeof(float)));
-        in.read(reinterpret_cast<char*>(input.data()),
-                static_cast<std::streamsize>(count * sizeof(float)));
-        Ort::Value x =
-            Ort::Value::CreateTensor<float>(mem, input.data(), count, shape.data(), shape.size());
+        Ort::Value x = read_crop(k);
         std::vector<Ort::Value> outs =
             session.Run(Ort::RunOptions{nullptr}, &in_c, &x, 1, out_c.data(), out_c.size());
         for (size_t o = 0; o < outs.size(); ++o) {

@@ -61,6 +61,25 @@ am::solve_file_job file_job(const core_options& o) {
   return job;
 }
 
+// What avm_solve_file, avm_solve_file_to_clip and avm_solve_frames share: the options read
+// and checked, the job made (file_job), `setup` giving it its input and output, the run, and
+// a failure reported as the file functions report it. `summary` is the run's.
+template <class Report, class Setup>
+avm_status run_file_job(const avm_solver_options* options, Report& report, Setup&& setup,
+                        am::solve_file_summary& summary) {
+  core_options o;
+  std::string msg;
+  if (!read_options(options, o, msg)) {
+    set_create_error(msg.c_str());
+    return report(AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
+  }
+  am::solve_file_job job = file_job(o);
+  setup(job);
+  const am::status st = job.run(summary);
+  if (!st) return report(code_for(st, job_code(summary.failure)), st.message().c_str());
+  return AVM_OK;
+}
+
 }  // namespace
 
 extern "C" {
@@ -188,20 +207,15 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
   if (in_landmarks == nullptr || out_pose == nullptr)
     return report(AVM_ERROR_INVALID_ARGUMENT, "avm_solve_file: a path is NULL");
   return guard("avm_solve_file", report, [&]() -> avm_status {
-    core_options o;
-    std::string msg;
-    if (!read_options(options, o, msg)) {
-      set_create_error(msg.c_str());
-      return report(AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
-    }
     // The library's solve-file job (the CLI's `solve` runs it too).
-    am::solve_file_job job = file_job(o);
-    job.input = in_landmarks;
-    job.output = out_pose;
     am::solve_file_summary summary;
-    const am::status st = job.run(summary);
-    if (!st) return report(code_for(st, job_code(summary.failure)), st.message().c_str());
-    return AVM_OK;
+    return run_file_job(
+        options, report,
+        [&](am::solve_file_job& job) {
+          job.input = in_landmarks;
+          job.output = out_pose;
+        },
+        summary);
   });
 }
 
@@ -219,23 +233,20 @@ AVATARMAP_C_API avm_status avm_solve_file_to_clip(const char* in_landmarks,
     return report(AVM_ERROR_INVALID_ARGUMENT,
                   "avm_solve_file_to_clip: in_landmarks and out must not be NULL");
   return guard("avm_solve_file_to_clip", report, [&]() -> avm_status {
-    core_options o;
-    std::string msg;
-    if (!read_options(options, o, msg)) {
-      set_create_error(msg.c_str());
-      return report(AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
-    }
     // avm_solve_file's job with the poses kept in the clip instead of written.
     std::unique_ptr<avm_clip> clip(new avm_clip());
-    am::solve_file_job job = file_job(o);
-    job.input = in_landmarks;
-    job.sink = [&clip](const am::proxy_pose& p) {
-      clip->frames.push_back(p);
-      return am::status{};
-    };
     am::solve_file_summary summary;
-    const am::status st = job.run(summary);
-    if (!st) return report(code_for(st, job_code(summary.failure)), st.message().c_str());
+    const avm_status code = run_file_job(
+        options, report,
+        [&](am::solve_file_job& job) {
+          job.input = in_landmarks;
+          job.sink = [&clip](const am::proxy_pose& p) {
+            clip->frames.push_back(p);
+            return am::status{};
+          };
+        },
+        summary);
+    if (code != AVM_OK) return code;
     clip->source_fps = summary.fps;  // a .pose.jsonl written from it has avm_solve_file's header
     *out = clip.release();
     return AVM_OK;
@@ -257,19 +268,11 @@ AVATARMAP_C_API avm_status avm_solve_frames(const avm_frame_block* frames,
   if (frames->count > 0 && out_poses == nullptr)
     return report(AVM_ERROR_INVALID_ARGUMENT, "avm_solve_frames: out_poses is NULL");
   return guard("avm_solve_frames", report, [&]() -> avm_status {
-    core_options o;
-    std::string msg;
-    if (!read_options(options, o, msg)) {
-      set_create_error(msg.c_str());
-      return report(AVM_ERROR_INVALID_ARGUMENT, msg.c_str());
-    }
     // The same job as avm_solve_file, its frames pulled from the block and its poses put in
     // out_poses (one per frame: no resampling).
     const std::int64_t count = frames->count;
-    am::solve_file_job job = file_job(o);
-    job.input = "frames";
-    std::int64_t next = 0;
-    job.source = [&](am::landmark_frame& out, bool& end) -> am::status {
+    std::int64_t next = 0, written = 0;
+    auto source = [&](am::landmark_frame& out, bool& end) -> am::status {
       if (next >= count) {
         end = true;
         return {};
@@ -280,16 +283,22 @@ AVATARMAP_C_API avm_status avm_solve_frames(const avm_frame_block* frames,
       block_row_to_frame(*frames, next++, out);
       return {};
     };
-    std::int64_t written = 0;
-    job.sink = [&](const am::proxy_pose& p) -> am::status {
+    auto sink = [&](const am::proxy_pose& p) -> am::status {
       if (written >= count)  // the job gives one pose per frame; never more
         return am::status::error("avm_solve_frames: more poses than frames");
       to_c_pose(p, out_poses[written++]);
       return {};
     };
     am::solve_file_summary summary;
-    const am::status st = job.run(summary);
-    if (!st) return report(code_for(st, job_code(summary.failure)), st.message().c_str());
+    const avm_status code = run_file_job(
+        options, report,
+        [&](am::solve_file_job& job) {
+          job.input = "frames";
+          job.source = source;
+          job.sink = sink;
+        },
+        summary);
+    if (code != AVM_OK) return code;
     if (written != count)
       return report(AVM_ERROR_INTERNAL, "avm_solve_frames: fewer poses than frames");
     return AVM_OK;

@@ -293,6 +293,7 @@ def run(args: argparse.Namespace, out=sys.stdout) -> int:
     timing = {"startup": 0.0, "wall": 0.0}
     if todo:
         results.extend(_run_on_dask(todo, options, args, timing))
+        _remove_work_folder(outdir)  # what workers that died left
     order = {os.path.abspath(p): i for i, p in enumerate(args.inputs)}
     results.sort(key=lambda r: (order.get(r.input, len(order)), r.input))
     _format_table(results, timing["wall"], timing["startup"], out)
@@ -321,10 +322,9 @@ def _run_on_dask(todo: List[Task], options: dict, args: argparse.Namespace,
         names = ["avatarmap-batch %s %s" % (os.path.basename(t.input), uuid.uuid4().hex[:8])
                  for t in todo]
         futures = client.map(convert_one, todo, options=options, key=names, pure=False)
-        show = not args.no_progress and sys.stderr.isatty()
-        if show:
-            progress(futures)
-            print("", file=sys.stderr)
+        if not args.no_progress and sys.stdout.isatty():
+            progress(futures)  # Dask's text bar, on standard output as the closing table
+            print("")
         results = []
         for task, f in zip(todo, futures):
             try:
@@ -334,12 +334,11 @@ def _run_on_dask(todo: List[Task], options: dict, args: argparse.Namespace,
                 if type(e).__name__ == "KilledWorker":
                     import dask
                     reason = ("the workers running it died %s times (Dask's "
-                              "distributed.scheduler.allowed-failures); a file that kills "
-                              "its worker (memory?)" %
+                              "distributed.scheduler.allowed-failures); the file may make its "
+                              "worker run out of memory" %
                               dask.config.get("distributed.scheduler.allowed-failures"))
                 results.append(Result(task.input, task.output, status="failed", reason=reason))
         timing["wall"] = time.perf_counter() - t1
-        _remove_work_folder(os.path.dirname(todo[0].output))
         return results
     finally:
         client.close()
