@@ -1,5 +1,6 @@
 // Per-frame solve cost: a full frame (pose + world, two hands + world, 478-point face) ->
-// proxy pose, one thread. Baseline: copying the landmark frame (the memory floor).
+// proxy pose, one thread, with and without the hand-shape fit. Baseline: copying the landmark
+// frame (the memory floor).
 #include <benchmark/benchmark.h>
 
 #include <cstring>
@@ -29,11 +30,12 @@ std::vector<landmark_frame> make_frames(bool hands, bool face) {
   return frames;
 }
 
-void run_solve(benchmark::State& state, bool hands, bool face) {
+void run_solve(benchmark::State& state, bool hands, bool face, bool fit_hands = true) {
   std::vector<landmark_frame> frames = make_frames(hands, face);
   solver_options o;
   o.image_width = 1280.f;
   o.image_height = 720.f;
+  o.fit_hand_shape = fit_hands;
   frame_solver solver(o);
   proxy_pose out;
   size_t i = 0;
@@ -49,6 +51,9 @@ void run_solve(benchmark::State& state, bool hands, bool face) {
 
 void BM_solve_full_frame(benchmark::State& s) { run_solve(s, true, true); }
 void BM_solve_body_only(benchmark::State& s) { run_solve(s, false, false); }
+// The same frames with the hands used as they are (solver_options::fit_hand_shape false): the
+// difference is the hand-shape stage (learn + fit, two hands).
+void BM_solve_full_frame_no_hand_fit(benchmark::State& s) { run_solve(s, true, true, false); }
 
 void BM_solve_full_frame_and_filter(benchmark::State& state) {
   std::vector<landmark_frame> frames = make_frames(true, true);
@@ -77,6 +82,7 @@ void BM_copy_landmark_frame(benchmark::State& state) {
 }
 
 BENCHMARK(BM_solve_full_frame);
+BENCHMARK(BM_solve_full_frame_no_hand_fit);
 BENCHMARK(BM_solve_body_only);
 BENCHMARK(BM_solve_full_frame_and_filter);
 BENCHMARK(BM_copy_landmark_frame);

@@ -91,6 +91,7 @@ class AvmSolverOptions(ctypes.Structure):
         ("expression_d_cutoff", _F),
         ("max_extrapolation_seconds", _F),
         ("file_filter", _I), ("file_smoothing", _F), ("file_threads", _I),
+        ("fit_hand_shape", _I),
     ]
 
 

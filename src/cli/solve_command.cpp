@@ -41,6 +41,9 @@ const char* k_solve_help =
     "  --fov DEG              camera's horizontal field of view (head under perspective, root\n"
     "                         motion); default: estimated from the pose's image and world\n"
     "                         points when they form one pinhole view, else 60\n"
+    "  --no-hand-fit          use the hand landmarks as they are (default: each hand's\n"
+    "                         points fitted to its shape learnt over the take, a rigid palm\n"
+    "                         and fingers of constant length; docs/solver.md)\n"
     "  --skip-bad-lines       report malformed lines and go on (default: stop at the first)\n"
     "  --threads 1|2          2 (default) parses the input on a second thread\n"
     "  --confidence           also write per-bone confidence\n"
@@ -60,6 +63,7 @@ int run_solve(int argc, char** argv) {
   std::string value;
   a.value("--output", job.output, "-o");
   job.options.mirror = a.flag("--mirror");
+  job.options.fit_hand_shape = !a.flag("--no-hand-fit");
   job.skip_bad_lines = a.flag("--skip-bad-lines");
   job.write_confidence = a.flag("--confidence");
   if (a.flag("--progress")) progress = progress_mode::on;

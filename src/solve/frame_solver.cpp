@@ -1,6 +1,8 @@
 // Landmarks -> proxy pose: the orchestrator. Each stage lives in its own file (docs/solver.md,
 // "Stages"); what couples them is visible here:
 //   prepare (solve_prepare.cpp): frame checks, mirroring, image aspect
+//   -> each hand fitted to the shape learnt so far, then learnt from (hand_shape.cpp; learnt
+//      in solve() only, measure() fits)
 //   -> measure body (solve_body.cpp), hands (solve_hands.cpp), face (solve_face.cpp)
 //   -> confidence gate (solve_gate.cpp with solve/confidence_gate.hpp): hysteresis, hold and
 //      ease, blend back in, per bone, for the hips position and for the expressions.
@@ -38,6 +40,8 @@ void frame_solver::reset() {
   world_stamp_.fill(0);
   world_generation_ = 1;
   have_arm_reference_[0] = have_arm_reference_[1] = false;
+  hand_shapes_[0].reset();
+  hand_shapes_[1].reset();
   hips_height_state_ = gate_state{};
   ground_state_ = gate_state{};
   face_state_ = gate_state{};
@@ -73,11 +77,21 @@ void frame_solver::update_focal(const landmark_frame& in) {
 }
 
 void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const {
+  prepared_frame f;
+  prepare_frame(in, options_, focal_per_width_, f);
+  measure_prepared(in, f, m, true);
+}
+
+void frame_solver::measure_prepared(const landmark_frame& in, prepared_frame& f,
+                                    frame_measurement& m, bool fit_hands) const {
   for (auto& b : m.bones) b.confidence = 0.f;  // the other fields are written with it
   m.hips_height_valid = m.hips_ground_valid = m.expressions_valid = false;
   m.expressions.fill(0.f);
-  prepared_frame f;
-  prepare_frame(in, options_, focal_per_width_, f);
+  if (fit_hands && options_.fit_hand_shape && options_.parts.hands) {
+    for (int side = 0; side < 2; ++side)
+      if (f.hand[side].c > 0.f && f.hand[side].metric)
+        hand_shapes_[side].fit(f.hand[side].p, f.hand[side].c);
+  }
   // Coupling to the previous frame: a straight arm keeps the twist it had.
   const glm::quat* arm_ref[2] = {have_arm_reference_[0] ? &arm_reference_[0] : nullptr,
                                  have_arm_reference_[1] ? &arm_reference_[1] : nullptr};
@@ -110,7 +124,15 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
   update_focal(in);
 
   frame_measurement& m = scratch_;
-  measure(in, m);
+  prepared_frame f;
+  prepare_frame(in, options_, focal_per_width_, f);
+  // Stage 1b: each hand fitted to the shape learnt so far, then learnt from (one alignment).
+  if (options_.fit_hand_shape && options_.parts.hands) {
+    for (int side = 0; side < 2; ++side)
+      if (f.hand[side].c > 0.f && f.hand[side].metric)
+        hand_shapes_[side].fit_and_learn(f.hand[side].p, f.hand[side].c);
+  }
+  measure_prepared(in, f, m, false);
   for (int side = 0; side < 2; ++side) {  // the next frame's straight-arm twist reference
     const bone_measurement& ua =
         m.bones[idx(side == 0 ? bone::left_upper_arm : bone::right_upper_arm)];

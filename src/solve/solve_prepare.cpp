@@ -53,6 +53,7 @@ void prepare_hand(const landmark_frame& in, const solver_options& o, int side, p
   hand_points& h = f.hand[side];
   h.c = 0.f;
   const bool world = in.has(world_part);
+  h.metric = world;
   if (!world && !in.has(image_part)) return;
   const auto& src = world ? (person_left ? in.left_hand_world : in.right_hand_world)
                           : (person_left ? in.left_hand : in.right_hand);

@@ -37,7 +37,8 @@ struct body_points {
 /// X), metres or VRM pixels.
 struct hand_points {
   std::array<glm::vec3, k_hand_landmark_count> p;
-  float c = 0.f;  // 1 when every point is finite, else 0
+  float c = 0.f;        // the points' mean confidence; 0 when a point is not finite
+  bool metric = false;  // from the hand's world landmarks (metres)
 };
 
 /// The face mesh points the solver reads, in VRM pixels with the perspective shear of the

@@ -25,12 +25,21 @@ namespace {
 // Kernels reach 3 sigma: the weight there is 1.1 % of the centre's.
 constexpr double k_kernel_reach = 3.0;
 constexpr int k_first_finger = static_cast<int>(bone::left_thumb_metacarpal);
-// Hands and fingers seen with a low confidence are filled as gaps, not smoothed: a few
-// millimetres of error turn a 2-4 cm finger bone, so a barely-seen hand's points say little.
+// The hand bones and fingers: a detection of them too short to believe is dropped
+// (drop_flicker).
 constexpr bool hand_or_finger(int b) {
   return b >= k_first_finger || b == idx(bone::left_hand) || b == idx(bone::right_hand);
 }
 constexpr int k_fingers_per_hand = 15;
+// Groups for the worth of barely-seen measurements (low_informative_): the body without the
+// hands, the fingers, the two hand bones. A hand bone spans the palm (~9 cm between six points)
+// and keeps a usable direction under noise that leaves a 2-4 cm finger bone at random.
+constexpr int k_low_body = 0, k_low_fingers = 1, k_low_hands = 2;
+constexpr int low_group_of(int b) {
+  return b >= k_first_finger                                       ? k_low_fingers
+         : b == idx(bone::left_hand) || b == idx(bone::right_hand) ? k_low_hands
+                                                                   : k_low_body;
+}
 // Body bones (torso, head, limbs) and fingers: kernel tables 0 and 1, with their own sigmas.
 constexpr int group_of(int b) { return b >= k_first_finger ? 1 : 0; }
 // Index of the lowest set bit of x != 0.
@@ -52,13 +61,15 @@ constexpr double k_reference_fps = 30.0;
 constexpr double k_noise_seconds = 4.0;
 constexpr double k_min_noise_factor = 0.25, k_max_noise_factor = 1.0;
 // Low-confidence observations (0 < confidence < observed_above) of a group -- the body without
-// the hands; the hands and fingers -- are smoothed (low_confidence_sigma_seconds) while their
-// measured noise (the same second differences, over the bones low in three frames running) is
-// at most k_low_noise_ratio x the confident bones' (the body's; the fingers') and below
-// k_low_noise_saturation radians per sample, where a bone's turn from frame to frame is mostly
-// noise (a finger's 2-4 cm bone under 30 mm of noise measures ~2.0, under 10 mm ~1.65); else
-// they are filled as gaps from the observed frames around them. Until measured: the body's
-// are smoothed, the hands' filled.
+// the hands; the fingers; the hand bones -- are smoothed (low_confidence_sigma_seconds) while
+// their measured noise (the same second differences, over the bones low in three frames
+// running) is below k_low_noise_saturation radians per sample, where a bone's turn from frame
+// to frame is mostly noise (a finger's 2-4 cm bone under 30 mm of noise measures ~2.0, under
+// 10 mm ~1.65), and, for the body and the fingers, at most k_low_noise_ratio x the confident
+// bones' of their kind (a hand bone under 30 mm measures ~1.2, 5-6 x the confident body's,
+// and its smoothed direction still beats filling a 1 s burst); else they are filled as gaps
+// from the observed frames around them. Until measured: the body's are smoothed, the hands'
+// and fingers' filled.
 constexpr double k_low_noise_ratio = 5.0;
 constexpr double k_low_noise_saturation = 1.8;
 // Shortest hand detection believed (drop_flicker): 0.25 s is 6 frames at 25 fps.
@@ -185,7 +196,7 @@ void offline_smoother::reset() noexcept {
   noise_.fill(0.0);
   low_noise_.fill(0.0);
   low_noise_weight_.fill(0.0);
-  low_informative_ = {true, false};
+  low_informative_ = {true, false, false};
   flicker_bits_ = 0;
   noise_dt_ = 0.0;
   noise_weight_ = 0.0;
@@ -368,13 +379,13 @@ void offline_smoother::observe_noise() noexcept {
       size[block * k_lanes + l] = std::sqrt(vx * vx + vy * vy + vz * vz);
     }
   }
-  double sum[2] = {0.0, 0.0}, low_sum[2] = {0.0, 0.0};
-  int n[2] = {0, 0}, low_n[2] = {0, 0};
+  double sum[2] = {0.0, 0.0}, low_sum[k_low_groups] = {0.0, 0.0, 0.0};
+  int n[2] = {0, 0}, low_n[k_low_groups] = {0, 0, 0};
   auto low = [&](float w) { return w > 0.f && w < threshold; };
   for (int i = 0; i < k_bone_count; ++i) {
     if (low(a.weight[i]) && low(b.weight[i]) && low(c.weight[i]) && size[i] > 1e-6f) {
-      low_sum[hand_or_finger(i) ? 1 : 0] += size[i];
-      ++low_n[hand_or_finger(i) ? 1 : 0];
+      low_sum[low_group_of(i)] += size[i];
+      ++low_n[low_group_of(i)];
     }
     if (!(a.weight[i] >= threshold && b.weight[i] >= threshold && c.weight[i] >= threshold))
       continue;
@@ -385,17 +396,22 @@ void offline_smoother::observe_noise() noexcept {
     ++n[group_of(i)];
   }
   // Running means as below, per group.
-  for (int g = 0; g < 2; ++g) {
+  for (int g = 0; g < k_low_groups; ++g) {
     if (low_n[g] == 0) continue;
     const double w = std::min(mean_dt, k_noise_seconds);
     const double total = std::min(low_noise_weight_[g] + w, k_noise_seconds);
     low_noise_[g] += w / std::max(total, w) * (low_sum[g] / low_n[g] - low_noise_[g]);
     low_noise_weight_[g] = total;
   }
-  for (int g = 0; g < 2; ++g)
+  // Against the confident bones' noise of the same kind: the body's for the body and the hand
+  // bones (which belong to the body's group there), the fingers' for the fingers.
+  for (int g = 0; g < k_low_groups; ++g)
     if (low_noise_weight_[g] > 0.0 && noise_weight_ > 0.0)
       low_informative_[g] =
-          low_noise_[g] <= std::min(k_low_noise_ratio * noise_[g], k_low_noise_saturation);
+          low_noise_[g] <= (g == k_low_hands
+                                ? k_low_noise_saturation
+                                : std::min(k_low_noise_ratio * noise_[g == k_low_fingers ? 1 : 0],
+                                           k_low_noise_saturation));
   if (n[0] + n[1] == 0) return;
   // A running mean over about k_noise_seconds: plain while less than that has been seen.
   const double w = std::min(mean_dt, k_noise_seconds);
@@ -783,7 +799,7 @@ void offline_smoother::emit(proxy_pose& out) noexcept {
     // confidence (observed neighbours dominate near the gap's ends).
     const float own = c.pose.confidence[b];
     if (options_.low_confidence_sigma_seconds > 0.f && own > 0.f && own == c.weight[b] &&
-        low_informative_[hand_or_finger(b) ? 1 : 0]) {
+        low_informative_[low_group_of(b)]) {
       how_low[b] = weighting::confidence;
       low_used = true;
       continue;

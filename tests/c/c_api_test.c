@@ -636,6 +636,7 @@ static void test_solve_file(void) {
   /* file_threads: 2 (parse ahead) by default; 1 writes the same bytes; others are refused. */
   avm_solver_options_init(&o);
   CHECK(o.file_threads == 2);
+  CHECK(o.fit_hand_shape == 1); /* the hands fitted to their learnt shape by default */
   CHECK_STATUS(avm_solve_file(in, out, &o, err, sizeof err), AVM_OK);
   {
     char* two = read_text(out);

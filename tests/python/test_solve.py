@@ -62,6 +62,7 @@ def _poses_equal(poses, ref, with_confidence=True):
     (("--filter", "live"), {"file_filter": "live"}),
     (("--filter", "none", "--mirror"), {"file_filter": "none", "mirror": True}),
     (("--smoothing", "2"), {"file_smoothing": 2.0}),
+    (("--no-hand-fit",), {"fit_hand_shape": False}),
 ])
 def test_solve_equals_the_cli(synth_file, cli, tmp_path, cli_args, options):
     """Python solve() == `avatarmap solve` read back from its text, bit for bit (the writer
@@ -71,6 +72,18 @@ def test_solve_equals_the_cli(synth_file, cli, tmp_path, cli_args, options):
     poses = am.solve(am.read_landmarks(synth_file), **options)
     assert len(poses) == 120
     _poses_equal(poses, read_poses_json(out, am.BONE_NAMES, am.EXPRESSION_NAMES))
+
+
+def test_hand_fit_is_on_by_default_and_can_be_turned_off(synth_file):
+    """fit_hand_shape (on by default) changes the noisy recording's fingers (off equals the
+    CLI's --no-hand-fit bit for bit: the parametrised test above)."""
+    lm = am.read_landmarks(synth_file)
+    fitted, raw = am.solve(lm), am.solve(lm, fit_hand_shape=False)
+    fingers = [i for i, n in enumerate(am.BONE_NAMES) if any(
+        f in n for f in ("Thumb", "Index", "Middle", "Ring", "Little"))]
+    assert len(fingers) == 30
+    assert not np.array_equal(fitted.rotations[:, fingers], raw.rotations[:, fingers])
+    np.testing.assert_array_equal(fitted.rotations, am.solve(lm, fit_hand_shape=True).rotations)
 
 
 def test_solve_file_equals_solve(synth_file, tmp_path):

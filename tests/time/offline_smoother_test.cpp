@@ -327,11 +327,11 @@ TEST(OfflineSmoother, BarelySeenFingersAreFilledNotSmoothed) {
   }
 }
 
-// A left index finger swinging (up to 3 rad/s) with Gaussian noise of `noise` radians per
-// axis, and during frames 120-149 confidence 0.2 with noise of `burst_noise` instead; returns the
-// largest error over the burst's frames.
-float finger_burst_error(float noise, float burst_noise, unsigned seed) {
-  const int finger = idx(bone::left_index_proximal);
+// A left index finger (or another bone) swinging (up to 3 rad/s) with Gaussian noise of `noise`
+// radians per axis, and during frames 120-149 confidence 0.2 with noise of `burst_noise`
+// instead; returns the largest error over the burst's frames.
+float finger_burst_error(float noise, float burst_noise, unsigned seed,
+                         int finger = idx(bone::left_index_proximal)) {
   std::mt19937 rng(seed);
   std::normal_distribution<float> n(0.f, 1.f);
   auto truth = [](double t) { return about(glm::vec3(0.f, 0.f, 1.f), float(std::sin(3.0 * t))); };
@@ -365,6 +365,20 @@ TEST(OfflineSmoother, LowConfidenceFingersAreUsedWhenTheyAreAsSteadyAsTheRest) {
   EXPECT_LT(filled, 70.f);
   // The filled burst is the same whatever garbage it holds (nothing of it is used).
   EXPECT_FLOAT_EQ(filled, finger_burst_error(0.05f, 2.5f, 3));
+}
+
+TEST(OfflineSmoother, ABarelySeenHandBoneIsSmoothedWhileAFingerAsNoisyIsFilled) {
+  // A hand bone spans the palm: under noise that leaves a finger bone at random it still
+  // carries the wrist's turn. Confident frames 0.02 rad, the burst 0.25 rad per axis (a
+  // second-difference size ~1.1 rad per sample, ~12 x the confident frames', under 1.8): the
+  // hand bone is smoothed through the burst and follows the swing; a finger with the same
+  // numbers is filled from the burst's edges (its group asks for at most 5 x).
+  const float hand = finger_burst_error(0.02f, 0.25f, 5, idx(bone::left_hand));
+  const float finger = finger_burst_error(0.02f, 0.25f, 5, idx(bone::left_index_proximal));
+  EXPECT_LT(hand, 25.f);
+  EXPECT_GT(finger, 35.f);
+  // Beyond 1.8 rad per sample (1 rad per axis) the hand bone is filled too.
+  EXPECT_GT(finger_burst_error(0.02f, 1.f, 5, idx(bone::left_hand)), 35.f);
 }
 
 // A left hand (hand and fingers) absent (confidence 0) except frames [from, to) where it is

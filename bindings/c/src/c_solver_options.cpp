@@ -56,6 +56,7 @@ avm_solver_options default_options() {
   o.file_filter = AVM_FILE_FILTER_OFFLINE;
   o.file_smoothing = am::offline_smoother_options{}.strength;
   o.file_threads = 2;
+  o.fit_hand_shape = s.fit_hand_shape ? 1 : 0;
   return o;
 }
 
@@ -98,6 +99,7 @@ bool read_options(const avm_solver_options* in, core_options& out, std::string& 
   s.forearm_twist_share = o.forearm_twist_share;
   s.horizontal_fov_degrees = o.horizontal_fov_degrees;
   s.rest_hips_height = o.rest_hips_height;
+  s.fit_hand_shape = o.fit_hand_shape != 0;
   am::status st = s.validate();
   if (!st) {
     msg = "avm_solver_options: " + st.message();

@@ -92,6 +92,7 @@ class AvmSolverOptions(ctypes.Structure):
         ("expression_beta", _F32), ("expression_d_cutoff", _F32),
         ("max_extrapolation_seconds", _F32),
         ("file_filter", _I32), ("file_smoothing", _F32), ("file_threads", _I32),
+        ("fit_hand_shape", _I32),
     ]
 
 

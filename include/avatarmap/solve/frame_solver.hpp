@@ -14,9 +14,14 @@
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "avatarmap/solve/confidence_gate.hpp"
+#include "avatarmap/solve/hand_shape.hpp"
 #include "avatarmap/solve/solver_options.hpp"
 
 namespace avatarmap {
+
+namespace solve_detail {
+struct prepared_frame;  // src/solve/solve_prepare.hpp
+}  // namespace solve_detail
 
 /// One bone's measurement before confidence gating and its confidence (0 = not measured this
 /// frame): a world rotation in VRM space, or, when has_local, the rotation relative to the
@@ -51,7 +56,8 @@ class frame_solver {
   /// treated as not seen.
   void solve(const landmark_frame& in, proxy_pose& out);
 
-  /// Measurement only (no gating, no state change): for tests and diagnostics.
+  /// Measurement only (no gating, no state change: the hands are fitted to the shapes learnt
+  /// so far, and nothing is learnt): for tests and diagnostics.
   void measure(const landmark_frame& in, frame_measurement& out) const;
 
   /// Forgets all state (as if newly constructed with the same options).
@@ -65,6 +71,8 @@ class frame_solver {
   /// Frames whose pose told something about the field of view (0 when it was given, or when
   /// no frame's image and world points formed one pinhole view, e.g. MediaPipe's own output).
   long fov_evidence_frames() const { return focal_frames_; }
+  /// The shape learnt of the avatar's left (0) or right (1) hand (options().fit_hand_shape).
+  const hand_shape& learnt_hand(int side) const { return hand_shapes_[side != 0 ? 1 : 0]; }
 
  private:
   // The gate stage (src/solve/solve_gate.cpp): this frame's measurement -> what is shown.
@@ -75,6 +83,10 @@ class frame_solver {
   const glm::quat& previous_world(int b) const;
   // Adds this frame's evidence on the focal length (horizontal_fov_degrees 0 only).
   void update_focal(const landmark_frame& in);
+  // The measuring stages on a prepared frame (fit_hands: fit the hands to their learnt shapes
+  // first; solve() has done it already).
+  void measure_prepared(const landmark_frame& in, solve_detail::prepared_frame& f,
+                        frame_measurement& m, bool fit_hands) const;
 
   solver_options options_;
   float focal_per_width_ = 1.f;  // focal length / image width, from the field of view
@@ -101,6 +113,7 @@ class frame_solver {
   double last_t_ = 0.0;
   bool started_ = false;
   mutable frame_measurement scratch_{};
+  std::array<hand_shape, 2> hand_shapes_{};  // avatar's left, right (canonical space)
 };
 
 }  // namespace avatarmap

@@ -54,6 +54,11 @@ struct solver_options {
   float horizontal_fov_degrees = 0.f;
   /// Hips height used while the legs have never been seen (metres).
   float rest_hips_height = 0.95f;
+  /// Fit each hand's metric landmarks to that hand's shape, learnt over the take: a rigid
+  /// palm and fingers of constant length (hand_shape.hpp; docs/solver.md "The hand's shape").
+  /// Takes a third of the landmark noise's effect off the fingers and changes nothing on exact
+  /// landmarks. false = the hand landmarks as they are.
+  bool fit_hand_shape = true;
 
   status validate() const {
     auto bad01 = [](float v) { return !(v >= 0.f && v <= 1.f); };

@@ -19,9 +19,9 @@
 // - seen with a low confidence of its own (0 < confidence < observed_above, e.g. an occluded
 //   limb the estimator still places): smoothed over low_confidence_sigma_seconds with every
 //   frame weighted by its confidence while such frames' measured noise says they still carry
-//   the motion (at most 5 x the confident bones' noise and below 1.8 rad per sample, per group:
-//   the body; the hands and fingers; until measured the body's are, the hands' are not); else
-//   filled as a gap.
+//   the motion (per group -- the body; the fingers: at most 5 x the confident bones' noise and
+//   below 1.8 rad per sample; the hand bones: below 1.8 rad; until measured the body's are,
+//   the hands' and fingers' are not); else filled as a gap.
 // - a hand or finger seen for less than 0.25 s between frames where it was not detected at all
 //   (confidence 0) is a false detection: its frames become gaps (confidence written 0), and the
 //   input's hold of it afterwards is replaced by what the input showed before it.
@@ -181,12 +181,14 @@ class offline_smoother {
   // sample, and of the frame interval; weights (seconds of evidence, capped).
   std::array<double, 2> noise_{};
   // The same over low-confidence observations (0 < weight < observed_above), per group
-  // (body without the hands; hands and fingers) and its running weight.
-  std::array<double, 2> low_noise_{};
-  std::array<double, 2> low_noise_weight_{};
+  // (k_low_groups: the body without the hands; the fingers; the two hand bones) and its
+  // running weight.
+  static constexpr int k_low_groups = 3;
+  std::array<double, k_low_groups> low_noise_{};
+  std::array<double, k_low_groups> low_noise_weight_{};
   // Whether low-confidence observations of each group still carry the motion (smoothed with
   // low_confidence_sigma_seconds) or not (filled as gaps); see observe_noise().
-  std::array<bool, 2> low_informative_{};
+  std::array<bool, k_low_groups> low_informative_{};
   // drop_flicker(): bones whose false detection is being replaced, and by what.
   std::uint64_t flicker_bits_ = 0;
   std::array<glm::quat, k_bone_count> flicker_fill_{};

@@ -297,6 +297,11 @@ typedef struct avm_solver_options {
                            file ahead on a second thread (the default, as `avatarmap solve`);
                            1 does everything on the calling thread (one task per core, e.g.
                            a batch's workers) */
+  /* -- added in 0.1.0 after file_threads (a caller whose struct_size ends before it gets the
+   *    default) -- */
+  int32_t fit_hand_shape; /* fit each hand's world landmarks to its shape learnt over the take
+                             (a rigid palm, fingers of constant length; docs/solver.md "The
+                             hand's shape"): less finger noise, exact landmarks unchanged; 1 */
 } avm_solver_options;
 
 /* What avm_solve_file does after solving each frame. */
