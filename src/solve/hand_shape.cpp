@@ -22,24 +22,28 @@ constexpr int k_finger_sweeps = 3;
 constexpr double k_stray_factor = 4.0;
 constexpr double k_stray_floor_m = 0.003;
 constexpr int k_strays_to_restart = 30;
-// Observed segment lengths outside [low, high] x the learnt one leave the finger as observed.
-constexpr float k_segment_low = 0.5f, k_segment_high = 1.5f;
-constexpr float k_full_low = 0.7f, k_full_high = 1.3f;
+// How far an observed segment's length may be from the learnt one: the fit is taken whole
+// within k_full_off x the learnt length or k_full_sd standard deviations of the length's noise
+// (sqrt(2) sigma: two ends), whichever is more, not at all beyond k_none_off x the length or
+// k_none_sd deviations (a failed depth estimate, a segment seen end-on), linearly between.
+constexpr float k_full_off = 0.3f, k_none_off = 0.5f;
+constexpr float k_full_sd = 3.f, k_none_sd = 5.f;
 // The palm's residual has 3 x 6 coordinates less 6 degrees of freedom of the rigid motion.
 constexpr double k_palm_dof = 3.0 * hand_shape::k_palm_points - 6.0;
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x + v.y + v.z); }
 
 // How much of the fit a finger takes for an observed segment of length l whose learnt length
-// is len: all of it within [k_full_low, k_full_high] x len, none outside [k_segment_low,
-// k_segment_high] x len, linear between (a finger does not snap between fitted and observed).
-float segment_weight(float l, float len) {
+// is len, with a length noise of sd (see k_full_off): a finger does not snap between fitted
+// and observed.
+float segment_weight(float l, float len, float sd) {
   if (!(len > 0.f) || !(l > 0.f)) return 0.f;
-  const float r = l / len;
-  if (r <= k_segment_low || r >= k_segment_high) return 0.f;
-  if (r < k_full_low) return (r - k_segment_low) / (k_full_low - k_segment_low);
-  if (r > k_full_high) return (k_segment_high - r) / (k_segment_high - k_full_high);
-  return 1.f;
+  const float off = std::fabs(l - len);
+  const float full = std::max(k_full_off * len, k_full_sd * sd);
+  const float none = std::max(k_none_off * len, k_none_sd * sd);
+  if (off <= full) return 1.f;
+  if (off >= none) return 0.f;
+  return (none - off) / (none - full);
 }
 
 // Orthonormal axes of a palm: X from the wrist to the middle knuckle, Z toward the index side
@@ -195,6 +199,7 @@ void hand_shape::fit_aligned(points& p, const glm::vec3& centre, const glm::quat
   // Per finger, from its fitted root: the observed joints o, the learnt lengths, the directions
   // d (from the observed segments) and the joints they give.
   constexpr int k_fingers = 5;
+  const float length_sd = 1.41421356f * noise_sigma();
   glm::vec3 o[k_fingers][3], d[k_fingers][3], joint[k_fingers][3];
   float len[k_fingers][3], weight[k_fingers];
   for (int f = 0; f < k_fingers; ++f) {
@@ -206,7 +211,7 @@ void hand_shape::fit_aligned(points& p, const glm::vec3& centre, const glm::quat
       o[f][k] = p[base + k + 1];
       const glm::vec3 seg = o[f][k] - from;
       const float l = glm::length(seg);
-      weight[f] = std::min(weight[f], segment_weight(l, len[f][k]));
+      weight[f] = std::min(weight[f], segment_weight(l, len[f][k], length_sd));
       d[f][k] = weight[f] > 0.f ? seg / l : glm::vec3(1.f, 0.f, 0.f);
       joint[f][k] = (k == 0 ? p[base] : joint[f][k - 1]) + len[f][k] * d[f][k];
       from = o[f][k];

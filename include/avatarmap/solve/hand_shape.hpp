@@ -17,8 +17,9 @@
 //
 // Points that already have the learnt shape (exact landmarks of a rigid skeleton) stay where
 // they are, so every bone still points exactly at its observed child joint. A finger with an
-// observed segment under half or over one and a half times its learnt length (a failed depth
-// estimate, or a segment seen end-on) keeps its observed points; nothing moves before the
+// observed segment off its learnt length by more than half of it or 5 deviations of the
+// length's noise (a failed depth estimate, or a segment seen end-on) keeps its observed points
+// (between 30 % or 3 deviations and that, it takes part of the fit); nothing moves before the
 // shape has been learnt from k_min_frames frames.
 //
 // Points are in metres (a hand's world landmarks, any axes and handedness, the same for every
