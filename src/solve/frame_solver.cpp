@@ -79,19 +79,21 @@ void frame_solver::update_focal(const landmark_frame& in) {
 void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const {
   prepared_frame f;
   prepare_frame(in, options_, focal_per_width_, f);
-  measure_prepared(in, f, m, true);
+  for (int side = 0; side < 2; ++side)  // the shapes learnt so far; nothing learnt
+    if (fits_hand(f, side)) hand_shapes_[side].fit(f.hand[side].p, f.hand[side].c);
+  measure_prepared(in, f, m);
 }
 
-void frame_solver::measure_prepared(const landmark_frame& in, prepared_frame& f,
-                                    frame_measurement& m, bool fit_hands) const {
+bool frame_solver::fits_hand(const prepared_frame& f, int side) const {
+  return options_.fit_hand_shape && options_.parts.hands && f.hand[side].c > 0.f &&
+         f.hand[side].metric;
+}
+
+void frame_solver::measure_prepared(const landmark_frame& in, const prepared_frame& f,
+                                    frame_measurement& m) const {
   for (auto& b : m.bones) b.confidence = 0.f;  // the other fields are written with it
   m.hips_height_valid = m.hips_ground_valid = m.expressions_valid = false;
   m.expressions.fill(0.f);
-  if (fit_hands && options_.fit_hand_shape && options_.parts.hands) {
-    for (int side = 0; side < 2; ++side)
-      if (f.hand[side].c > 0.f && f.hand[side].metric)
-        hand_shapes_[side].fit(f.hand[side].p, f.hand[side].c);
-  }
   // Coupling to the previous frame: a straight arm keeps the twist it had.
   const glm::quat* arm_ref[2] = {have_arm_reference_[0] ? &arm_reference_[0] : nullptr,
                                  have_arm_reference_[1] ? &arm_reference_[1] : nullptr};
@@ -127,12 +129,9 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
   prepared_frame f;
   prepare_frame(in, options_, focal_per_width_, f);
   // Stage 1b: each hand fitted to the shape learnt so far, then learnt from (one alignment).
-  if (options_.fit_hand_shape && options_.parts.hands) {
-    for (int side = 0; side < 2; ++side)
-      if (f.hand[side].c > 0.f && f.hand[side].metric)
-        hand_shapes_[side].fit_and_learn(f.hand[side].p, f.hand[side].c);
-  }
-  measure_prepared(in, f, m, false);
+  for (int side = 0; side < 2; ++side)
+    if (fits_hand(f, side)) hand_shapes_[side].fit_and_learn(f.hand[side].p, f.hand[side].c);
+  measure_prepared(in, f, m);
   for (int side = 0; side < 2; ++side) {  // the next frame's straight-arm twist reference
     const bone_measurement& ua =
         m.bones[idx(side == 0 ? bone::left_upper_arm : bone::right_upper_arm)];

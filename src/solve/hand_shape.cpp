@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "avatarmap/core/rotation.hpp"
+#include "solve/solve_geometry.hpp"
+
 namespace avatarmap {
 namespace {
 
@@ -46,22 +49,12 @@ float segment_weight(float l, float len, float sd) {
   return (none - off) / (none - full);
 }
 
-// Orthonormal axes of a palm: X from the wrist to the middle knuckle, Z toward the index side
-// (orthogonalised), Y = Z x X. Columns of the matrix.
-glm::mat3 palm_axes(const glm::vec3* p) {
-  glm::vec3 x = p[k_slot_middle] - p[k_slot_wrist];
-  const float lx = glm::length(x);
-  x = lx > 0.f ? x / lx : glm::vec3(1.f, 0.f, 0.f);
-  glm::vec3 z = p[k_slot_index] - p[k_slot_pinky];
-  z -= glm::dot(z, x) * x;
-  const float lz = glm::length(z);
-  if (!(lz > 1e-9f)) {
-    z = std::fabs(x.z) < 0.9f ? glm::vec3(0.f, 0.f, 1.f) : glm::vec3(0.f, 1.f, 0.f);
-    z = glm::normalize(z - glm::dot(z, x) * x);
-  } else {
-    z /= lz;
-  }
-  return glm::mat3(x, glm::cross(z, x), z);
+// The palm's own axes (as solve_hands measures the hand): X from the wrist to the middle
+// knuckle, Z toward the index side.
+glm::quat palm_frame(const glm::vec3* p) {
+  return solve_detail::frame_from_axes<solve_detail::k_px, solve_detail::k_pz>(
+      normalize_or(p[k_slot_middle] - p[k_slot_wrist], solve_detail::k_x),
+      p[k_slot_index] - p[k_slot_pinky]);
 }
 
 }  // namespace
@@ -70,8 +63,7 @@ glm::quat hand_shape::align(const palm_points& observed, float* residual) const 
   // Start: the rotation between the two palms' own axes; then Gauss-Newton on
   // sum |R a_i - b_i|^2 with R <- exp(w) R, J w = sum (R a_i) x b_i,
   // J = sum (|q|^2 I - q q^T), q = R a_i; in double (a few microns matter on a 2 cm bone).
-  const glm::mat3 start = palm_axes(observed.data()) * glm::transpose(palm_axes(palm_.data()));
-  glm::dquat r = glm::normalize(glm::dquat(glm::quat_cast(start)));
+  glm::dquat r(palm_frame(observed.data()) * glm::conjugate(palm_frame(palm_.data())));
   for (int step = 0; step < k_align_steps; ++step) {
     glm::dvec3 g(0.0);
     glm::dmat3 j(0.0);

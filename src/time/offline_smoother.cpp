@@ -35,6 +35,7 @@ constexpr int k_fingers_per_hand = 15;
 // hands, the fingers, the two hand bones. A hand bone spans the palm (~9 cm between six points)
 // and keeps a usable direction under noise that leaves a 2-4 cm finger bone at random.
 constexpr int k_low_body = 0, k_low_fingers = 1, k_low_hands = 2;
+static_assert(k_low_body == 0 && k_low_fingers == 1, "the body and fingers share noise_'s groups");
 constexpr int low_group_of(int b) {
   return b >= k_first_finger                                       ? k_low_fingers
          : b == idx(bone::left_hand) || b == idx(bone::right_hand) ? k_low_hands
@@ -403,15 +404,14 @@ void offline_smoother::observe_noise() noexcept {
     low_noise_[g] += w / std::max(total, w) * (low_sum[g] / low_n[g] - low_noise_[g]);
     low_noise_weight_[g] = total;
   }
-  // Against the confident bones' noise of the same kind: the body's for the body and the hand
-  // bones (which belong to the body's group there), the fingers' for the fingers.
-  for (int g = 0; g < k_low_groups; ++g)
-    if (low_noise_weight_[g] > 0.0 && noise_weight_ > 0.0)
-      low_informative_[g] =
-          low_noise_[g] <= (g == k_low_hands
-                                ? k_low_noise_saturation
-                                : std::min(k_low_noise_ratio * noise_[g == k_low_fingers ? 1 : 0],
-                                           k_low_noise_saturation));
+  for (int g = 0; g < k_low_groups; ++g) {
+    if (!(low_noise_weight_[g] > 0.0 && noise_weight_ > 0.0)) continue;
+    // The body and the fingers also against their confident bones' noise (groups 0 and 1 of
+    // noise_); the hand bones against the saturation alone.
+    double limit = k_low_noise_saturation;
+    if (g != k_low_hands) limit = std::min(limit, k_low_noise_ratio * noise_[g]);
+    low_informative_[g] = low_noise_[g] <= limit;
+  }
   if (n[0] + n[1] == 0) return;
   // A running mean over about k_noise_seconds: plain while less than that has been seen.
   const double w = std::min(mean_dt, k_noise_seconds);

@@ -83,10 +83,11 @@ class frame_solver {
   const glm::quat& previous_world(int b) const;
   // Adds this frame's evidence on the focal length (horizontal_fov_degrees 0 only).
   void update_focal(const landmark_frame& in);
-  // The measuring stages on a prepared frame (fit_hands: fit the hands to their learnt shapes
-  // first; solve() has done it already).
-  void measure_prepared(const landmark_frame& in, solve_detail::prepared_frame& f,
-                        frame_measurement& m, bool fit_hands) const;
+  // Whether a prepared hand is fitted to its shape (options, and metric points seen).
+  bool fits_hand(const solve_detail::prepared_frame& f, int side) const;
+  // The measuring stages on a prepared frame whose hands are fitted already.
+  void measure_prepared(const landmark_frame& in, const solve_detail::prepared_frame& f,
+                        frame_measurement& m) const;
 
   solver_options options_;
   float focal_per_width_ = 1.f;  // focal length / image width, from the field of view
