@@ -424,11 +424,12 @@ status read_impl(const std::string& path, vrma_clip& out, const vrma_read_option
   clip.duration = times.back();
   if (options.fps > 0.0) {
     // Bounded like every resampling: a key at 1e9 s must not ask for 3e10 frames.
-    const double t0 = times.front();
+    const double t0 = times.front(), t_last = times.back();
     std::size_t count = 0;
-    if (status s = resampled_frame_count(t0, times.back(), options.fps, path, count); !s) return s;
+    if (status s = resampled_frame_count(t0, t_last, options.fps, path, count); !s) return s;
     times.resize(count);
-    for (std::size_t k = 0; k < count; ++k) times[k] = t0 + static_cast<double>(k) / options.fps;
+    for (std::size_t k = 0; k < count; ++k)
+      times[k] = resampled_frame_time(t0, t_last, k, options.fps);
   }
 
   // ---- rest pose ----

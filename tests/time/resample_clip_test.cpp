@@ -67,6 +67,23 @@ TEST(ResampleClip, FloatTimesDoNotLoseTheLastFrameAndEdgeCases) {
   EXPECT_EQ(out.size(), 1u);
 }
 
+TEST(ResampleClip, TheToleratedLastFrameIsAtTheLastKeyNotPastIt) {
+  // 0.03332 s at 30 fps is 0.9996 frames: within the thousandth of tolerance, so 2 frames, and
+  // the second is at the last key (+0.03332), not at 1/30 = 0.033333... past it (fuzz_vrma
+  // found a clip read at 30 fps whose last frame lay past its keys).
+  const std::vector<proxy_pose> clip = clip_at({5.0, 5.03332});
+  std::vector<proxy_pose> out;
+  ASSERT_TRUE(resample_clip(clip, 30.0, false, out).ok());
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].t, 5.0);
+  EXPECT_EQ(out[1].t, 5.03332);
+  ASSERT_TRUE(resample_clip(clip, 30.0, true, out).ok());
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[1].t, 5.03332 - 5.0);
+  // Frames inside the clip keep t0 + k / fps exactly.
+  EXPECT_EQ(resampled_frame_time(5.0, 6.0, 7, 30.0), 5.0 + 7.0 / 30.0);
+}
+
 TEST(ResampleClip, RefusesABadFrameRate) {
   const std::vector<proxy_pose> clip = spin_clip(30.0, 10, 0.0);
   for (double fps : {0.0, -30.0, std::numeric_limits<double>::quiet_NaN(),

@@ -71,6 +71,14 @@ inline status resampled_frame_count(double t_first, double t_last, double fps,
   return {};
 }
 
+/// The time of resampled frame k (0-based, k < resampled_frame_count) of a clip from `t_first`
+/// to `t_last` at `fps`: t_first + k / fps, but never past t_last. The count's thousandth of a
+/// frame of tolerance would otherwise put the last frame up to 1e-3 / fps past the last key;
+/// it is at the last key instead.
+inline double resampled_frame_time(double t_first, double t_last, std::size_t k, double fps) {
+  return std::min(t_first + static_cast<double>(k) / fps, t_last);
+}
+
 /// Sorts `frames` by time, stably (frames with equal times keep their order; non-finite times
 /// go last). Returns how many frames had a time earlier than the frame before them: 0 means the
 /// clip was already in order and nothing moved.
@@ -87,8 +95,9 @@ inline std::size_t sort_clip_by_time(std::vector<proxy_pose>& frames) {
   return backward;
 }
 
-/// Samples `frames` at t0 + k / fps (t0 = the first frame's time) for every k with the sample
-/// within the clip (count from resampled_frame_count) into `out` (cleared first; must not be
+/// Samples `frames` at resampled_frame_time (t0 + k / fps, t0 = the first frame's time, never
+/// past the last frame) for every k with the sample within the clip (count from
+/// resampled_frame_count) into `out` (cleared first; must not be
 /// `frames`). `rebase`: output times start at 0 (else they keep the clip's clock).
 /// Times must be finite and must not decrease (sort_clip_by_time puts a clip in order); at equal
 /// times the later frame wins. An empty clip gives an empty result. Fails, with a message
@@ -116,9 +125,9 @@ inline status resample_clip(const std::vector<proxy_pose>& frames, double fps, b
                            std::to_string(i - 1) + " (t = " + seconds_text(frames[i - 1].t) +
                            " s); resampling needs the frames in time order (sort them first)");
   }
-  const double t0 = frames.front().t;
+  const double t0 = frames.front().t, t_last = frames.back().t;
   std::size_t count = 0;
-  if (status s = resampled_frame_count(t0, frames.back().t, fps, what, count); !s) return s;
+  if (status s = resampled_frame_count(t0, t_last, fps, what, count); !s) return s;
   try {
     out.resize(count);
   } catch (const std::bad_alloc&) {
@@ -128,7 +137,7 @@ inline status resample_clip(const std::vector<proxy_pose>& frames, double fps, b
   }
   std::size_t seg = 0;
   for (std::size_t k = 0; k < count; ++k) {
-    const double t = t0 + static_cast<double>(k) / fps;
+    const double t = resampled_frame_time(t0, t_last, k, fps);
     while (seg + 1 < frames.size() && frames[seg + 1].t <= t) ++seg;
     proxy_pose& o = out[k];
     if (seg + 1 >= frames.size()) {
@@ -150,7 +159,7 @@ inline status resample_clip(const std::vector<proxy_pose>& frames, double fps, b
       for (int e = 0; e < k_expression_count; ++e)
         o.expressions[e] = v * a.expressions[e] + u * b.expressions[e];
     }
-    o.t = rebase ? static_cast<double>(k) / fps : t;
+    o.t = rebase ? resampled_frame_time(0.0, t_last - t0, k, fps) : t;
   }
   return {};
 }
