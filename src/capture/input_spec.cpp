@@ -1,5 +1,6 @@
 #include "capture/input_spec.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cstddef>
 
@@ -51,6 +52,19 @@ input_spec classify_input(const std::string& text, bool exists) {
   }
   if (text.find('%') != std::string::npos) r.kind = input_kind::pattern;
   return r;
+}
+
+std::string shown_input(const std::string& text) {
+  const std::size_t scheme_end = text.find("://");
+  if (scheme_end == std::string::npos) return text;
+  const std::size_t start = scheme_end + 3;
+  // The authority ends at the first '/', '?' or '#'; credentials are what precede its last '@'.
+  const std::size_t end = std::min(text.find_first_of("/?#", start), text.size());
+  const std::size_t at = text.rfind('@', end == 0 ? 0 : end - 1);
+  if (at == std::string::npos || at < start) return text;
+  const std::size_t colon = text.find(':', start);
+  const std::size_t user_end = colon != std::string::npos && colon < at ? colon + 1 : start;
+  return text.substr(0, user_end) + "***" + text.substr(at);
 }
 
 }  // namespace avatarmap

@@ -50,8 +50,9 @@ struct live_session::impl {
   std::unique_ptr<capture_pipeline> pipeline;
   int latency_capacity = 1;
 
-  // Images: `incoming` is the pushing thread's own; `waiting` is handed over under `m`;
-  // `work` is the worker's own.
+  // Images: `incoming` is the pushing thread's own (under `push_m`: pushes from several
+  // threads are serialised); `waiting` is handed over under `m`; `work` is the worker's own.
+  std::mutex push_m;
   image_copy incoming, waiting, work;
   std::mutex m;
   std::condition_variable cv;
@@ -138,6 +139,7 @@ status live_session::push(const image_view& image, double t) {
   if (!std::isfinite(t)) return status::error("live_session::push: t must be finite");
   if (status st = check_image(image); !st.ok()) return st;
   impl& s = *impl_;
+  std::lock_guard<std::mutex> push_lock(s.push_m);
   s.incoming.copy_from(image, t);
   {
     std::lock_guard<std::mutex> lock(s.m);

@@ -348,6 +348,29 @@ struct video_source::impl {
     return static_cast<impl*>(opaque)->should_stop() ? 1 : 0;
   }
 
+  // Every nested open of a network input (an HLS playlist's segments and keys, a DASH
+  // manifest's parts) passes here before FFmpeg's own whitelist refuses a local protocol:
+  // the refusal is remembered so that the message says what happened, rather than "not a
+  // stream FFmpeg can read".
+  int (*default_io_open)(AVFormatContext*, AVIOContext**, const char*, int,
+                         AVDictionary**) = nullptr;
+  std::string refused_protocol;  // the local protocol a stream asked for ("file"), if any
+  static int checked_io_open(AVFormatContext* s, AVIOContext** pb, const char* url, int flags,
+                             AVDictionary** options) {
+    impl* self = static_cast<impl*>(s->opaque);
+    if (self->live && url != nullptr) {
+      const char* proto = avio_find_protocol_name(url);
+      const std::string name = proto ? proto : "";
+      bool network = false;
+      for (const char* p : k_network_protocols) network = network || name == p;
+      if (!network) {
+        if (self->refused_protocol.empty()) self->refused_protocol = name.empty() ? "?" : name;
+        return AVERROR(EPERM);
+      }
+    }
+    return self->default_io_open(s, pb, url, flags, options);
+  }
+
   // Opens `url` with the demuxer `format` (nullptr: probed) and the options `opts` (freed
   // here) into `fmt`, with the interrupt callback; returns 0 or FFmpeg's error code.
   int open_input(const std::string& url, const AVInputFormat* format, AVDictionary*& opts,
@@ -360,6 +383,10 @@ struct video_source::impl {
     }
     fmt->interrupt_callback.callback = &impl::interrupt_callback;
     fmt->interrupt_callback.opaque = this;
+    fmt->opaque = this;
+    default_io_open = fmt->io_open;
+    refused_protocol.clear();
+    if (default_io_open) fmt->io_open = &impl::checked_io_open;
     if (nonblock) fmt->flags |= AVFMT_FLAG_NONBLOCK;
     const int err = avformat_open_input(&fmt, url.c_str(), format, &opts);
     av_dict_free(&opts);
@@ -496,6 +523,10 @@ struct video_source::impl {
             "port";
       else if (err == AVERROR(ECONNREFUSED))
         m += ": no server at this address and port; check the URL and that the server runs";
+      else if (!refused_protocol.empty())
+        m = path + ": the stream refers to something to read through '" + refused_protocol +
+            "' (a local file or pipe), which avatarmap refuses for network inputs: a stream may "
+            "only lead to other network addresses (docs/security.md)";
       else if (err == AVERROR_INVALIDDATA)
         m += ": what came is not a stream FFmpeg can read";
       else
@@ -824,17 +855,19 @@ status video_source::open(const std::string& path, const video_source_options& o
   if (status st = check_options(options); !st) return st;
   std::error_code ec;
   const input_spec spec = classify_input(path, fs::exists(path, ec));
+  // Messages name the input without a URL's credentials.
+  const std::string shown = spec.kind == input_kind::url ? shown_input(path) : path;
   if (spec.kind != input_kind::device &&
       (!options.video_size.empty() || options.framerate > 0 || !options.input_format.empty()))
-    return status::error(path +
+    return status::error(shown +
                          ": a video size, frame rate or input format is for devices "
                          "(FORMAT:DEVICE, e.g. v4l2:/dev/video0), not for files or URLs");
   auto p = std::make_unique<impl>();
   p->options = options;
-  p->path = path;
+  p->path = shown;
   p->packet = av_packet_alloc();
   p->frame = av_frame_alloc();
-  if (!p->packet || !p->frame) return status::error(path + ": out of memory");
+  if (!p->packet || !p->frame) return status::error(shown + ": out of memory");
 
   if (spec.kind == input_kind::device || spec.kind == input_kind::url) {
     p->live = true;
@@ -850,12 +883,12 @@ status video_source::open(const std::string& path, const video_source_options& o
   if (fs::is_directory(file, ec)) {
     p->files = folder_images(file);
     if (p->files.empty())
-      return status::error(path +
+      return status::error(shown +
                            ": the folder has no image files (jpg, png, bmp, tif, webp, "
                            "ppm)");
   } else if (fs::exists(file, ec)) {
-    if (!fs::is_regular_file(file, ec)) return status::error(path + ": not a regular file");
-    if (fs::file_size(file, ec) == 0) return status::error(path + ": empty file");
+    if (!fs::is_regular_file(file, ec)) return status::error(shown + ": not a regular file");
+    if (fs::file_size(file, ec) == 0) return status::error(shown + ": empty file");
     if (status st = p->open_file(file, p->info); !st) return st;
     p->open = true;
     impl_ = std::move(p);
@@ -863,12 +896,12 @@ status video_source::open(const std::string& path, const video_source_options& o
   } else {
     std::string prefix, suffix;
     int width = 0;
-    if (spec.kind != input_kind::pattern) return status::error(path + ": no such file or folder");
+    if (spec.kind != input_kind::pattern) return status::error(shown + ": no such file or folder");
     if (!parse_frame_pattern(file, prefix, suffix, width))
-      return status::error(path + ": not a file, and not a pattern with one %d or %0Nd");
+      return status::error(shown + ": not a file, and not a pattern with one %d or %0Nd");
     p->files = pattern_images(prefix, suffix, width);
     if (p->files.empty())
-      return status::error(path + ": no file matches the pattern (looked for numbers 0..4: " +
+      return status::error(shown + ": no file matches the pattern (looked for numbers 0..4: " +
                            pattern_name(prefix, suffix, width, 0) + ", ...)");
   }
 

@@ -85,9 +85,9 @@ bool parse_estimator_options(args& a, bool hands_face_default, estimator_options
   a.value("--precision", precision);
   a.value("--hand-model", hand_model);
   a.value("--models", o.source);
-  double threads = 2, lanes = 2;
-  a.number("--threads", threads);
-  a.number("--lanes", lanes);
+  int threads = 2, lanes = 2;
+  a.integer("--threads", threads, 1, 64);
+  a.integer("--lanes", lanes, 1, 2);
   o.static_images = a.flag("--static");
   o.mirrored_input = a.flag("--mirrored");
   o.spin = a.flag("--spin");
@@ -112,16 +112,12 @@ bool parse_estimator_options(args& a, bool hands_face_default, estimator_options
     return false;
   }
   o.precision = precision == "int8" ? model_precision::int8 : model_precision::float32;
-  if (!(threads >= 1 && threads <= 64)) {
-    error = "--threads must be 1..64";
+  if (!a.error().empty()) {
+    error = a.error();
     return false;
   }
-  o.threads = static_cast<int>(threads);
-  if (lanes != 1 && lanes != 2) {
-    error = "--lanes is 1 or 2";
-    return false;
-  }
-  o.lanes = static_cast<int>(lanes);
+  o.threads = threads;
+  o.lanes = lanes;
   return true;
 }
 

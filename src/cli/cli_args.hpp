@@ -65,6 +65,31 @@ class args {
     return true;
   }
 
+  /// Like value() but parses a whole number written in decimal (an optional '-', then digits:
+  /// no "0x50", "8e1", "80.0" or spaces) within [lo, hi]; sets error() naming the option and
+  /// the range when it is not one.
+  bool integer(const std::string& name, long long& out, long long lo, long long hi) {
+    std::string s;
+    if (!value(name, s)) return false;
+    const std::size_t first = !s.empty() && s[0] == '-' ? 1 : 0;
+    bool digits = s.size() > first && s.size() - first <= 18;
+    for (std::size_t i = first; digits && i < s.size(); ++i) digits = s[i] >= '0' && s[i] <= '9';
+    const long long v = digits ? std::strtoll(s.c_str(), nullptr, 10) : 0;
+    if (!digits || v < lo || v > hi) {
+      error_ = "option " + name + " needs a whole number in " + std::to_string(lo) + ".." +
+               std::to_string(hi) + ", got '" + s + "'";
+      return false;
+    }
+    out = v;
+    return true;
+  }
+  bool integer(const std::string& name, int& out, int lo, int hi) {
+    long long v = 0;
+    if (!integer(name, v, lo, hi)) return false;
+    out = static_cast<int>(v);
+    return true;
+  }
+
   /// What is left after the options were taken; unknown "-x" options are reported by
   /// check_no_options().
   const std::vector<std::string>& rest() const { return items_; }

@@ -11,6 +11,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <mutex>
 #include <string>
@@ -167,6 +168,10 @@ int run_live_command(int argc, char** argv) {
   double stream_t = 0.0;                 // capture time of the newest pose
   clock_type::time_point stream_wall{};  // when it was pushed
   std::atomic<bool> done{false};
+  // The output thread waits for its next period on this, so a stop is seen at once whatever
+  // --fps is (a plain sleep of one period made `--fps 0.05 --seconds 2` last 20 s).
+  std::mutex stop_m;
+  std::condition_variable stop_cv;
   long written = 0;
   status write_status;
   std::thread output([&] {
@@ -177,7 +182,10 @@ int run_live_command(int argc, char** argv) {
     double last_t = -INFINITY;  // output times always increase (processing time varies)
     while (!done.load()) {
       next += period;
-      std::this_thread::sleep_until(next);
+      {
+        std::unique_lock<std::mutex> lock(stop_m);
+        if (stop_cv.wait_until(lock, next, [&] { return done.load(); })) break;
+      }
       {
         std::lock_guard<std::mutex> lock(m);
         if (!have_pose) continue;
@@ -241,7 +249,11 @@ int run_live_command(int argc, char** argv) {
                   return true;
                 },
                 lo, stats);
-  done.store(true);
+  {
+    std::lock_guard<std::mutex> lock(stop_m);
+    done.store(true);
+  }
+  stop_cv.notify_all();
   output.join();
   if (!source.end_reason().empty())  // a device or stream that stalled or ended
     std::fprintf(stderr, "%slive: %s\n", progress ? "\n" : "", source.end_reason().c_str());

@@ -94,13 +94,7 @@ int run_solve(int argc, char** argv) {
   const bool fps_given = a.number("--fps", num);
   if (fps_given) job.output_fps = num;
   if (a.number("--fov", num)) job.options.horizontal_fov_degrees = static_cast<float>(num);
-  if (a.number("--threads", num)) {
-    if (num != 1.0 && num != 2.0) {
-      std::fprintf(stderr, "avatarmap solve: --threads is 1 or 2\n");
-      return 2;
-    }
-    job.threads = static_cast<int>(num);
-  }
+  a.integer("--threads", job.threads, 1, 2);
   if (a.value("--parts", value)) {
     solve_parts p{false, false, false, false};
     size_t start = 0;

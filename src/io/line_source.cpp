@@ -1,5 +1,6 @@
 #include "io/line_source.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -18,6 +19,7 @@ bool line_source::open_file(const std::string& path, std::string& out_error) {
   const line_source_limits& lim = default_line_source_limits();
   block_size_ = lim.block_size > 0 ? lim.block_size : 1;
   max_line_ = lim.max_line;
+  max_skipped_ = std::max(lim.max_skipped_line, lim.max_line * 16);
   if (path == "-") {
     file_ = stdin;
     owns_file_ = false;
@@ -39,6 +41,7 @@ void line_source::open_stream(std::FILE* file, bool owns) {
   const line_source_limits& lim = default_line_source_limits();
   block_size_ = lim.block_size > 0 ? lim.block_size : 1;
   max_line_ = lim.max_line;
+  max_skipped_ = std::max(lim.max_skipped_line, lim.max_line * 16);
   file_ = file;
   owns_file_ = owns;
   buf_.resize(block_size_);
@@ -100,7 +103,37 @@ line_status line_source::next(std::string_view& out_line, std::string& out_error
   }
 
   if (!file_) return line_status::end;
-  bool too_long = false;
+  if (skipping_) {
+    // The rest of a line already reported as over the cap is dropped up to its line end, but
+    // not forever: past max_skipped_ bytes (an endless line: /dev/zero, a stream with no line
+    // end) the input is given up with a last error, so that a caller that goes on after
+    // errors (--skip-bad-lines) still ends.
+    for (;;) {
+      const char* base = buf_.data() + begin_;
+      const std::size_t avail = end_ - begin_;
+      const char* nl = static_cast<const char*>(std::memchr(base, '\n', avail));
+      if (nl) {
+        begin_ += static_cast<std::size_t>(nl - base) + 1;
+        scanned_ = 0;
+        skipping_ = false;
+        break;
+      }
+      skipped_ += avail;
+      begin_ = end_ = scanned_ = 0;
+      if (eof_) {
+        skipping_ = false;
+        return line_status::end;
+      }
+      if (skipped_ > max_skipped_) {
+        skipping_ = false;
+        eof_ = true;  // given up: the next call ends
+        out_error = "line without an end after " + std::to_string(skipped_) +
+                    " bytes: the rest of the input is not read";
+        return line_status::error;
+      }
+      if (!fill(out_error)) return line_status::error;
+    }
+  }
   for (;;) {
     const char* base = buf_.data() + begin_;
     std::size_t avail = end_ - begin_;
@@ -108,12 +141,12 @@ line_status line_source::next(std::string_view& out_line, std::string& out_error
         scanned_ < avail
             ? static_cast<const char*>(std::memchr(base + scanned_, '\n', avail - scanned_))
             : nullptr;
-    if (nl || (eof_ && avail > 0) || (too_long && eof_)) {
+    if (nl || (eof_ && avail > 0)) {
       std::size_t len = nl ? static_cast<std::size_t>(nl - base) : avail;
       begin_ += nl ? len + 1 : len;
       scanned_ = 0;
       ++line_;
-      if (too_long || len > max_line_) {
+      if (len > max_line_) {
         first_ = false;
         out_error = "line longer than " + std::to_string(max_line_) + " bytes (the limit)";
         return line_status::error;
@@ -132,11 +165,15 @@ line_status line_source::next(std::string_view& out_line, std::string& out_error
     if (eof_) return line_status::end;
     scanned_ = avail;
     if (avail > max_line_) {
-      // Drop what we have of this line and keep reading until its end; memory stays bounded.
-      too_long = true;
+      // Reported now, while reading, not when the line ends (it may never end); the rest of
+      // the line is dropped by the next call. Memory stays bounded by the cap.
+      ++line_;
       first_ = false;
-      begin_ = end_ = 0;
-      scanned_ = 0;
+      skipping_ = true;
+      skipped_ = avail;
+      begin_ = end_ = scanned_ = 0;
+      out_error = "line longer than " + std::to_string(max_line_) + " bytes (the limit)";
+      return line_status::error;
     }
     if (!fill(out_error)) {
       ++line_;

@@ -1,8 +1,11 @@
 // Internal: reads a text file (or standard input, or a memory buffer) one line at a time in
 // constant memory. The file is read in blocks (1 MiB by default); a line that does not fit
-// in a block grows the buffer, up to a cap (64 MiB by default), beyond which the line is
-// reported as an error and skipped. Line ends are "\n" or "\r\n"; a last line without a
-// line end is still a line. A UTF-8 byte-order mark at the start is skipped.
+// in a block grows the buffer, up to a cap (64 MiB by default). A line over the cap is
+// reported as an error as soon as the cap is passed (not when the line ends, which an endless
+// input never reaches); a call after it drops the rest of that line, but gives up the input
+// with a last error once the line has passed 1 GiB (or 16 caps, if more) without an end, so
+// that no call reads without bound. Line ends are "\n" or "\r\n"; a last line without a line
+// end is still a line. A UTF-8 byte-order mark at the start is skipped.
 #pragma once
 
 #include <cstddef>
@@ -15,12 +18,16 @@ namespace avatarmap::io_detail {
 
 inline constexpr std::size_t k_default_block_size = std::size_t{1} << 20;
 inline constexpr std::size_t k_default_max_line = std::size_t{64} << 20;
+/// A line over the cap is dropped up to its end while it stays within this many bytes (and
+/// 16 caps); a longer one gives the input up.
+inline constexpr std::size_t k_default_max_skipped_line = std::size_t{1} << 30;
 
 /// Block size and line cap used by readers opened afterwards. Tests shrink them to exercise
 /// lines that span blocks; not thread-safe, not for production use.
 struct line_source_limits {
   std::size_t block_size = k_default_block_size;
   std::size_t max_line = k_default_max_line;
+  std::size_t max_skipped_line = k_default_max_skipped_line;
 };
 line_source_limits& default_line_source_limits();
 
@@ -53,6 +60,8 @@ class line_source {
   bool owns_file_ = false;
   bool eof_ = false;
   bool first_ = true;
+  bool skipping_ = false;      // the rest of a line over the cap is still to be dropped
+  std::size_t skipped_ = 0;    // bytes of that line seen so far
   const char* mem_ = nullptr;  // memory mode when non-null (or size 0)
   bool memory_mode_ = false;
   std::size_t mem_size_ = 0;
@@ -63,6 +72,7 @@ class line_source {
   std::size_t scanned_ = 0;  // bytes after begin_ already known to hold no '\n'
   std::size_t block_size_ = k_default_block_size;
   std::size_t max_line_ = k_default_max_line;
+  std::size_t max_skipped_ = k_default_max_skipped_line;
   long line_ = 0;
 };
 

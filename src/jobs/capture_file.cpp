@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "avatarmap/io/landmark_file.hpp"
+#include "capture/input_spec.hpp"
 #include "jobs/prefetch_ring.hpp"
 
 namespace avatarmap {
@@ -108,7 +109,7 @@ status capture_file_job::validate() const {
     return status::error("capture_file_job.seconds must be finite and >= 0 (0 = all)");
   if (names_live_input(input)) {
     if (!allow_live_input)
-      return status::error(input +
+      return status::error(shown_input(input) +
                            ": a device or stream; give a video file, an image, a folder of "
                            "images or a pattern (live input: avm_live or `avatarmap live`)");
     if (loops > 1) return status::error("loops is for files, not devices or streams");
@@ -133,9 +134,10 @@ status capture_file_job::run(capture_file_summary& s) const {
   const bool live_input =
       info.kind == video_source_kind::camera || info.kind == video_source_kind::stream;
   if (live_input && !allow_live_input)
-    return fail(job_failure::invalid_argument,
-                status::error(input + ": a device or stream; give a video file, an image, a "
-                                      "folder of images or a pattern"));
+    return fail(
+        job_failure::invalid_argument,
+        status::error(shown_input(input) + ": a device or stream; give a video file, an image, a "
+                                           "folder of images or a pattern"));
   if (live_input && loops > 1)
     return fail(job_failure::invalid_argument,
                 status::error("loops is for files, not devices or streams"));

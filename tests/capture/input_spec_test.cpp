@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 
 namespace avatarmap {
 namespace {
@@ -90,4 +91,17 @@ TEST(input_spec, known_answers) {
 }
 
 }  // namespace
+TEST(InputSpec, ShownInputHidesCredentials) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"rtsp://cam:secret@10.0.0.5:554/live", "rtsp://cam:***@10.0.0.5:554/live"},
+      {"http://token@example.org/a.m3u8", "http://***@example.org/a.m3u8"},
+      {"srt://u:p:q@host:9000?mode=caller", "srt://u:***@host:9000?mode=caller"},
+      {"https://example.org/a@b/c.m3u8", "https://example.org/a@b/c.m3u8"},  // '@' in the path
+      {"udp://127.0.0.1:5000", "udp://127.0.0.1:5000"},
+      {"take@home.mp4", "take@home.mp4"},
+      {"v4l2:/dev/video0", "v4l2:/dev/video0"},
+  };
+  for (const auto& [in, out] : cases) EXPECT_EQ(shown_input(in), out) << in;
+}
+
 }  // namespace avatarmap

@@ -312,6 +312,51 @@ TEST(VideoSourceLive, UnknownAndLocalSchemesAreRefusedWithTheList) {
   }
 }
 
+// A playlist from the network that names a local file: refused (the protocol whitelist), and
+// the message says so instead of "not a stream FFmpeg can read".
+TEST(VideoSourceLive, AStreamThatNamesALocalFileIsRefusedAndSaysSo) {
+  SKIP_WITHOUT_SCHEME("http");
+  const quiet_log quiet;
+  test::temp_dir dir("vsl_hls");
+  const std::string local = dir.file("secret.ts");
+  test::write_text(local, "not to be read");
+  // (A bare path is relative to the playlist's URL: another HTTP request, not a local file.)
+  for (const std::string& segment : std::vector<std::string>{"file:" + local, "file://" + local}) {
+    SCOPED_TRACE(segment);
+    const std::string playlist =
+        "#EXTM3U\n#EXT-X-VERSION:3\n#EXT-X-TARGETDURATION:1\n"
+        "#EXTINF:1.0,\n" +
+        segment + "\n#EXT-X-ENDLIST\n";
+    tcp_sender server(
+        "HTTP/1.0 200 OK\r\nContent-Type: application/vnd.apple.mpegurl\r\n"
+        "Content-Length: " +
+            std::to_string(playlist.size()) + "\r\n\r\n" + playlist,
+        false);
+    ASSERT_GT(server.port(), 0);
+    video_source src;
+    video_source_options o;
+    o.open_timeout_seconds = 5;
+    const std::string url = "http://127.0.0.1:" + std::to_string(server.port()) + "/x.m3u8";
+    const status st = src.open(url, o);
+    ASSERT_FALSE(st.ok());
+    EXPECT_TRUE(contains(st.message(), "refuses for network inputs")) << st.message();
+    EXPECT_FALSE(contains(st.message(), "not a stream FFmpeg can read")) << st.message();
+  }
+}
+
+// Credentials in a URL never reach a message.
+TEST(VideoSourceLive, MessagesHideAUrlsCredentials) {
+  SKIP_WITHOUT_SCHEME("rtsp");
+  const quiet_log quiet;
+  video_source src;
+  const int port = free_port(SOCK_STREAM);
+  ASSERT_GT(port, 0);
+  const status st = src.open("rtsp://cam:s3cret@127.0.0.1:" + std::to_string(port) + "/x");
+  ASSERT_FALSE(st.ok());
+  EXPECT_FALSE(contains(st.message(), "s3cret")) << st.message();
+  EXPECT_TRUE(contains(st.message(), "rtsp://cam:***@127.0.0.1:")) << st.message();
+}
+
 TEST(VideoSourceLive, UnreachableStreamsSayWhy) {
   SKIP_WITHOUT_SCHEME("rtsp");
   const quiet_log quiet;

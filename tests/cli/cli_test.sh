@@ -207,7 +207,9 @@ case $case_name in
     run 2 capture in.mp4 -o out.landmarks.jsonl --precision fp16
     expect_in err.txt "--precision is float or int8"
     run 2 capture in.mp4 -o out.landmarks.jsonl --lanes 3
-    expect_in err.txt "--lanes is 1 or 2"
+    expect_in err.txt "option --lanes needs a whole number in 1..2, got '3'"
+    run 2 capture in.mp4 -o out.landmarks.jsonl --threads 0x4
+    expect_in err.txt "option --threads needs a whole number in 1..64"
     run 2 capture in.mp4 -o out.landmarks.jsonl --loop 0
     run 1 capture missing.mp4 -o out.landmarks.jsonl
     expect_in err.txt "missing.mp4"

@@ -5,6 +5,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <random>
@@ -233,6 +234,52 @@ TEST(line_source, memory_and_stream_apply_the_same_line_cap) {
     EXPECT_EQ(src.line_number(), 3);
     EXPECT_EQ(src.next(line, err), line_status::end);
   }
+  default_line_source_limits() = saved;
+}
+
+// An input that never ends a line (/dev/zero, `solve - < /dev/zero`): the cap is reported
+// while reading, after about a cap's worth of bytes, not when the line ends; a caller that goes
+// on gets the rest of a long line dropped up to its end, and an endless one given up after
+// max_skipped_line bytes (16 caps here), with a last error and then the end.
+struct endless_input {
+  std::size_t served = 0;
+  std::size_t newline_at = static_cast<std::size_t>(-1);  // byte offset of one '\n'
+};
+ssize_t endless_read(void* cookie, char* buf, std::size_t size) {
+  auto* in = static_cast<endless_input*>(cookie);
+  for (std::size_t i = 0; i < size; ++i) buf[i] = in->served + i == in->newline_at ? '\n' : 'x';
+  in->served += size;
+  return static_cast<ssize_t>(size);
+}
+
+TEST(line_source, an_endless_line_is_reported_after_the_cap_not_at_its_end) {
+  line_source_limits saved = default_line_source_limits();
+  default_line_source_limits() = {4096, 100000, 1600000};
+  const std::size_t slack = 3 * 4096;
+  endless_input in;
+  in.newline_at = 350000;  // the first line ends here (3.5 caps); the second never does
+  cookie_io_functions_t io{endless_read, nullptr, nullptr, nullptr};
+  line_source src;
+  src.open_stream(fopencookie(&in, "rb", io), true);
+  std::string_view line;
+  std::string err;
+  ASSERT_EQ(src.next(line, err), line_status::error);
+  EXPECT_NE(err.find("longer than 100000 bytes"), std::string::npos) << err;
+  EXPECT_EQ(src.line_number(), 1);
+  EXPECT_LE(in.served, 100000u + slack);
+  // Going on: the rest of line 1 is dropped, then line 2 is over the cap too.
+  ASSERT_EQ(src.next(line, err), line_status::error);
+  EXPECT_NE(err.find("longer than 100000 bytes"), std::string::npos) << err;
+  EXPECT_EQ(src.line_number(), 2);
+  EXPECT_LE(in.served, in.newline_at + 100000u + slack);
+  // Going on again: line 2 has no end; given up after max_skipped_line, then the end.
+  ASSERT_EQ(src.next(line, err), line_status::error);
+  EXPECT_NE(err.find("line without an end after"), std::string::npos) << err;
+  EXPECT_GE(in.served, in.newline_at + 16 * 100000u);
+  EXPECT_LE(in.served, in.newline_at + 16 * 100000u + 100000u + slack);
+  const std::size_t served = in.served;
+  EXPECT_EQ(src.next(line, err), line_status::end);
+  EXPECT_EQ(in.served, served);
   default_line_source_limits() = saved;
 }
 

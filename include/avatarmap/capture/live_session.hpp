@@ -7,9 +7,10 @@
 //
 // Memory: three image buffers (the caller's copy, the waiting one, the worker's), each grown
 // only when a larger image comes; push(), sample() and latest() allocate nothing otherwise.
-// Thread-safety: push() from one thread at a time; sample(), latest(), stats() and
-// last_error() from any threads, concurrently with push(); the destructor stops and joins the
-// worker and must not run concurrently with any other call.
+// Thread-safety: push(), sample(), latest(), stats() and last_error() from any threads,
+// concurrently (pushes from several threads are serialised: each waits for the one in
+// progress); the destructor stops and joins the worker and must not run concurrently with any
+// other call (the C API's avm_live_destroy waits for the calls in flight).
 #pragma once
 
 #include <memory>
@@ -48,9 +49,9 @@ class live_session {
   live_session(const live_session&) = delete;
   live_session& operator=(const live_session&) = delete;
 
-  /// Camera thread: copies `image` (capture time `t`, seconds, increasing) for the worker and
-  /// returns at once. Errors: a bad image (check_image) or a time that is not finite; nothing
-  /// is queued then.
+  /// Camera thread (several are serialised): copies `image` (capture time `t`, seconds,
+  /// increasing) for the worker and returns at once. Errors: a bad image (check_image) or a
+  /// time that is not finite; nothing is queued then.
   status push(const image_view& image, double t);
   /// Any thread: the pose at capture time `t` (slerp between processed frames, a short
   /// extrapolation past the newest, then held). false before the first processed frame.

@@ -685,12 +685,17 @@ AVATARMAP_C_API avm_status avm_live_create(const avm_estimator_options* options,
                                            avm_live** out);
 
 /* Stops the worker (waits for the image in process, if any) and frees the handle. NULL does
- * nothing. No other call on the handle may be in flight or follow. */
+ * nothing. Any thread: calls on the handle already in flight on other threads are waited for,
+ * and a call that starts once destroy has begun fails with AVM_ERROR_INVALID_ARGUMENT (the
+ * handle is looked up, not dereferenced; avm_live_last_error says it was destroyed) — until
+ * a new live handle happens to get the same address, so do not rely on it after destroy has
+ * returned. Destroying twice is a no-op. */
 AVATARMAP_C_API void avm_live_destroy(avm_live* live);
 
 /* Camera thread: copies `image` (capture time t, seconds, increasing) for the worker and
- * returns at once. Allocates only when an image larger than any before arrives. One thread at
- * a time may push; it may run concurrently with the calls below.
+ * returns at once. Allocates only when an image larger than any before arrives. Pushes from
+ * several threads are serialised (each waits for the one in progress); pushes run
+ * concurrently with the calls below.
  * Failures (nothing queued): AVM_ERROR_INVALID_ARGUMENT for the image checks of
  * avm_estimator_process() or t not finite. */
 AVATARMAP_C_API avm_status avm_live_push(avm_live* live, const avm_image* image, double t);
@@ -708,7 +713,7 @@ AVATARMAP_C_API avm_status avm_live_sample(const avm_live* live, double t, avm_p
 AVATARMAP_C_API avm_status avm_live_latest(const avm_live* live, avm_pose* out_pose);
 
 /* Any thread: the counters and latency so far. AVM_ERROR_INVALID_ARGUMENT when an argument
- * is NULL. */
+ * is NULL (or the handle was destroyed, as for every avm_live_* call). */
 AVATARMAP_C_API avm_status avm_live_get_stats(const avm_live* live, avm_live_stats* out_stats);
 
 /* Any thread: the message of the last image the worker failed on, else of the last failed
