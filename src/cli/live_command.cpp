@@ -107,17 +107,17 @@ int run_live_command(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap live: --fps must be in (0, 1000], --seconds >= 0\n");
     return 2;
   }
-  pose_server_options serve_options = default_viewer_options("live");
+  pose_server_options serve_options = default_viewer_options("live", "--serve");
   if (!serve.empty() && !parse_host_port(serve, serve_options.host, serve_options.port, error)) {
     std::fprintf(stderr, "avatarmap live: --serve: %s\n", error.c_str());
     return 2;
   }
   // The viewer's server first: a port in use is reported before the models load.
-  pose_server server;         // its own thread; publish() never waits for a page
-  builtin_avatar_file shown;  // the page shows the built-in avatar
+  pose_server server;  // its own thread; publish() never waits for a page
   if (!serve.empty()) {
     if (quiet) serve_options.on_event = nullptr;
-    if (shown.write().ok()) serve_options.avatar_path = shown.path;
+    if (status avatar_status = use_builtin_avatar(serve_options); !avatar_status)  // from memory
+      std::fprintf(stderr, "live: the built-in avatar: %s\n", avatar_status.message().c_str());
     const status serve_status = server.start(serve_options);
     if (!serve_status.ok()) {
       std::fprintf(stderr, "avatarmap live: %s\n", serve_status.message().c_str());
@@ -125,6 +125,7 @@ int run_live_command(int argc, char** argv) {
     }
     std::fprintf(stderr, "live: viewer at %s (poses on %s)\n", server.url().c_str(),
                  k_pose_socket_path);
+    print_exposure("live", server);
   }
   if (const int rc = vmc.open()) return rc;
   video_source source;

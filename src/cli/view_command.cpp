@@ -32,7 +32,8 @@ const char* k_view_help =
     "\n"
     "Serves the browser viewer: a page (three.js + three-vrm) that shows AVATAR.vrm posed by\n"
     "proxy poses sent over a WebSocket. Prints the page's URL on standard output; open it in a\n"
-    "browser. Runs until Ctrl-C (or --seconds).\n"
+    "browser (with --host 0.0.0.0 it is this machine's loopback URL; the addresses other\n"
+    "machines use follow on standard error). Runs until Ctrl-C (or --seconds).\n"
     "  FILE.pose.jsonl   played in a loop at its own time stamps, streamed to every page as\n"
     "                    `avatarmap live --serve` streams live poses\n"
     "  FILE.vrma         played in a loop by the page (three-vrm-animation)\n"
@@ -43,12 +44,17 @@ const char* k_view_help =
     "                        as `avatarmap avatar` writes it)\n"
     "  --port P              port to serve on (default 8080; 0 picks a free one)\n"
     "  --host H              address to listen on (default 127.0.0.1: this machine only;\n"
-    "                        0.0.0.0 shows the page, avatar and poses to the network)\n"
+    "                        0.0.0.0 shows the page, avatar and poses to the network, with a\n"
+    "                        warning; requests must then name this machine: a loopback\n"
+    "                        name, one of its addresses or its host name)\n"
+    "  --allow-host N[,N...] further names (or addresses) requests may give as their Host\n"
+    "                        beyond loopback, e.g. the machine's DNS name\n"
     "  --connect [HOST:]PORT the page takes its poses from `avatarmap live --serve PORT`\n"
     "                        (host default 127.0.0.1)\n"
     "  --open                open the page in the desktop's browser (xdg-open)\n"
     "  --seconds S           stop after S seconds\n"
-    "  --quiet               no lines about pages connecting and leaving\n"
+    "  --quiet               no lines about pages connecting, leaving or refused (the\n"
+    "                        warning about --host beyond loopback stays)\n"
     "\n"
     "The page's modules come from scripts/fetch_viewer_modules.sh (run by scripts/setup.sh);\n"
     "AVATARMAP_VIEWER_MODULES and AVATARMAP_VIEWER_PAGE override where they are looked for.\n";
@@ -74,12 +80,14 @@ int run_view(int argc, char** argv) {
     std::fputs(k_view_help, stdout);
     return 0;
   }
-  std::string avatar, host = "127.0.0.1", connect;
-  double port = 8080, seconds = 0;
+  std::string avatar, host = "127.0.0.1", connect, allow_hosts;
+  int port = 8080;
+  double seconds = 0;
   a.value("--avatar", avatar);
   a.value("--host", host);
-  a.number("--port", port);
+  a.integer("--port", port, 0, 65535);
   a.value("--connect", connect);
+  a.value("--allow-host", allow_hosts);
   a.number("--seconds", seconds);
   const bool open = a.flag("--open");
   const bool quiet = a.flag("--quiet");
@@ -88,8 +96,8 @@ int run_view(int argc, char** argv) {
                  !a.error().empty() ? a.error().c_str() : "give at most one FILE (see --help)");
     return 2;
   }
-  if (!(port >= 0 && port <= 65535 && port == static_cast<int>(port)) || !(seconds >= 0)) {
-    std::fprintf(stderr, "avatarmap view: --port must be an integer in 0..65535, --seconds >= 0\n");
+  if (!(seconds >= 0)) {
+    std::fprintf(stderr, "avatarmap view: --seconds must be >= 0\n");
     return 2;
   }
   const std::string file = a.rest().empty() ? std::string() : a.rest()[0];
@@ -102,10 +110,16 @@ int run_view(int argc, char** argv) {
                  file.c_str());
     return 2;
   }
-  pose_server_options o = default_viewer_options("view");
+  pose_server_options o = default_viewer_options("view", "--port");
   if (quiet) o.on_event = nullptr;
   o.host = host;
-  o.port = static_cast<int>(port);
+  o.port = port;
+  for (std::size_t start = 0; start < allow_hosts.size();) {
+    std::size_t end = allow_hosts.find(',', start);
+    if (end == std::string::npos) end = allow_hosts.size();
+    if (end > start) o.allowed_hosts.push_back(allow_hosts.substr(start, end - start));
+    start = end + 1;
+  }
   if (!connect.empty()) {
     if (pose_file) {
       std::fprintf(stderr,
@@ -125,34 +139,32 @@ int run_view(int argc, char** argv) {
                         std::to_string(live_port) + k_pose_socket_path;
   }
 
-  // Without --avatar: the built-in avatar (`avatarmap avatar`), written to a temporary file that
-  // is removed when the viewer stops.
-  builtin_avatar_file builtin;
-  if (avatar.empty()) {
-    if (status st = builtin.write(); !st) {
+  // Without --avatar: the built-in avatar (`avatarmap avatar`), served from memory (no file).
+  // A given avatar and the clip are checked by the project's own readers (docs/security.md)
+  // before a browser is given them.
+  const bool builtin = avatar.empty();
+  if (builtin) {
+    if (status st = use_builtin_avatar(o); !st) {
       std::fprintf(stderr,
                    "avatarmap view: the built-in avatar: %s (--avatar FILE.vrm shows another)\n",
                    st.message().c_str());
       return 1;
     }
-    avatar = builtin.path;
+  } else {
+    raw_rig rig;
+    if (status st = load_avatar(avatar, rig); !st) {
+      std::fprintf(stderr, "avatarmap view: %s\n", st.message().c_str());
+      return 1;
+    }
+    if (rig.source != rig_source::vrm0 && rig.source != rig_source::vrm1) {
+      std::fprintf(stderr,
+                   "avatarmap view: %s is not a VRM avatar (no VRM humanoid): the viewer shows "
+                   "VRM 0.x and 1.0 models (.vrm)\n",
+                   avatar.c_str());
+      return 1;
+    }
+    o.avatar_path = avatar;
   }
-
-  // The avatar and the clip are checked by the project's own readers (docs/security.md) before
-  // a browser is given them.
-  raw_rig rig;
-  if (status st = load_avatar(avatar, rig); !st) {
-    std::fprintf(stderr, "avatarmap view: %s\n", st.message().c_str());
-    return 1;
-  }
-  if (rig.source != rig_source::vrm0 && rig.source != rig_source::vrm1) {
-    std::fprintf(stderr,
-                 "avatarmap view: %s is not a VRM avatar (no VRM humanoid): the viewer shows VRM "
-                 "0.x and 1.0 models (.vrm)\n",
-                 avatar.c_str());
-    return 1;
-  }
-  o.avatar_path = avatar;
   pose_file_player player;
   if (pose_file) {
     if (status st = player.open(file); !st) {
@@ -175,9 +187,9 @@ int run_view(int argc, char** argv) {
   }
   std::printf("%s\n", server.url().c_str());
   std::fflush(stdout);
+  print_exposure("view", server);
   if (!quiet) {
-    std::fprintf(stderr, "view: showing %s",
-                 builtin.path.empty() ? avatar.c_str() : "the built-in avatar");
+    std::fprintf(stderr, "view: showing %s", builtin ? "the built-in avatar" : avatar.c_str());
     if (pose_file)
       std::fprintf(stderr, ", playing %s (%ld poses, %.1f s) in a loop", file.c_str(),
                    player.frames(), player.duration());
@@ -213,6 +225,8 @@ int run_view(int argc, char** argv) {
   if (!quiet) {
     std::fprintf(stderr, "view: %ld page connections, %ld poses sent", stats.connections,
                  stats.sent);
+    if (stats.refused > 0)
+      std::fprintf(stderr, ", %ld requests refused for their Host or Origin", stats.refused);
     if (stats.first_posed_frame_ms >= 0)
       std::fprintf(stderr, "; the last page drew its first posed frame %.0f ms after loading",
                    stats.first_posed_frame_ms);

@@ -2,11 +2,11 @@
 #include "cli/viewer_setup.hpp"
 
 #include <sys/stat.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
+#include <string>
+#include <vector>
 
 #include "avatarmap/avatar/builtin_avatar.hpp"
 
@@ -41,10 +41,11 @@ std::string modules_folder() {
 
 }  // namespace
 
-pose_server_options default_viewer_options(const char* command) {
+pose_server_options default_viewer_options(const char* command, const char* port_option) {
   pose_server_options o;
   o.page_dir = page_folder();
   o.modules_dir = modules_folder();
+  o.port_option = port_option;
   std::string prefix = std::string(command) + ": ";
   o.on_event = [prefix](std::string_view line) {
     std::fprintf(stderr, "%s%.*s\n", prefix.c_str(), static_cast<int>(line.size()), line.data());
@@ -72,18 +73,33 @@ bool parse_host_port(const std::string& text, std::string& out_host, int& out_po
   return true;
 }
 
-status builtin_avatar_file::write() {
-  std::error_code ec;
-  const std::filesystem::path dir = std::filesystem::temp_directory_path(ec);
-  const std::string p = (ec ? std::filesystem::path(".") : dir).string() + "/avatarmap-viewer-" +
-                        std::to_string(static_cast<long>(getpid())) + ".vrm";
-  if (status st = write_builtin_avatar(p); !st) return st;
-  path = p;
+status use_builtin_avatar(pose_server_options& options) {
+  std::string glb;
+  if (status st = builtin_avatar_glb(builtin_avatar_options{}, glb); !st) return st;
+  options.avatar_path.clear();
+  options.avatar_data = std::move(glb);
+  options.avatar_name = "builtin.vrm";
   return {};
 }
 
-builtin_avatar_file::~builtin_avatar_file() {
-  if (!path.empty()) std::remove(path.c_str());
+void print_exposure(const char* command, const pose_server& server) {
+  if (!server.exposed()) return;
+  const std::string address = server.listen_address();
+  const char* every = address.rfind("0.0.0.0:", 0) == 0 ? " (every IPv4 address of this machine)"
+                      : address.rfind("[::]:", 0) == 0  ? " (every address of this machine)"
+                                                        : "";
+  const std::vector<std::string> urls = server.network_urls();
+  std::string reach;
+  for (std::size_t i = 0; i < urls.size() && i < 4; ++i) reach += (i ? ", " : "") + urls[i];
+  if (urls.size() > 4) reach += ", ...";
+  if (reach.empty()) reach = "this machine's addresses (none found besides loopback)";
+  std::fprintf(stderr, "%s: listening on %s%s: other machines reach it at %s\n", command,
+               address.c_str(), every, reach.c_str());
+  std::fprintf(stderr,
+               "%s: warning: the page, the avatar and the poses are readable, unencrypted, by "
+               "anyone on the network who can reach port %d; listen on 127.0.0.1 (the default) "
+               "to keep them on this machine\n",
+               command, server.port());
 }
 
 }  // namespace avatarmap::cli

@@ -1,6 +1,7 @@
 // What `avatarmap view` and `avatarmap live --serve` share about the viewer's server
 // (stream/pose_server.hpp, docs/viewer.md): where the page and the modules are, how a
-// [HOST:]PORT option reads, and the server's event lines on standard error.
+// [HOST:]PORT option reads, the built-in avatar, the server's event lines and its exposure
+// warning on standard error.
 #pragma once
 
 #include <string>
@@ -12,20 +13,25 @@ namespace avatarmap::cli {
 
 /// Options with the page folder (AVATARMAP_VIEWER_PAGE, else the source tree's viewer/, else
 /// the installed one), the modules folder (AVATARMAP_VIEWER_MODULES, else the cache that
-/// scripts/fetch_viewer_modules.sh fills) and event lines printed as "COMMAND: LINE".
-pose_server_options default_viewer_options(const char* command);
+/// scripts/fetch_viewer_modules.sh fills), event lines printed as "COMMAND: LINE" and
+/// `port_option` (the option that sets the port: "--port", "--serve") for the port-in-use
+/// message.
+pose_server_options default_viewer_options(const char* command, const char* port_option);
 
 /// Parses "PORT" or "HOST:PORT" ("[V6]:PORT") into out_host (unchanged when absent) and
 /// out_port (0..65535); false with a message otherwise.
 bool parse_host_port(const std::string& text, std::string& out_host, int& out_port,
                      std::string& error);
 
-/// The built-in avatar (`avatarmap avatar`) written to a temporary file for the viewer to serve,
-/// removed when this goes out of scope.
-struct builtin_avatar_file {
-  std::string path;  // empty until write() succeeds
-  status write();
-  ~builtin_avatar_file();
-};
+/// Makes the server show the built-in avatar (`avatarmap avatar`): its bytes in
+/// options.avatar_data, served from memory as /avatar.vrm and named "builtin.vrm" on the page
+/// (no file is written). Fails only when the avatar cannot be made (out of memory).
+status use_builtin_avatar(pose_server_options& options);
+
+/// When `server` listens beyond loopback (pose_server::exposed()): two lines on standard error,
+/// "COMMAND: listening on ADDRESS ...: other machines reach it at URL, ..." and a warning that
+/// the page, the avatar and the poses are readable by anyone on the network who can reach the
+/// port. Nothing otherwise.
+void print_exposure(const char* command, const pose_server& server);
 
 }  // namespace avatarmap::cli

@@ -7,15 +7,18 @@
 #include "avatarmap/stream/pose_server.hpp"
 
 #include <arpa/inet.h>
+#include <ifaddrs.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -65,6 +68,13 @@ bool parse_host(const std::string& host, sockaddr_storage& out, socklen_t& out_l
   return IN6_IS_ADDR_LOOPBACK(&v6->sin6_addr);
 }
 
+// 0.0.0.0 or ::: every address of the machine.
+[[maybe_unused]] bool is_wildcard(const sockaddr_storage& a) {
+  if (a.ss_family == AF_INET)
+    return reinterpret_cast<const sockaddr_in*>(&a)->sin_addr.s_addr == htonl(INADDR_ANY);
+  return IN6_IS_ADDR_UNSPECIFIED(&reinterpret_cast<const sockaddr_in6*>(&a)->sin6_addr);
+}
+
 // The host part of "HOST[:PORT]" or "[V6]:PORT" or a URL "scheme://HOST[:PORT]/...".
 [[maybe_unused]] std::string_view host_part(std::string_view s) {
   if (auto p = s.find("://"); p != std::string_view::npos) s.remove_prefix(p + 3);
@@ -83,9 +93,11 @@ bool parse_host(const std::string& host, sockaddr_storage& out, socklen_t& out_l
 }
 
 // What binding `host`:`port` fails with, checked by binding a socket of our own (lws reports
-// only that it could not); empty when it can be bound.
+// only that it could not); empty when it can be bound. `port_option` is the command-line option
+// that sets the port (named in the advice; empty = none).
 [[maybe_unused]] std::string bind_problem(const sockaddr_storage& addr, socklen_t len,
-                                          const std::string& host, int port) {
+                                          const std::string& host, int port,
+                                          const std::string& port_option) {
   const int fd = ::socket(addr.ss_family, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (fd < 0) return std::string("cannot create a socket: ") + std::strerror(errno);
   const int one = 1;
@@ -100,8 +112,9 @@ bool parse_host(const std::string& host, sockaddr_storage& out, socklen_t& out_l
     const int e = errno;
     const std::string where = host + " port " + std::to_string(port);
     if (e == EADDRINUSE)
-      problem = where + " is in use by another program: choose another port (--port; 0 picks a " +
-                "free one) or stop the program that holds it";
+      problem = where + " is in use by another program: choose another port (" +
+                (port_option.empty() ? std::string() : port_option + "; ") +
+                "port 0 picks a free one) or stop the program that holds it";
     else if (e == EADDRNOTAVAIL)
       problem = host + " is not an address of this machine: use 127.0.0.1 (the default) or one " +
                 "of its own addresses";
@@ -136,6 +149,8 @@ status pose_server_options::validate() const {
                          "AVATARMAP_VIEWER_MODULES to the folder it fills");
   if (!avatar_path.empty() && !is_file(avatar_path))
     return status::error("pose server: avatar '" + avatar_path + "' is not a readable file");
+  if (!avatar_path.empty() && !avatar_data.empty())
+    return status::error("pose server: give the avatar as avatar_path or as avatar_data, not both");
   if (!clip_path.empty() && !is_file(clip_path))
     return status::error("pose server: clip '" + clip_path + "' is not a readable file");
   return {};
@@ -145,19 +160,39 @@ status pose_server_options::validate() const {
 
 namespace {
 
+using clock_type = std::chrono::steady_clock;
+
 // Bytes of one message: a pose line with every bone (confidence is not sent).
 constexpr std::size_t k_message_capacity = io_detail::k_pose_line_max;
 // Room write_shortest_float may use past the reserved bytes (pose_text.hpp).
 constexpr std::size_t k_message_slack = io_detail::k_shortest_float_room + 32;
 // A page's messages (its report) are small; longer ones are ignored.
 constexpr std::size_t k_rx_max = 256;
+// Bytes of a body served from memory (the config, the built-in avatar) written per callback.
+constexpr std::size_t k_body_chunk = 16384;
+// Refusals (foreign Host or Origin) logged one by one; after them, one summary line per
+// k_refusal_summary_every at most, so that a page that retries in a loop cannot flood the log.
+constexpr int k_refusals_logged = 5;
+constexpr auto k_refusal_summary_every = std::chrono::seconds(10);
+// How often the machine's addresses and name are read again when a Host matches none of them
+// (a new DHCP lease, a VPN coming up).
+constexpr auto k_machine_refresh_every = std::chrono::seconds(5);
+
+// Headers every served file carries: no MIME sniffing, no framing by other sites, no referrer.
+constexpr std::array<std::array<const char*, 2>, 3> k_file_headers = {{
+    {"x-content-type-options:", "nosniff"},
+    {"x-frame-options:", "deny"},
+    {"referrer-policy:", "no-referrer"},
+}};
 
 struct http_session {
-  bool config_pending;  // /config.json: headers sent, body to write when writeable
+  const std::string* body;  // a body served from memory, written when writeable; or null
+  std::size_t body_sent;
 };
 
 struct ws_session {
   std::uint64_t sent_seq;  // the newest pose this connection has been handed (0 = none)
+  bool established;        // accepted (counted in open); lws zeroes the session
   std::size_t rx_len;
   bool rx_overflow;
   char rx[k_rx_max];
@@ -184,13 +219,126 @@ void lws_log_sink(int level, const char* line) {
     g_last_log.pop_back();
 }
 
+// A header's text for the log: printable ASCII, at most 80 characters.
+std::string printable(std::string_view s) {
+  std::string r;
+  for (char c : s.substr(0, 80)) r += c >= 0x20 && c < 0x7f ? c : '?';
+  if (s.size() > 80) r += "...";
+  return r;
+}
+
+std::string lower(std::string_view s) {
+  std::string r(s);
+  for (char& c : r) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return r;
+}
+
+// An IP address as bytes: 4 (IPv4) or 16 (IPv6); an IPv4-mapped IPv6 address is its IPv4.
+struct ip_address {
+  int family = 0;
+  std::array<unsigned char, 16> bytes{};
+  bool operator==(const ip_address& o) const { return family == o.family && bytes == o.bytes; }
+  bool loopback() const {
+    if (family == AF_INET) return bytes[0] == 127;
+    static constexpr std::array<unsigned char, 16> v6_loopback = {0, 0, 0, 0, 0, 0, 0, 0,
+                                                                  0, 0, 0, 0, 0, 0, 0, 1};
+    return bytes == v6_loopback;
+  }
+};
+
+ip_address ip_of(const sockaddr* a) {
+  ip_address r;
+  if (a->sa_family == AF_INET) {
+    r.family = AF_INET;
+    std::memcpy(r.bytes.data(), &reinterpret_cast<const sockaddr_in*>(a)->sin_addr, 4);
+  } else if (a->sa_family == AF_INET6) {
+    const in6_addr& v6 = reinterpret_cast<const sockaddr_in6*>(a)->sin6_addr;
+    if (IN6_IS_ADDR_V4MAPPED(&v6)) {
+      r.family = AF_INET;
+      std::memcpy(r.bytes.data(), v6.s6_addr + 12, 4);
+    } else {
+      r.family = AF_INET6;
+      std::memcpy(r.bytes.data(), v6.s6_addr, 16);
+    }
+  }
+  return r;
+}
+
+// The address a Host header's host part names ("1.2.3.4", "[v6]", "[fe80::1%25eth0]"); false
+// for a name.
+bool parse_ip(std::string_view host, ip_address& out) {
+  std::string h(host);
+  if (h.size() >= 2 && h.front() == '[' && h.back() == ']') h = h.substr(1, h.size() - 2);
+  if (const auto zone = h.find('%'); zone != std::string::npos) h.resize(zone);
+  sockaddr_storage a{};
+  socklen_t len = 0;
+  if (h == "localhost" || !parse_host(h, a, len)) return false;
+  out = ip_of(reinterpret_cast<const sockaddr*>(&a));
+  return true;
+}
+
+// The text of an address, IPv6 in brackets, for a URL.
+std::string url_host(const ip_address& a) {
+  char text[INET6_ADDRSTRLEN] = {};
+  inet_ntop(a.family, a.bytes.data(), text, sizeof text);
+  return a.family == AF_INET6 ? "[" + std::string(text) + "]" : std::string(text);
+}
+
+// What a Host header may name when the server listens beyond loopback: the addresses of the
+// machine's interfaces, its host name (and NAME.local, its mDNS name), the names given in
+// options.allowed_hosts.
+struct machine_names {
+  std::vector<ip_address> addresses;
+  std::vector<std::string> names;  // lower case, without a trailing dot
+
+  void read(const std::vector<std::string>& allowed) {
+    addresses.clear();
+    names.clear();
+    ifaddrs* list = nullptr;
+    if (::getifaddrs(&list) == 0) {
+      for (const ifaddrs* i = list; i; i = i->ifa_next)
+        if (i->ifa_addr &&
+            (i->ifa_addr->sa_family == AF_INET || i->ifa_addr->sa_family == AF_INET6))
+          addresses.push_back(ip_of(i->ifa_addr));
+      ::freeifaddrs(list);
+    }
+    char name[256] = {};
+    if (::gethostname(name, sizeof name - 1) == 0 && name[0]) {
+      add_name(name);
+      if (!std::strchr(name, '.')) add_name(std::string(name) + ".local");
+    }
+    for (const std::string& a : allowed) {
+      ip_address ip;
+      if (parse_ip(a, ip))
+        addresses.push_back(ip);
+      else
+        add_name(a);
+    }
+  }
+  void add_name(std::string_view n) {
+    std::string l = lower(n);
+    while (!l.empty() && l.back() == '.') l.pop_back();
+    if (!l.empty()) names.push_back(l);
+  }
+  bool has(std::string_view host) const {
+    ip_address ip;
+    if (parse_ip(host, ip))
+      return std::find(addresses.begin(), addresses.end(), ip) != addresses.end();
+    std::string l = lower(host);
+    while (!l.empty() && l.back() == '.') l.pop_back();
+    return !l.empty() && std::find(names.begin(), names.end(), l) != names.end();
+  }
+};
+
 // What the service thread's callbacks and publish() share (the context's user data).
 struct server_state {
   pose_server_options options;
   bool loopback = true;
   int port = 0;
-  std::string url;
+  std::string url, listen_address;
+  std::vector<std::string> network_urls;
   std::string config_json;
+  std::string file_headers;  // k_file_headers as lws_serve_http_file takes them
   std::thread thread;
   std::atomic<bool> stopping{false};
   bool started = false;
@@ -205,41 +353,101 @@ struct server_state {
   // Service thread only.
   std::vector<unsigned char> send_buffer =
       std::vector<unsigned char>(LWS_PRE + k_message_capacity + k_message_slack);
-  std::vector<unsigned char> http_buffer = std::vector<unsigned char>(LWS_PRE + 4096);
+  std::vector<unsigned char> http_buffer = std::vector<unsigned char>(LWS_PRE + k_body_chunk);
+  machine_names machine;
+  clock_type::time_point machine_read_at;
+  int refusals_logged = 0;
+  long refusals_unlogged = 0;
+  clock_type::time_point refusals_summarised_at;
 
   std::atomic<int> open{0};
-  std::atomic<long> connections{0}, published{0}, sent{0}, skipped{0};
+  std::atomic<long> connections{0}, published{0}, sent{0}, skipped{0}, refused{0};
   std::atomic<double> first_posed_ms{-1.0};
 
   void event(const std::string& line) const {
     if (options.on_event) options.on_event(line);
   }
 
-  // Whether a request's Host header names this server: any name when listening beyond
-  // loopback; else only loopback names, so that a web page that rebinds its own domain name to
-  // 127.0.0.1 cannot read the avatar or the poses (DNS rebinding).
-  bool host_allowed(lws* wsi) const {
-    if (!loopback) return true;
+  // Counts a refused request and logs it: the first k_refusals_logged one by one, the rest in
+  // summaries (summarise_refusals).
+  void refusal(const std::string& line) {
+    ++refused;
+    if (refusals_logged < k_refusals_logged) {
+      ++refusals_logged;
+      refusals_summarised_at = clock_type::now();
+      event(line + (refusals_logged == k_refusals_logged
+                        ? "; further refusals are counted in one line per 10 s"
+                        : ""));
+      return;
+    }
+    ++refusals_unlogged;
+    summarise_refusals(false);
+  }
+  // The line about refusals not logged yet, once k_refusal_summary_every has passed since the
+  // last (or now when `now_anyway`, as the server stops).
+  void summarise_refusals(bool now_anyway) {
+    if (refusals_unlogged == 0) return;
+    const auto now = clock_type::now();
+    if (!now_anyway && now - refusals_summarised_at < k_refusal_summary_every) return;
+    const double seconds = std::chrono::duration<double>(now - refusals_summarised_at).count();
+    char line[160];
+    std::snprintf(line, sizeof line,
+                  "refused %ld more requests or WebSockets for their Host or Origin over %.1f s",
+                  refusals_unlogged, seconds);
+    event(line);
+    refusals_unlogged = 0;
+    refusals_summarised_at = now;
+  }
+
+  // Whether a request's Host header names this server: a loopback name; when listening beyond
+  // loopback also an address or name of this machine (machine_names). Anything else is
+  // refused, so that a web page that rebinds its own domain name to this machine's address
+  // cannot read the avatar or the poses (DNS rebinding). Writes the header to out_host.
+  bool host_allowed(lws* wsi, std::string& out_host) {
     char host[256];
-    if (lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) <= 0) return false;
-    return is_loopback_name(host_part(host));
+    if (lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) <= 0) {
+      out_host = lws_hdr_total_length(wsi, WSI_TOKEN_HOST) > 0 ? "(too long)" : "(none)";
+      return false;
+    }
+    out_host = host;
+    const std::string_view h = host_part(host);
+    if (is_loopback_name(h)) return true;
+    if (loopback) return false;
+    if (machine.has(h)) return true;
+    if (clock_type::now() - machine_read_at < k_machine_refresh_every) return false;
+    machine.read(options.allowed_hosts);
+    machine_read_at = clock_type::now();
+    return machine.has(h);
   }
   // A WebSocket's Origin: absent (not a browser), or a page served from a loopback name (this
-  // server's or `view --connect`'s), or with a non-loopback listener the Host itself.
-  bool origin_allowed(lws* wsi) const {
+  // server's or `view --connect`'s), or with a non-loopback listener the Host itself (checked
+  // by host_allowed). Writes the header to out_origin.
+  bool origin_allowed(lws* wsi, std::string& out_origin) const {
     char origin[256];
     const int n = lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN);
-    if (n <= 0) return lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) == 0;
+    if (n <= 0) {
+      const bool absent = lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) == 0;
+      out_origin = absent ? "(none)" : "(too long)";
+      return absent;
+    }
+    out_origin = origin;
     const std::string_view oh = host_part(origin);
     if (is_loopback_name(oh)) return true;
     if (loopback) return false;
     char host[256];
-    return lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) > 0 && host_part(host) == oh;
+    return lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST) > 0 &&
+           lower(host_part(host)) == lower(oh);
   }
 };
 
 server_state* server_of(lws* wsi) {
   return static_cast<server_state*>(lws_context_user(lws_get_context(wsi)));
+}
+
+std::string peer_of(lws* wsi) {
+  char peer[64] = {};
+  lws_get_peer_simple(wsi, peer, sizeof peer);
+  return peer;
 }
 
 // A path below a served folder: segments of [A-Za-z0-9._-], none empty or starting with '.'.
@@ -292,15 +500,35 @@ std::string route(const server_state& s, std::string_view path) {
   return s.options.page_dir + "/" + std::string(name);
 }
 
-// Headers every served file carries: no MIME sniffing, no framing by other sites, no referrer.
-constexpr char k_file_headers[] =
-    "x-content-type-options: nosniff\r\nx-frame-options: deny\r\nreferrer-policy: no-referrer\r\n";
-
 int finish(lws* wsi) { return lws_http_transaction_completed(wsi) ? -1 : 0; }
 
 int refuse(lws* wsi, unsigned code, const char* body) {
   lws_return_http_status(wsi, code, body);
   return -1;  // close: error answers are rare and the page never makes them
+}
+
+// Answers with `body` (owned by the server, alive until it stops) from memory: the headers now,
+// the body in k_body_chunk pieces as the connection takes them (LWS_CALLBACK_HTTP_WRITEABLE).
+int serve_memory(lws* wsi, server_state& s, http_session* session, const std::string& body,
+                 const char* mime, bool no_store) {
+  unsigned char* start = s.http_buffer.data() + LWS_PRE;
+  unsigned char* p = start;
+  unsigned char* end = s.http_buffer.data() + s.http_buffer.size() - 1;
+  if (lws_add_http_common_headers(wsi, HTTP_STATUS_OK, mime, body.size(), &p, end)) return 1;
+  if (no_store &&
+      lws_add_http_header_by_token(wsi, WSI_TOKEN_HTTP_CACHE_CONTROL,
+                                   reinterpret_cast<const unsigned char*>("no-store"), 8, &p, end))
+    return 1;
+  for (const auto& h : k_file_headers)
+    if (lws_add_http_header_by_name(wsi, reinterpret_cast<const unsigned char*>(h[0]),
+                                    reinterpret_cast<const unsigned char*>(h[1]),
+                                    static_cast<int>(std::strlen(h[1])), &p, end))
+      return 1;
+  if (lws_finalize_write_http_header(wsi, start, &p, end)) return 1;
+  session->body = &body;
+  session->body_sent = 0;
+  lws_callback_on_writable(wsi);
+  return 0;
 }
 
 int http_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, size_t len) {
@@ -310,49 +538,53 @@ int http_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, s
       return 1;  // a WebSocket without our subprotocol
     case LWS_CALLBACK_HTTP: {
       server_state& s = *server_of(wsi);
-      session->config_pending = false;
-      if (!s.host_allowed(wsi))
+      session->body = nullptr;
+      std::string host;
+      if (!s.host_allowed(wsi, host)) {
+        s.refusal("refused a request from " + peer_of(wsi) + ": Host '" + printable(host) +
+                  "' is not " +
+                  (s.loopback ? "a loopback name" : "a name or address of this machine") +
+                  " (a page of another site, or DNS rebinding)");
         return refuse(wsi, HTTP_STATUS_FORBIDDEN,
-                      "this server answers only to 127.0.0.1 and localhost");
+                      s.loopback ? "this server answers only to 127.0.0.1 and localhost"
+                                 : "this server answers only to the names and addresses of its "
+                                   "machine");
+      }
       if (lws_hdr_total_length(wsi, WSI_TOKEN_GET_URI) <= 0)
         return refuse(wsi, HTTP_STATUS_METHOD_NOT_ALLOWED, "only GET");
       const std::string_view path(static_cast<const char*>(in),
                                   in ? std::strlen(static_cast<const char*>(in)) : 0);
-      if (path == "/config.json") {
-        unsigned char* start = s.http_buffer.data() + LWS_PRE;
-        unsigned char* p = start;
-        unsigned char* end = s.http_buffer.data() + s.http_buffer.size() - 1;
-        if (lws_add_http_common_headers(wsi, HTTP_STATUS_OK, "application/json",
-                                        s.config_json.size(), &p, end) ||
-            lws_add_http_header_by_token(wsi, WSI_TOKEN_HTTP_CACHE_CONTROL,
-                                         reinterpret_cast<const unsigned char*>("no-store"), 8, &p,
-                                         end) ||
-            lws_finalize_write_http_header(wsi, start, &p, end))
-          return 1;
-        session->config_pending = true;
-        lws_callback_on_writable(wsi);
-        return 0;
-      }
+      if (path == "/config.json")
+        return serve_memory(wsi, s, session, s.config_json, "application/json", true);
+      if (path == "/avatar.vrm" && s.options.avatar_path.empty() && !s.options.avatar_data.empty())
+        return serve_memory(wsi, s, session, s.options.avatar_data, "model/gltf-binary", false);
       const std::string file = route(s, path);
       // The avatar and the clip are glTF binaries whatever their names end with.
       const char* mime =
           path == "/avatar.vrm" || path == "/clip.vrma" ? "model/gltf-binary" : mime_of(file);
       if (file.empty() || !mime || !is_file(file))
         return refuse(wsi, HTTP_STATUS_NOT_FOUND, "not found");
-      const int n = lws_serve_http_file(wsi, file.c_str(), mime, k_file_headers,
-                                        static_cast<int>(sizeof k_file_headers - 1));
+      const int n = lws_serve_http_file(wsi, file.c_str(), mime, s.file_headers.c_str(),
+                                        static_cast<int>(s.file_headers.size()));
       if (n < 0 || (n > 0 && lws_http_transaction_completed(wsi))) return -1;
       return 0;
     }
     case LWS_CALLBACK_HTTP_WRITEABLE: {
-      if (!session || !session->config_pending) return 0;
+      if (!session || !session->body) return 0;
       server_state& s = *server_of(wsi);
-      session->config_pending = false;
-      const std::size_t n = std::min(s.config_json.size(), s.http_buffer.size() - LWS_PRE);
-      std::memcpy(s.http_buffer.data() + LWS_PRE, s.config_json.data(), n);
-      if (lws_write(wsi, s.http_buffer.data() + LWS_PRE, n, LWS_WRITE_HTTP_FINAL) !=
-          static_cast<int>(n))
+      const std::string& body = *session->body;
+      const std::size_t n = std::min(body.size() - session->body_sent, k_body_chunk);
+      std::memcpy(s.http_buffer.data() + LWS_PRE, body.data() + session->body_sent, n);
+      session->body_sent += n;
+      const bool last = session->body_sent == body.size();
+      if (lws_write(wsi, s.http_buffer.data() + LWS_PRE, n,
+                    last ? LWS_WRITE_HTTP_FINAL : LWS_WRITE_HTTP) != static_cast<int>(n))
         return 1;
+      if (!last) {
+        lws_callback_on_writable(wsi);
+        return 0;
+      }
+      session->body = nullptr;
       return finish(wsi);
     }
     case LWS_CALLBACK_HTTP_FILE_COMPLETION:
@@ -371,8 +603,16 @@ int ws_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, siz
       if (lws_hdr_copy(wsi, uri, sizeof uri, WSI_TOKEN_GET_URI) <= 0 ||
           std::strcmp(uri, k_pose_socket_path) != 0)
         return 1;
-      if (!s.host_allowed(wsi) || !s.origin_allowed(wsi)) {
-        s.event("refused a WebSocket from a page of another site (Origin or Host not loopback)");
+      std::string host, origin;
+      if (!s.host_allowed(wsi, host)) {
+        s.refusal("refused a WebSocket from " + peer_of(wsi) + ": Host '" + printable(host) +
+                  "' is not " +
+                  (s.loopback ? "a loopback name" : "a name or address of this machine"));
+        return 1;
+      }
+      if (!s.origin_allowed(wsi, origin)) {
+        s.refusal("refused a WebSocket from " + peer_of(wsi) + ": Origin '" + printable(origin) +
+                  "' is a page of another site");
         return 1;
       }
       return 0;
@@ -380,6 +620,7 @@ int ws_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, siz
     case LWS_CALLBACK_ESTABLISHED: {
       server_state& s = *server_of(wsi);
       session->sent_seq = 0;
+      session->established = true;
       session->rx_len = 0;
       session->rx_overflow = false;
       session->peer[0] = '\0';
@@ -442,6 +683,9 @@ int ws_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, siz
       return 0;
     }
     case LWS_CALLBACK_CLOSED: {
+      // lws calls this for a handshake the filter refused too: only accepted ones were counted.
+      if (!session || !session->established) return 0;
+      session->established = false;
       server_state& s = *server_of(wsi);
       const int open = --s.open;
       s.event("page at " + std::string(session->peer) + " left (" + std::to_string(open) +
@@ -479,22 +723,29 @@ status pose_server::start(const pose_server_options& options) {
   s.loopback = is_loopback(addr);
   const std::string host = options.host == "localhost" ? "127.0.0.1" : options.host;
   if (options.port != 0) {
-    if (std::string problem = bind_problem(addr, addr_len, host, options.port); !problem.empty())
+    if (std::string problem = bind_problem(addr, addr_len, host, options.port, options.port_option);
+        !problem.empty())
       return status::error("pose server: " + problem);
   }
 
   nlohmann::json config;
+  const bool has_avatar = !options.avatar_path.empty() || !options.avatar_data.empty();
   config["protocol"] = k_pose_socket_protocol;
-  config["avatar"] = options.avatar_path.empty() ? nlohmann::json() : nlohmann::json("/avatar.vrm");
+  config["avatar"] = has_avatar ? nlohmann::json("/avatar.vrm") : nlohmann::json();
   config["clip"] = options.clip_path.empty() ? nlohmann::json() : nlohmann::json("/clip.vrma");
   config["pose_socket"] =
       options.pose_socket_url.empty() ? nlohmann::json() : nlohmann::json(options.pose_socket_url);
   auto base_name = [](const std::string& p) { return p.substr(p.find_last_of('/') + 1); };
-  config["avatar_name"] = base_name(options.avatar_path);
+  config["avatar_name"] = !options.avatar_name.empty()   ? options.avatar_name
+                          : !options.avatar_path.empty() ? base_name(options.avatar_path)
+                          : has_avatar                   ? std::string("avatar.vrm")
+                                                         : std::string();
   config["clip_name"] = base_name(options.clip_path);
   s.config_json = config.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  if (s.config_json.size() > s.http_buffer.size() - LWS_PRE - 1)
-    return status::error("pose server: the avatar or clip path is too long");
+  s.file_headers.clear();
+  for (const auto& h : k_file_headers) s.file_headers += std::string(h[0]) + " " + h[1] + "\r\n";
+  s.machine.read(options.allowed_hosts);
+  s.machine_read_at = clock_type::now();
 
   lws_set_log_level(LLL_ERR, lws_log_sink);
   lws_context_creation_info info;
@@ -514,7 +765,8 @@ status pose_server::start(const pose_server_options& options) {
   lws_context* ctx = lws_create_context(&info);
   if (!ctx) {
     std::string why;
-    if (options.port != 0) why = bind_problem(addr, addr_len, host, options.port);
+    if (options.port != 0)
+      why = bind_problem(addr, addr_len, host, options.port, options.port_option);
     if (why.empty()) {
       std::lock_guard<std::mutex> lock(g_log_mutex);
       why = "could not start on " + host + " port " + std::to_string(options.port) +
@@ -524,16 +776,40 @@ status pose_server::start(const pose_server_options& options) {
   }
   lws_vhost* vh = lws_get_vhost_by_name(ctx, "avatarmap");
   s.port = vh ? lws_get_vhost_listen_port(vh) : options.port;
-  const std::string shown = host == "0.0.0.0" ? "127.0.0.1" : host == "::" ? "::1" : host;
-  s.url = "http://" + (shown.find(':') != std::string::npos ? "[" + shown + "]" : shown) + ":" +
-          std::to_string(s.port) + "/";
+  const std::string port_text = ":" + std::to_string(s.port);
+  auto bracketed = [](const std::string& h) {
+    return h.find(':') != std::string::npos ? "[" + h + "]" : h;
+  };
+  s.listen_address = bracketed(host) + port_text;
+  const bool wildcard = is_wildcard(addr);
+  const std::string shown = host == "0.0.0.0" ? "127.0.0.1" : wildcard ? "::1" : host;
+  s.url = "http://" + bracketed(shown) + port_text + "/";
+  s.network_urls.clear();
+  if (!s.loopback && !wildcard) s.network_urls.push_back(s.url);
+  if (wildcard) {
+    for (const ip_address& a : s.machine.addresses) {
+      // Not loopback (url() is that), not link-local IPv6 (a URL would need its zone), not IPv6
+      // on an IPv4 listener.
+      const bool v6 = a.family == AF_INET6;
+      if (a.loopback() || (v6 && a.bytes[0] == 0xfe && (a.bytes[1] & 0xc0) == 0x80) ||
+          (v6 && addr.ss_family == AF_INET))
+        continue;
+      const std::string u = "http://" + url_host(a) + port_text + "/";
+      if (std::find(s.network_urls.begin(), s.network_urls.end(), u) == s.network_urls.end())
+        s.network_urls.push_back(u);
+    }
+  }
   {
     std::lock_guard<std::mutex> lock(s.m);
     s.context = ctx;
   }
   s.started = true;
   s.thread = std::thread([&s, ctx] {
-    while (!s.stopping.load()) lws_service(ctx, 0);
+    while (!s.stopping.load()) {
+      lws_service(ctx, 0);
+      s.summarise_refusals(false);
+    }
+    s.summarise_refusals(true);
   });
   return {};
 }
@@ -556,6 +832,9 @@ void pose_server::stop() {
 
 int pose_server::port() const { return impl_->port; }
 std::string pose_server::url() const { return impl_->url; }
+std::string pose_server::listen_address() const { return impl_->listen_address; }
+bool pose_server::exposed() const { return impl_->port != 0 && !impl_->loopback; }
+std::vector<std::string> pose_server::network_urls() const { return impl_->network_urls; }
 
 void pose_server::publish(const proxy_pose& pose) {
   impl& s = *impl_;
@@ -573,6 +852,7 @@ pose_server_stats pose_server::stats() const {
   pose_server_stats r;
   r.pages_connected = s.open.load();
   r.connections = s.connections.load();
+  r.refused = s.refused.load();
   r.published = s.published.load();
   r.sent = s.sent.load();
   r.skipped = s.skipped.load();
@@ -597,6 +877,9 @@ status pose_server::start(const pose_server_options& options) {
 void pose_server::stop() {}
 int pose_server::port() const { return 0; }
 std::string pose_server::url() const { return {}; }
+std::string pose_server::listen_address() const { return {}; }
+bool pose_server::exposed() const { return false; }
+std::vector<std::string> pose_server::network_urls() const { return {}; }
 void pose_server::publish(const proxy_pose&) { ++impl_->published; }
 pose_server_stats pose_server::stats() const {
   pose_server_stats r;

@@ -1,13 +1,16 @@
 // pose_server (include/avatarmap/stream/pose_server.hpp) through plain sockets: HTTP GETs of
-// the page, a module and the config; paths outside the served folders and foreign Host or
-// Origin headers refused; the WebSocket handshake against RFC 6455's own example; pose
-// messages read back by the pose reader (bit-exact); every page served; a page that stops
-// reading gets the newest pose instead of a queue; a page that vanishes mid-stream; a port in
-// use; publish() allocating nothing.
+// the page, a module and the config; an avatar served from memory; paths outside the served
+// folders and foreign Host or Origin headers refused, also when listening on 0.0.0.0 (forged
+// Host headers, sent to 127.0.0.1 only); refused WebSockets not counted as pages and their log
+// bounded; the WebSocket handshake against RFC 6455's own example; pose messages read back by
+// the pose reader (bit-exact); every page served; a page that stops reading gets the newest
+// pose instead of a queue; a page that vanishes mid-stream; a port in use, naming the option
+// that sets it; publish() allocating nothing. The load test: pose_server_load_test.cpp.
 #include "avatarmap/stream/pose_server.hpp"
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <ifaddrs.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -17,6 +20,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
+#include <mutex>
 #include <random>
 #include <string>
 #include <thread>
@@ -26,6 +31,7 @@
 #include "avatarmap/synth/random_pose.hpp"
 // The counter only: stream_allocation_test.cpp defines the counting operator new.
 #define AVATARMAP_COUNTING_NEW_COUNTER_ONLY
+#include "http_test_client.hpp"
 #include "support/counting_new.hpp"
 #include "support/temp_dir.hpp"
 
@@ -33,6 +39,11 @@ namespace avatarmap {
 namespace {
 
 using namespace std::chrono_literals;
+using test::get;
+using test::http_answer;
+using test::k_protocol_header;
+using test::request;
+using test::ws_client;
 
 std::string source_dir() {
   const char* s = std::getenv("AVATARMAP_SOURCE_DIR");
@@ -66,148 +77,6 @@ struct fixture_dirs {
   }
 };
 
-int connect_to(int port, int rcvbuf = 0) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  if (rcvbuf > 0) ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
-  timeval tv{10, 0};
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(static_cast<uint16_t>(port));
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
-}
-
-void send_all(int fd, const std::string& s) {
-  std::size_t off = 0;
-  while (off < s.size()) {
-    const ssize_t n = ::send(fd, s.data() + off, s.size() - off, MSG_NOSIGNAL);
-    if (n <= 0) return;
-    off += static_cast<std::size_t>(n);
-  }
-}
-
-struct http_answer {
-  int status = 0;
-  std::string head, body;
-  std::string header(const std::string& name) const {
-    std::string lower = head;
-    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    const auto p = lower.find("\r\n" + name + ":");
-    if (p == std::string::npos) return {};
-    const auto start = head.find_first_not_of(' ', p + name.size() + 3);
-    return head.substr(start, head.find("\r\n", start) - start);
-  }
-};
-
-// Sends a raw request, reads the answer (head + Content-Length bytes, or until closed).
-http_answer request(int port, const std::string& raw) {
-  http_answer r;
-  const int fd = connect_to(port);
-  if (fd < 0) return r;
-  send_all(fd, raw);
-  std::string data;
-  char buf[65536];
-  for (;;) {
-    const auto end = data.find("\r\n\r\n");
-    if (end != std::string::npos) {
-      r.head = data.substr(0, end + 2);
-      const std::string len = r.header("content-length");
-      if (!len.empty() && data.size() - end - 4 >= std::stoul(len)) break;
-    }
-    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
-    if (n <= 0) break;
-    data.append(buf, static_cast<std::size_t>(n));
-  }
-  ::close(fd);
-  const auto end = data.find("\r\n\r\n");
-  if (end == std::string::npos) return r;
-  r.head = data.substr(0, end + 2);
-  r.body = data.substr(end + 4);
-  if (r.head.size() > 12) r.status = std::atoi(r.head.c_str() + 9);
-  return r;
-}
-
-http_answer get(int port, const std::string& path, const std::string& host = "127.0.0.1") {
-  return request(port, "GET " + path + " HTTP/1.1\r\nHost: " + host + ":" + std::to_string(port) +
-                           "\r\nConnection: close\r\n\r\n");
-}
-
-// A WebSocket client on a raw socket (RFC 6455): the handshake, then whole text messages.
-struct ws_client {
-  int fd = -1;
-  std::string pending;   // bytes read past the last message
-  std::string response;  // the handshake's answer
-
-  bool open(int port, const std::string& extra_headers, int rcvbuf = 0,
-            const std::string& key = "dGhlIHNhbXBsZSBub25jZQ==") {
-    fd = connect_to(port, rcvbuf);
-    if (fd < 0) return false;
-    send_all(fd, "GET /pose HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
-                     "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: " + key +
-                     "\r\nSec-WebSocket-Version: 13\r\n" + extra_headers + "\r\n");
-    char buf[4096];
-    while (pending.find("\r\n\r\n") == std::string::npos) {
-      const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
-      if (n <= 0) return false;
-      pending.append(buf, static_cast<std::size_t>(n));
-    }
-    const auto end = pending.find("\r\n\r\n");
-    response = pending.substr(0, end + 2);
-    pending.erase(0, end + 4);
-    return response.rfind("HTTP/1.1 101", 0) == 0;
-  }
-  bool read_bytes(std::size_t n) {
-    char buf[65536];
-    while (pending.size() < n) {
-      const ssize_t got = ::recv(fd, buf, sizeof buf, 0);
-      if (got <= 0) return false;
-      pending.append(buf, static_cast<std::size_t>(got));
-    }
-    return true;
-  }
-  // The next text message (server frames are unmasked); false on close or time-out.
-  bool read(std::string& out) {
-    out.clear();
-    for (;;) {
-      if (!read_bytes(2)) return false;
-      const auto b0 = static_cast<unsigned char>(pending[0]);
-      const auto b1 = static_cast<unsigned char>(pending[1]);
-      std::size_t header = 2, len = b1 & 0x7f;
-      if (len == 126) {
-        if (!read_bytes(4)) return false;
-        len =
-            (static_cast<unsigned char>(pending[2]) << 8) | static_cast<unsigned char>(pending[3]);
-        header = 4;
-      } else if (len == 127) {
-        if (!read_bytes(10)) return false;
-        len = 0;
-        for (int i = 2; i < 10; ++i) len = (len << 8) | static_cast<unsigned char>(pending[i]);
-        header = 10;
-      }
-      if (b1 & 0x80) return false;  // a server never masks
-      if (!read_bytes(header + len)) return false;
-      const int opcode = b0 & 0x0f;
-      out += pending.substr(header, len);
-      pending.erase(0, header + len);
-      if (opcode == 8) return false;
-      if (b0 & 0x80) return true;
-    }
-  }
-  void close() {
-    if (fd >= 0) ::close(fd);
-    fd = -1;
-  }
-  ~ws_client() { close(); }
-};
-
-const std::string k_protocol_header =
-    std::string("Sec-WebSocket-Protocol: ") + k_pose_socket_protocol + "\r\n";
-
 double message_t(const std::string& m) { return std::atof(m.c_str() + m.find("\"t\":") + 4); }
 
 proxy_pose pose_at(double t, unsigned seed = 1) {
@@ -233,6 +102,9 @@ TEST(pose_server, serves_the_page_a_module_and_the_config) {
   ASSERT_TRUE(server.start(f.options()).ok());
   ASSERT_GT(server.port(), 0);
   EXPECT_EQ(server.url(), "http://127.0.0.1:" + std::to_string(server.port()) + "/");
+  EXPECT_EQ(server.listen_address(), "127.0.0.1:" + std::to_string(server.port()));
+  EXPECT_FALSE(server.exposed());
+  EXPECT_TRUE(server.network_urls().empty());
 
   const http_answer page = get(server.port(), "/");
   EXPECT_EQ(page.status, 200);
@@ -417,6 +289,23 @@ TEST(pose_server, a_port_in_use_is_a_clear_error) {
   EXPECT_NE(st.message().find("port " + std::to_string(o.port) + " is in use"), std::string::npos)
       << st.message();
   EXPECT_NE(st.message().find("--port"), std::string::npos) << st.message();
+
+  // `live --serve` sets the port with --serve: the message names that option, not --port.
+  const int holder2 = ::socket(AF_INET, SOCK_STREAM, 0);
+  a.sin_port = 0;
+  ASSERT_EQ(::bind(holder2, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  ASSERT_EQ(::listen(holder2, 1), 0);
+  len = sizeof a;
+  ::getsockname(holder2, reinterpret_cast<sockaddr*>(&a), &len);
+  o.port = ntohs(a.sin_port);
+  o.port_option = "--serve";
+  pose_server served;
+  const status st2 = served.start(o);
+  ::close(holder2);
+  ASSERT_FALSE(st2.ok());
+  EXPECT_NE(st2.message().find("(--serve; port 0 picks a free one)"), std::string::npos)
+      << st2.message();
+  EXPECT_EQ(st2.message().find("--port"), std::string::npos) << st2.message();
 }
 
 TEST(pose_server, options_are_checked_before_binding) {
@@ -453,6 +342,161 @@ TEST(pose_server, publish_allocates_nothing) {
   const long before = g_allocations.load();
   for (int i = 0; i < 200; ++i) server.publish(p);
   EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
+// The event lines a server reports, for the tests that count them.
+struct event_log {
+  std::mutex m;
+  std::vector<std::string> lines;
+  std::function<void(std::string_view)> sink() {
+    return [this](std::string_view l) {
+      std::lock_guard<std::mutex> lock(m);
+      lines.emplace_back(l);
+    };
+  }
+  int count(const std::string& start) {
+    std::lock_guard<std::mutex> lock(m);
+    int n = 0;
+    for (const std::string& l : lines) n += l.rfind(start, 0) == 0;
+    return n;
+  }
+};
+
+TEST(pose_server, the_avatar_can_be_served_from_memory_to_every_load) {
+  fixture_dirs f;
+  pose_server_options o = f.options();
+  // 1 MB: many chunks of the body writer; every byte value.
+  std::string bytes(1 << 20, '\0');
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<char>((i * 7919) >> 3);
+  o.avatar_data = bytes;
+  o.avatar_name = "builtin.vrm";
+  pose_server server;
+  ASSERT_TRUE(server.start(o).ok());
+  for (int load = 0; load < 3; ++load) {  // page reloads keep getting it
+    const http_answer avatar = get(server.port(), "/avatar.vrm");
+    EXPECT_EQ(avatar.status, 200);
+    EXPECT_EQ(avatar.header("content-type"), "model/gltf-binary");
+    EXPECT_EQ(avatar.header("x-content-type-options"), "nosniff");
+    EXPECT_TRUE(avatar.body == bytes) << "load " << load << ": " << avatar.body.size() << " bytes";
+    const http_answer config = get(server.port(), "/config.json");
+    EXPECT_NE(config.body.find("\"avatar\":\"/avatar.vrm\""), std::string::npos) << config.body;
+    EXPECT_NE(config.body.find("\"avatar_name\":\"builtin.vrm\""), std::string::npos);
+  }
+  // Both at once is a mistake.
+  write_file(f.dir.file("me.vrm"), "glTF");
+  o.avatar_path = f.dir.file("me.vrm");
+  EXPECT_NE(o.validate().message().find("not both"), std::string::npos);
+}
+
+TEST(pose_server, refused_websockets_are_not_counted_and_their_log_is_bounded) {
+  fixture_dirs f;
+  event_log log;
+  pose_server_options o = f.options();
+  o.on_event = log.sink();
+  pose_server server;
+  ASSERT_TRUE(server.start(o).ok());
+  ws_client page;
+  ASSERT_TRUE(page.open(server.port(), k_protocol_header));
+  constexpr int k_origin = 60, k_host = 40;
+  for (int i = 0; i < k_origin; ++i) {
+    ws_client c;
+    EXPECT_FALSE(c.open(server.port(), k_protocol_header + "Origin: http://evil.example\r\n"));
+  }
+  for (int i = 0; i < k_host; ++i) {
+    ws_client c;
+    EXPECT_FALSE(c.open(server.port(), k_protocol_header, 0,
+                        "dGhlIHNhbXBsZSBub25jZQ==", "rebound.evil.example"));
+  }
+  ws_client second;
+  ASSERT_TRUE(second.open(server.port(), k_protocol_header));
+  EXPECT_TRUE(eventually([&] { return server.stats().refused == k_origin + k_host; }))
+      << server.stats().refused;
+  EXPECT_TRUE(eventually([&] { return server.stats().pages_connected == 2; }))
+      << server.stats().pages_connected;
+  EXPECT_EQ(server.stats().connections, 2);
+  second.close();
+  EXPECT_TRUE(eventually([&] { return server.stats().pages_connected == 1; }))
+      << server.stats().pages_connected;
+  server.stop();
+  EXPECT_EQ(server.stats().pages_connected, 0);
+  // Five refusals one by one, the rest in one summary as the server stops.
+  EXPECT_EQ(log.count("refused a WebSocket"), 5);
+  EXPECT_EQ(log.count("refused " + std::to_string(k_origin + k_host - 5) + " more"), 1);
+  EXPECT_EQ(log.count("refused"), 6);
+  EXPECT_EQ(log.count("page connected"), 2);
+  EXPECT_EQ(log.count("page at"), 2);  // both left
+}
+
+// The machine's own non-loopback addresses, as a Host header writes them.
+std::vector<std::string> own_addresses() {
+  std::vector<std::string> r;
+  ifaddrs* list = nullptr;
+  if (::getifaddrs(&list) != 0) return r;
+  for (const ifaddrs* i = list; i; i = i->ifa_next) {
+    if (!i->ifa_addr || i->ifa_addr->sa_family != AF_INET) continue;
+    char text[INET_ADDRSTRLEN] = {};
+    const auto* v4 = reinterpret_cast<const sockaddr_in*>(i->ifa_addr);
+    inet_ntop(AF_INET, &v4->sin_addr, text, sizeof text);
+    if (std::string(text).rfind("127.", 0) != 0) r.emplace_back(text);
+  }
+  ::freeifaddrs(list);
+  return r;
+}
+
+TEST(pose_server, beyond_loopback_it_answers_only_to_this_machines_names) {
+  // Listens on every address, but every request of this test goes to 127.0.0.1: what differs
+  // is only the Host header a browser would send (forged here).
+  fixture_dirs f;
+  event_log log;
+  pose_server_options o = f.options();
+  o.host = "0.0.0.0";
+  o.allowed_hosts = {"Viewer.Example"};
+  o.on_event = log.sink();
+  pose_server server;
+  ASSERT_TRUE(server.start(o).ok());
+  const int port = server.port();
+  EXPECT_TRUE(server.exposed());
+  EXPECT_EQ(server.listen_address(), "0.0.0.0:" + std::to_string(port));
+  EXPECT_EQ(server.url(), "http://127.0.0.1:" + std::to_string(port) + "/");
+  for (const std::string& u : server.network_urls())
+    EXPECT_EQ(u.find("127."), std::string::npos) << u;  // loopback is url(), not a network URL
+
+  std::vector<std::string> allowed = {"127.0.0.1", "localhost",      "[::1]",
+                                      "127.1.2.3", "viewer.example", "VIEWER.EXAMPLE."};
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) == 0 && name[0]) allowed.emplace_back(name);
+  for (const std::string& a : own_addresses()) allowed.push_back(a);
+  for (const std::string& h : allowed) EXPECT_EQ(get(port, "/", h).status, 200) << "Host: " << h;
+
+  // DNS rebinding and foreign names: a name that merely contains an allowed one, a Host that
+  // is missing or empty, an address that is not this machine's.
+  int refused = 0;
+  const std::vector<std::string> foreign_hosts = {
+      "evil.example",        "127.0.0.1.evil.example", std::string(name) + ".evil.example",
+      "viewer.example.evil", "198.51.100.77",          "[2001:db8::1]"};
+  for (const std::string& h : foreign_hosts) {
+    EXPECT_EQ(get(port, "/", h).status, 403) << "Host: " << h;
+    ++refused;
+  }
+  EXPECT_EQ(request(port, test::get_request("/avatar.vrm", "")).status, 403);
+  EXPECT_EQ(request(port, "GET / HTTP/1.1\r\nConnection: close\r\n\r\n").status, 403);
+  refused += 2;
+  // WebSockets: a foreign Host is refused; a page served by this machine's name may connect.
+  ws_client rebound;
+  EXPECT_FALSE(
+      rebound.open(port, k_protocol_header, 0, "dGhlIHNhbXBsZSBub25jZQ==", "evil.example"));
+  ws_client foreign;
+  EXPECT_FALSE(foreign.open(port, k_protocol_header + "Origin: http://evil.example\r\n"));
+  refused += 2;
+  ws_client named;
+  EXPECT_TRUE(named.open(
+      port, k_protocol_header + "Origin: http://viewer.example:" + std::to_string(port) + "\r\n", 0,
+      "dGhlIHNhbXBsZSBub25jZQ==", "viewer.example"))
+      << named.response;
+  EXPECT_EQ(server.stats().refused, refused);
+  EXPECT_TRUE(eventually([&] { return server.stats().pages_connected == 1; }));
+  server.stop();
+  EXPECT_EQ(log.count("refused a request from 127.0.0.1: Host 'evil.example:"), 1);
 }
 
 }  // namespace

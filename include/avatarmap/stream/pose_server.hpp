@@ -1,7 +1,9 @@
 // The browser viewer's server (docs/viewer.md): serves the viewer page (the project's
 // viewer/ folder), the JavaScript modules it imports (three.js and three-vrm, fetched from npm
 // by scripts/fetch_viewer_modules.sh) and the avatar and clip it shows, and broadcasts proxy
-// poses to every connected page over a WebSocket. Bound to 127.0.0.1 by default.
+// poses to every connected page over a WebSocket. Bound to 127.0.0.1 by default; bound beyond
+// loopback it answers only requests that name this machine in their Host header
+// (docs/security.md).
 //
 // Threads: start() runs the server on a thread of its own; publish() may be called from any
 // thread (the live loop's) and never waits for a client: it replaces the newest pose, and each
@@ -15,6 +17,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
@@ -30,38 +33,55 @@ inline constexpr const char* k_pose_socket_path = "/pose";
 
 struct pose_server_options {
   /// Address to listen on: an IPv4 or IPv6 literal, or "localhost" (= 127.0.0.1). Anything
-  /// but a loopback address makes the page, avatar and poses visible to the network.
+  /// but a loopback address makes the page, avatar and poses visible to the network
+  /// (pose_server::exposed()); 0.0.0.0 and :: listen on every address of the machine.
   std::string host = "127.0.0.1";
   /// TCP port, 0 to 65535; 0 lets the system choose a free one (see pose_server::port()).
   int port = 8080;
+  /// The command-line option that sets the port, named in the port-in-use message ("--port",
+  /// "--serve"); empty = none named.
+  std::string port_option = "--port";
+  /// Further names (DNS names, addresses) a request's Host header may give when listening
+  /// beyond loopback, compared without case and port; beside them only loopback names, the
+  /// machine's own addresses and host name are answered (docs/security.md).
+  std::vector<std::string> allowed_hosts;
   /// Folder with the viewer page (index.html, viewer.js): required.
   std::string page_dir;
   /// Folder with three/, three-vrm/, three-vrm-animation/ (scripts/fetch_viewer_modules.sh):
   /// required.
   std::string modules_dir;
-  /// Avatar (.vrm) the page loads, served as /avatar.vrm; empty = none (the page asks for
-  /// one to be dropped on it).
+  /// Avatar (.vrm) the page loads, served as /avatar.vrm; empty = avatar_data, else none (the
+  /// page asks for one to be dropped on it).
   std::string avatar_path;
+  /// The avatar's bytes, served from memory as /avatar.vrm when avatar_path is empty (the
+  /// built-in avatar: no file is written anywhere).
+  std::string avatar_data;
+  /// The avatar's name the page shows; empty = avatar_path's file name, or "avatar.vrm".
+  std::string avatar_name;
   /// VRM Animation (.vrma) the page plays in a loop, served as /clip.vrma; empty = none.
   std::string clip_path;
   /// WebSocket URL the page takes its poses from; empty = this server's own k_pose_socket_path.
   /// (`avatarmap view --connect PORT` points the page at a `live --serve PORT`.)
   std::string pose_socket_url;
   /// Called on the server's thread with one line about each page that connects, leaves or
-  /// reports its first posed frame; may be empty. Must not call back into the server.
+  /// reports its first posed frame, and about requests refused for their Host or Origin (the
+  /// first few, then one summary line per 10 s at most, so that a hostile page cannot flood
+  /// the log); may be empty. Must not call back into the server.
   std::function<void(std::string_view)> on_event;
 
-  /// ok, or a message naming the field and its allowed range (a missing folder or file).
+  /// ok, or a message naming the field and its allowed range (a missing folder or file, both
+  /// avatar_path and avatar_data given).
   status validate() const;
 };
 
 /// Counters since start(), readable from any thread.
 struct pose_server_stats {
-  int pages_connected = 0;           // WebSocket connections open now
-  long connections = 0;              // WebSocket connections accepted in all
-  long published = 0;                // publish() calls
-  long sent = 0;                     // pose messages handed to connections, all together
-  long skipped = 0;                  // poses a connection never got because a newer one came first
+  int pages_connected = 0;  // WebSocket connections accepted and open now
+  long connections = 0;     // WebSocket connections accepted in all
+  long refused = 0;         // requests and WebSocket handshakes refused for their Host or Origin
+  long published = 0;       // publish() calls
+  long sent = 0;            // pose messages handed to connections, all together
+  long skipped = 0;         // poses a connection never got because a newer one came first
   double first_posed_frame_ms = -1;  // the latest page's report: page load -> first posed frame
 };
 
@@ -82,8 +102,20 @@ class pose_server {
 
   /// The port listened on (the chosen one when options.port was 0); 0 before start().
   int port() const;
-  /// http://HOST:PORT/ (IPv6 hosts in brackets); empty before start().
+  /// A URL that opens the page on this machine: http://HOST:PORT/ with the address listened
+  /// on (IPv6 in brackets), or with 127.0.0.1 (::1) when that is 0.0.0.0 (::); empty before
+  /// start().
   std::string url() const;
+  /// The address and port listened on, as bound: "127.0.0.1:8080", "0.0.0.0:8080",
+  /// "[::]:8080"; empty before start().
+  std::string listen_address() const;
+  /// True when listening beyond loopback: other machines may load the page, the avatar and the
+  /// poses. False before start().
+  bool exposed() const;
+  /// When exposed(): the URLs by which other machines reach the server (the address listened
+  /// on, or for 0.0.0.0 / :: each non-loopback address of the machine's interfaces when it
+  /// started; link-local IPv6 left out); else empty.
+  std::vector<std::string> network_urls() const;
 
   /// Makes `pose` the newest pose and wakes the server to send it to every page. Any thread,
   /// before, during or after start(); never blocks on a client, never allocates.
