@@ -27,7 +27,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from solve_ctypes import (AVM_OK, AvmError, AvmFrame, AvmPose,  # noqa: E402
-                          AvmSolverOptions, load_library, text)
+                          AvmSolverOptions, load_library, set_field, text)
 
 AVM_ERROR_END_OF_FILE = 4
 AVM_ERROR_UNSUPPORTED = 5
@@ -127,7 +127,11 @@ def frames(video, width, height, limit):
 def image_of(buf, width, height):
     img = AvmImage()
     img.data = ctypes.cast(ctypes.c_char_p(buf), ctypes.c_void_p)
-    img.width, img.height, img.stride_bytes, img.format = width, height, width * 3, AVM_PIXEL_RGB8
+    # Checked: a width from a hostile file's header must not wrap in the int32_t fields.
+    set_field(img, "width", width, "image width")
+    set_field(img, "height", height, "image height")
+    set_field(img, "stride_bytes", width * 3, "image row stride (width x 3 bytes)")
+    img.format = AVM_PIXEL_RGB8
     return img
 
 
@@ -166,8 +170,8 @@ def main():
     lib.avm_estimator_options_init_sized(ctypes.byref(opts), ctypes.sizeof(opts))
     models = args.models.encode() if args.models else None
     opts.models_dir = models
-    opts.hands = 0 if args.no_hands else 1
-    opts.face = 0 if args.no_face else 1
+    set_field(opts, "hands", 0 if args.no_hands else 1)
+    set_field(opts, "face", 0 if args.no_face else 1)
     width, height, fps = probe(args.video)
     handle = ctypes.c_void_p()
     create = lib.avm_live_create if args.live else lib.avm_estimator_create

@@ -99,6 +99,41 @@ class AvmError(RuntimeError):
     pass
 
 
+def set_field(struct, name, value, what=None):
+    """struct.name = value, checked first against the field's C type: ctypes itself keeps the
+    low 32 bits of 2**32 in an int32_t (0) and stores 1e39 in a float as inf, silently.
+    Integer fields take integers within their type's range (booleans as 0 or 1), float fields
+    finite numbers within theirs. Raises AvmError naming the field and the range. (The
+    avatarmap package does the same for every field it fills: avatarmap._lib.c_value.)"""
+    ctype = dict(type(struct)._fields_)[name]
+    what = what or name
+    if ctype in (ctypes.c_float, ctypes.c_double):
+        top = 3.4028234663852886e38 if ctype is ctypes.c_float else sys.float_info.max
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise AvmError("%s: expected a number, got %r" % (what, value))
+        try:
+            v = float(value)
+        except OverflowError:
+            v = math.inf
+        if not (math.isfinite(v) and -top <= v <= top):
+            raise AvmError("%s: expected a finite number within +-%.8g (a C %s), got %.6g"
+                           % (what, top, "float" if ctype is ctypes.c_float else "double", v))
+    else:
+        if isinstance(value, bool):
+            value = int(value)
+        if not isinstance(value, int):
+            raise AvmError("%s: expected an integer, got %r" % (what, value))
+        bits = 8 * ctypes.sizeof(ctype)
+        lo, hi = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if ctype(-1).value == -1 \
+            else (0, (1 << bits) - 1)
+        if not lo <= value <= hi:
+            raise AvmError("%s: expected an integer in [%d, %d], got %s"
+                           % (what, lo, hi, value if value.bit_length() <= 64 else
+                              "an integer of %d bits" % value.bit_length()))
+        v = value
+    setattr(struct, name, v)
+
+
 def text(c_string):
     """A message from the C API as str (bytes that are not UTF-8, e.g. of a file name, shown
     as replacement characters rather than failing)."""
@@ -385,11 +420,16 @@ def main(argv):
                                              ctypes.sizeof(options)) != AVM_OK:
             raise AvmError("avm_solver_options_init_sized failed")
         options.struct_size = ctypes.sizeof(AvmSolverOptions)  # what this script knows
-        options.mirror = 1 if args.mirror else 0
+        set_field(options, "mirror", 1 if args.mirror else 0)
         if args.landmarks:
             header, frames = read_landmark_file(args.landmarks)
-            if header and header.get("image_size"):
-                options.image_width, options.image_height = map(float, header["image_size"])
+            size = header.get("image_size") if header else None
+            if size:
+                if not isinstance(size, list) or len(size) != 2:
+                    raise AvmError("%s: header image_size: expected [width, height], got %r"
+                                   % (args.landmarks, size))
+                set_field(options, "image_width", size[0], "header image_size[0]")
+                set_field(options, "image_height", size[1], "header image_size[1]")
         else:
             frames = synthetic_frames()
         solver = Solver(lib, options)

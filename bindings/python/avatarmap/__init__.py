@@ -11,8 +11,10 @@ See docs/python.md.
     poses = am.solve(lm)                       # offline smoothing, as `avatarmap solve`
     am.write_animation(poses, "take.vrma")
 
-Errors raise AvatarmapError subclasses carrying the C API's message. Handles (Solver,
-Retargeter, Estimator, Live) close with ``with`` blocks or close(). Calls into the library
+Errors raise AvatarmapError subclasses carrying the C API's message; values that do not fit
+the C field they fill raise InvalidArgumentError before any call. Handles (Solver,
+Retargeter, Estimator, Live) close with ``with`` blocks or close(), from any thread: close()
+waits for the calls in flight, later calls raise "... is closed". Calls into the library
 release the GIL, so different handles work in parallel from different threads.
 """
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import ctypes
 import os
+import stat
+import threading
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple, Union
 
@@ -12,7 +14,8 @@ import numpy as np
 from . import _lib
 from ._errors import InvalidArgumentError, error_for
 from ._lib import (BONE_COUNT, EXPRESSION_COUNT, FACE_POINTS, FACE_POINTS_NO_IRIS, HAND_POINTS,
-                   POSE_DTYPE, POSE_POINTS, AvmFrameBlock, AvmSolverOptions, fn, text)
+                   POSE_DTYPE, POSE_POINTS, AvmFrameBlock, AvmSolverOptions, c_value, fn,
+                   set_field, text)
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -61,6 +64,10 @@ class Landmarks:
     seen in a frame is NaN there (its first point's x is what counts); a 468-point face has
     rows 468..477 NaN. ``left``/``right`` are the person's sides. ``image_width`` and
     ``image_height`` are pixels (0 unknown), ``fps`` the nominal rate (0 unknown).
+
+    read_landmarks() returns a part that no frame of the file carries as a read-only NaN
+    array of the same shape that takes no memory (``numpy.broadcast_to``); the other arrays
+    are writable. ``np.array(lm.face)`` gives a writable copy of such a part.
     """
 
     t: np.ndarray
@@ -181,7 +188,10 @@ SOLVER_OPTION_NAMES = tuple(n for n, _ in AvmSolverOptions._fields_ if n != "str
 
 def solver_options(options: Dict[str, Any]) -> AvmSolverOptions:
     """avm_solver_options from keyword arguments named as its fields (file_filter also as
-    "offline" | "live" | "none"). Ranges are checked by the C API."""
+    "offline" | "live" | "none"). Each value is checked against its C field first
+    (_lib.set_field: flags True/False or 0/1, integers within int32_t, finite floats within a
+    float's range: InvalidArgumentError naming the option); the C API checks the rest of each
+    range."""
     # Room for a newer library's longer struct: *_init writes the library's own size.
     buf = ctypes.create_string_buffer(4096)
     o = AvmSolverOptions.from_buffer(buf)
@@ -199,32 +209,41 @@ def solver_options(options: Dict[str, Any]) -> AvmSolverOptions:
                 raise InvalidArgumentError(
                     "file_filter %r: expected \"offline\", \"live\" or \"none\"" % value, 1)
             value = _lib.FILE_FILTERS[value]
-        try:
-            setattr(o, name, value)
-        except TypeError:
-            raise InvalidArgumentError("solver option %s: expected a number or bool, got %r"
-                                       % (name, value), 1) from None
+        set_field(o, name, value, "solver option " + name)
     return o
 
 
 # ---- arrays <-> avm_frame_block -----------------------------------------------------------
 
 
+def _never_seen(a: np.ndarray) -> bool:
+    """Whether `a` is one NaN repeated (numpy.broadcast_to: every stride 0), as read_landmarks
+    returns a part that no frame of its file carries."""
+    return a.size > 0 and not any(a.strides) and bool(np.isnan(a.flat[0]))
+
+
 def _part_array(value: Any, n: int, name: str, points: int) -> Optional[np.ndarray]:
-    """A part as a C-contiguous float32 (n, points, 5) array (None stays None). Accepts
+    """A part as a C-contiguous float32 (n, points, 5) array; None (NULL in C: never seen)
+    for None and for one NaN repeated (read_landmarks' part that no frame carries). Accepts
     (n, points, 3) (visibility and presence 1) and, for the face, 468 points."""
     if value is None:
         return None
+    ok_points = (points, FACE_POINTS_NO_IRIS) if name == "face" else (points,)
     try:
-        a = np.asarray(value, dtype=np.float32)
+        raw = np.asarray(value)
+        if raw.dtype.kind == "c":
+            raise TypeError("complex numbers")
+        a = raw if raw.dtype.kind == "f" and _never_seen(raw) else raw.astype(np.float32,
+                                                                             copy=False)
     except (TypeError, ValueError) as e:
         raise InvalidArgumentError("landmarks.%s: not an array of numbers (%s)" % (name, e),
                                    1) from None
-    ok_points = (points, FACE_POINTS_NO_IRIS) if name == "face" else (points,)
     if a.ndim != 3 or a.shape[0] != n or a.shape[1] not in ok_points or a.shape[2] not in (3, 5):
         raise InvalidArgumentError(
             "landmarks.%s: shape %s, expected (%d, %s, 5) (or 3 columns: x, y, z)"
             % (name, a.shape, n, " or ".join(str(p) for p in ok_points)), 1)
+    if _never_seen(a):
+        return None  # no copy of n frames of NaN
     if a.shape[1] != points or a.shape[2] != 5:
         full = np.full((n, points, 5), np.nan, dtype=np.float32)
         full[:, :a.shape[1], :a.shape[2]] = a
@@ -260,34 +279,108 @@ def frame_block(landmarks: Landmarks) -> Tuple[AvmFrameBlock, List[np.ndarray]]:
 # ---- files --------------------------------------------------------------------------------
 
 
+class _SerialGate:
+    """Calls one at a time (a lock); close() refuses new calls at once and takes the lock, so
+    it waits for the call in flight, and the calls queued behind it find the handle closed."""
+
+    __slots__ = ("_owner", "_lock")
+
+    def __init__(self, owner: "_Handle") -> None:
+        self._owner = owner
+        self._lock = threading.Lock()
+
+    def __enter__(self) -> ctypes.c_void_p:
+        if self._owner._closing:  # at once, not after the call in flight
+            raise self._owner._closed_error()
+        self._lock.acquire()
+        if self._owner._closing or not self._owner._h:
+            self._lock.release()
+            raise self._owner._closed_error()
+        return self._owner._h
+
+    def __exit__(self, *exc: object) -> None:
+        self._lock.release()
+
+    def close(self, destroy: Any) -> None:
+        self._owner._closing = True  # new calls are refused from here on
+        with self._lock:
+            destroy()
+
+
+class _SharedGate:
+    """Calls side by side (counted); close() refuses new calls at once and waits until the
+    count is zero."""
+
+    __slots__ = ("_owner", "_cond", "_busy")
+
+    def __init__(self, owner: "_Handle") -> None:
+        self._owner = owner
+        self._cond = threading.Condition(threading.Lock())
+        self._busy = 0
+
+    def __enter__(self) -> ctypes.c_void_p:
+        with self._cond:
+            if self._owner._closing or not self._owner._h:
+                raise self._owner._closed_error()
+            self._busy += 1
+            return self._owner._h
+
+    def __exit__(self, *exc: object) -> None:
+        with self._cond:
+            self._busy -= 1
+            if not self._busy:
+                self._cond.notify_all()
+
+    def close(self, destroy: Any) -> None:
+        with self._cond:
+            self._owner._closing = True
+            while self._busy:
+                self._cond.wait()
+            destroy()  # under the lock: a second close() waits for the first to finish
+
+
 class _Handle:
-    """Owns a C handle; closed by close(), a `with` block or garbage collection."""
+    """Owns a C handle; closed by close(), a `with` block or garbage collection.
+
+    Every call on the handle goes through `with self._use() as h:`; it raises "<Class> is
+    closed" once close() has begun, and close() waits for the calls in flight before
+    destroying the handle, so a handle closed by one thread while others use it never reaches
+    C freed. With _serial (the C handle is single-threaded: Solver, Retargeter, Estimator,
+    readers, clips) calls also wait for each other; a Live lets its calls overlap (its C
+    functions are for different threads) and serialises push() itself."""
 
     _destroy_name = ""
+    _serial = True
 
     def __init__(self) -> None:
         self._h = ctypes.c_void_p()
+        self._closing = False  # close() has begun: no new call starts
+        self._gate = _SerialGate(self) if self._serial else _SharedGate(self)
 
     @property
     def closed(self) -> bool:
-        return not self._h
+        return self._closing or not self._h
+
+    def _closed_error(self) -> InvalidArgumentError:
+        return InvalidArgumentError("%s is closed" % type(self).__name__, 1)
 
     def _handle(self) -> ctypes.c_void_p:
-        if not self._h:
-            raise InvalidArgumentError("%s is closed" % type(self).__name__, 1)
+        if self.closed:
+            raise self._closed_error()
         return self._h
 
+    def _use(self) -> Union[_SerialGate, _SharedGate]:
+        """The context of one call (or a few that belong together): the C handle."""
+        return self._gate
+
     def close(self) -> None:
-        """Frees the C handle (again: nothing). Waits for a call in flight on another thread
-        when the handle serialises its calls (Solver, Retargeter, Estimator)."""
-        lock = getattr(self, "_lock", None)
-        if lock is not None:
-            with lock:
-                h, self._h = self._h, ctypes.c_void_p()
-        else:
+        """Frees the C handle (again: nothing). Waits for the calls in flight on other
+        threads; calls made after it began raise InvalidArgumentError("... is closed")."""
+        def destroy() -> None:
             h, self._h = self._h, ctypes.c_void_p()
-        if h:
-            fn(self._destroy_name)(h)
+            if h:
+                fn(self._destroy_name)(h)
+        self._gate.close(destroy)
 
     def __enter__(self):  # type: ignore[no-untyped-def]
         self._handle()
@@ -299,7 +392,7 @@ class _Handle:
     def __del__(self) -> None:
         try:
             self.close()
-        except Exception:  # interpreter shutdown: the library may be gone
+        except Exception:  # interpreter shutdown (the library may be gone), or no __init__
             pass
 
 
@@ -318,83 +411,118 @@ class _Clip(_Handle):
         return fn("avm_clip_last_error")(self._h)
 
 
-_READ_BLOCK = 8192  # frames per avm_landmark_reader_read call
+_READ_BLOCK = 256          # frames per avm_landmark_reader_read call
+_MIN_FRAME_BYTES = 8       # '{"t":0}\n': the least text of a frame
+_MIN_POINT_BYTES = 8       # '[0,0,0],': the least text of one point
+_FIRST_ALLOCATION = 256 << 20  # bytes: the most an array starts with; past it, it grows
 
 
-def _estimate_frames(path: bytes) -> int:
-    """A generous guess of a landmark file's frame count from its size and its first MiB's
-    lines. Arrays of this many rows are allocated uninitialised: rows never read are pages
-    never touched, so a guess too high costs address space, not memory."""
+def _regular_file_size(path: bytes) -> int:
+    """The size of a regular file, from os.stat alone (the file is never opened or read for
+    it), or 0: a FIFO, /dev/stdin, a pipe from a shell's <(...), a device, an error (the
+    reader reports it)."""
     try:
-        size = os.path.getsize(path)
-        with open(path, "rb") as f:
-            sample = f.read(1 << 20)
-    except OSError:
-        return 0  # the reader reports the error
-    lines = max(sample.count(b"\n"), 1)
-    if len(sample) >= size:
-        return lines + 1
-    return int(size / len(sample) * lines * 1.5) + 1024
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return 0
+    return st.st_size if stat.S_ISREG(st.st_mode) else 0
+
+
+class _Rows:
+    """A growing array of frames: rows [0, n) hold what was read. It starts at the most rows
+    a file of `size` bytes can hold when each costs at least `min_text` bytes of text (never
+    more than _FIRST_ALLOCATION bytes; rows never written are pages never touched) and
+    doubles when full, so memory follows the frames read."""
+
+    def __init__(self, row_shape: Tuple[int, ...], dtype: Any, size: int, min_text: int,
+                 need: int) -> None:
+        row_bytes = int(np.prod(row_shape, dtype=np.int64)) * np.dtype(dtype).itemsize
+        guess = min(size // min_text, _FIRST_ALLOCATION // row_bytes)
+        self.row_bytes = row_bytes
+        self.data = np.empty((max(guess, need),) + row_shape, dtype=dtype)
+
+    def reserve(self, n: int, need: int) -> None:
+        """Room for `need` rows, keeping rows [0, n)."""
+        if need > len(self.data):
+            bigger = np.empty((max(need, 2 * len(self.data)),) + self.data.shape[1:],
+                              dtype=self.data.dtype)
+            bigger[:n] = self.data[:n]
+            self.data = bigger
+
+    def address(self, row: int) -> int:
+        return self.data.ctypes.data + row * self.row_bytes
+
+    def finish(self, n: int) -> np.ndarray:
+        """Rows [0, n), the memory past them given back (realloc in place, no copy)."""
+        a, self.data = self.data, np.empty((0,) + self.data.shape[1:], self.data.dtype)
+        try:
+            a.resize((n,) + a.shape[1:], refcheck=False)  # no view of `a` exists
+            return a
+        except ValueError:
+            return a[:n]
 
 
 def read_landmarks(path: PathLike) -> Landmarks:
     """Reads a whole ``*.landmarks.jsonl`` file (docs/file-formats.md) into arrays.
 
+    The file is opened once and read once, front to back, so a FIFO, ``/dev/stdin`` or a
+    shell's ``<(...)`` reads as a file does. Memory follows the frames read: a part that no
+    frame carries takes none (a read-only NaN array, numpy.broadcast_to); a regular file's
+    size (os.stat) only sizes the first allocation.
+
     Raises FileIOError (cannot open), ParseError ("FILE:LINE: ..." of the first malformed
     line)."""
-    reader = _Reader()
     p = _path(path, "read_landmarks")
+    size = _regular_file_size(p)
+    reader = _Reader()
     _check(fn("avm_landmark_reader_open")(p, ctypes.byref(reader._h)),
            fn("avm_last_create_error")())
-    with reader:
-        w, h, fps = ctypes.c_int32(), ctypes.c_int32(), ctypes.c_double()
-        _check(fn("avm_landmark_reader_header")(reader._h, ctypes.byref(w), ctypes.byref(h),
+    with reader, reader._use() as h:
+        w, ht, fps = ctypes.c_int32(), ctypes.c_int32(), ctypes.c_double()
+        _check(fn("avm_landmark_reader_header")(h, ctypes.byref(w), ctypes.byref(ht),
                                                 ctypes.byref(fps)),
-               fn("avm_landmark_reader_last_error")(reader._h))
-        # Read straight into arrays of the guessed size; past it, into further chunks that
-        # are joined at the end (the only copy).
-        chunks: List[Landmarks] = []
-        current = _uninitialised(max(_estimate_frames(p), _READ_BLOCK))
-        used = 0
+               fn("avm_landmark_reader_last_error")(h))
+        # Parts are read straight into their arrays once a frame has carried them; until
+        # then into one block of scratch rows, checked after each read.
+        scratch = {name: np.empty((_READ_BLOCK, points, 5), dtype=np.float32)
+                   for name, points in PARTS}
+        t = _Rows((), np.float64, size, _MIN_FRAME_BYTES, _READ_BLOCK)
+        parts: Dict[str, Optional[_Rows]] = {name: None for name, _ in PARTS}
+        block = AvmFrameBlock()
+        block.struct_size = ctypes.sizeof(AvmFrameBlock)
+        block.count = _READ_BLOCK
         read = ctypes.c_int64()
+        n = 0
         while True:
-            if used == len(current):
-                chunks.append(current)
-                current, used = _uninitialised(max(len(current) // 2, _READ_BLOCK)), 0
-            room = _slice(current, used, min(used + _READ_BLOCK, len(current)))
-            block, _keep = frame_block(room)
-            st = fn("avm_landmark_reader_read")(reader._h, ctypes.byref(block),
-                                                ctypes.byref(read))
+            t.reserve(n, n + _READ_BLOCK)
+            block.t = t.address(n)
+            for name, _ in PARTS:
+                rows = parts[name]
+                if rows is not None:
+                    rows.reserve(n, n + _READ_BLOCK)
+                setattr(block, name, rows.address(n) if rows is not None
+                        else scratch[name].ctypes.data)
+            st = fn("avm_landmark_reader_read")(h, ctypes.byref(block), ctypes.byref(read))
             if st == _lib.ERROR_END_OF_FILE:
                 break
-            _check(st, fn("avm_landmark_reader_last_error")(reader._h))
-            if read.value <= 0:
+            _check(st, fn("avm_landmark_reader_last_error")(h))
+            k = read.value
+            if k <= 0:
                 break
-            used += read.value
-        chunks.append(_slice(current, 0, used))
-    out = _concat(chunks)
-    out.image_width, out.image_height, out.fps = int(w.value), int(h.value), float(fps.value)
+            for name, points in PARTS:
+                if parts[name] is None and not np.isnan(scratch[name][:k]).all():
+                    rows = _Rows((points, 5), np.float32, size, points * _MIN_POINT_BYTES,
+                                 n + _READ_BLOCK)
+                    rows.data[:n] = np.nan  # the frames before: not seen
+                    rows.data[n:n + k] = scratch[name][:k]
+                    parts[name] = rows
+            n += k
+    out = Landmarks(t=t.finish(n), **{
+        name: rows.finish(n) if rows is not None
+        else np.broadcast_to(np.float32(np.nan), (n, points, 5))
+        for (name, points), rows in zip(PARTS, parts.values())})
+    out.image_width, out.image_height, out.fps = int(w.value), int(ht.value), float(fps.value)
     return out
-
-
-def _uninitialised(n: int) -> Landmarks:
-    return Landmarks(t=np.empty(n, dtype=np.float64),
-                     **{name: np.empty((n, points, 5), dtype=np.float32)
-                        for name, points in PARTS})
-
-
-def _slice(lm: Landmarks, first: int, end: int) -> Landmarks:
-    """Rows [first, end) as views (C-contiguous: rows are whole frames)."""
-    return Landmarks(t=lm.t[first:end], **{name: getattr(lm, name)[first:end]
-                                           for name, _ in PARTS})
-
-
-def _concat(chunks: List[Landmarks]) -> Landmarks:
-    if len(chunks) == 1:
-        return chunks[0]
-    return Landmarks(t=np.concatenate([c.t for c in chunks]),
-                     **{name: np.concatenate([getattr(c, name) for c in chunks])
-                        for name, _ in PARTS})
 
 
 def read_poses(path: PathLike) -> Poses:
@@ -426,7 +554,7 @@ def solve(landmarks: Landmarks, **options: Any) -> Poses:
     ``options`` are avm_solver_options' fields by name (``mirror=True``,
     ``file_filter="live"``, ``rotation_min_cutoff=1.2``, ...); the landmarks' image size is
     used when ``image_width``/``image_height`` are not given. Raises InvalidArgumentError
-    (shapes, options, times not finite or not increasing)."""
+    (shapes, options, a time not finite)."""
     if not isinstance(landmarks, Landmarks):
         raise InvalidArgumentError("solve: expected avatarmap.Landmarks, got %s"
                                    % type(landmarks).__name__, 1)
@@ -480,24 +608,29 @@ def write_animation(poses: Poses, path: PathLike, *, fps: float = 0.0,
     if not isinstance(poses, Poses):
         raise InvalidArgumentError("write_animation: expected avatarmap.Poses, got %s"
                                    % type(poses).__name__, 1)
+    target = _Target(path, fps, avatar, mapping)
     rec = np.ascontiguousarray(poses.records)
     with _Clip() as clip:
         if len(rec):
             _check(fn("avm_clip_add_poses")(clip._h, rec.ctypes.data, len(rec)),
                    clip.last_error())
-        _write_clip(clip, path, fps, avatar, mapping)
+        target.write(clip)
 
 
-def _write_clip(clip: _Clip, path: PathLike, fps: float, avatar: Optional[PathLike],
-                mapping: Optional[str]) -> None:
-    err = ctypes.create_string_buffer(_ERR_SIZE)
-    try:
-        fps_value = float(fps)
-    except (TypeError, ValueError):
-        raise InvalidArgumentError("fps: expected a number, got %r" % (fps,), 1) from None
-    _check(fn("avm_clip_write")(clip._h, _path(path, "path"), fps_value,
-                                _text_arg(avatar, "avatar"), _text_arg(mapping, "mapping"),
-                                err, _ERR_SIZE), err.value)
+class _Target:
+    """An output's arguments, checked before any work (avm_clip_write's)."""
+
+    def __init__(self, path: PathLike, fps: float, avatar: Optional[PathLike],
+                 mapping: Optional[str]) -> None:
+        self.path = _path(path, "path")
+        self.fps = c_value(ctypes.c_double, fps, "fps")
+        self.avatar = _text_arg(avatar, "avatar")
+        self.mapping = _text_arg(mapping, "mapping")
+
+    def write(self, clip: _Clip) -> None:
+        err = ctypes.create_string_buffer(_ERR_SIZE)
+        _check(fn("avm_clip_write")(clip._h, self.path, self.fps, self.avatar, self.mapping,
+                                    err, _ERR_SIZE), err.value)
 
 
 def convert_file(in_path: PathLike, out_path: PathLike, *, fps: float = 0.0,
@@ -509,18 +642,20 @@ def convert_file(in_path: PathLike, out_path: PathLike, *, fps: float = 0.0,
     as solve_file(IN) solves it, with ``options`` as solve()'s (avm_solve_file_to_clip; the
     bytes of ``avatarmap convert`` of the landmarks). Written atomically."""
     src = _path(in_path, "convert_file")
+    target = _Target(out_path, fps, avatar, mapping)
+    landmarks = os.fsdecode(src).lower().endswith(".landmarks.jsonl")  # by name: never opened
+    if not landmarks and options:
+        raise InvalidArgumentError("convert_file: solver options (%s) apply to a "
+                                   "*.landmarks.jsonl input only" % ", ".join(sorted(options)), 1)
+    o = solver_options(options) if landmarks else None
     clip = _Clip.__new__(_Clip)
     _Handle.__init__(clip)
     err = ctypes.create_string_buffer(_ERR_SIZE)
-    if os.fsdecode(os.fspath(in_path)).lower().endswith(".landmarks.jsonl"):
-        _check(fn("avm_solve_file_to_clip")(src, solver_options(options), ctypes.byref(clip._h),
-                                            err, _ERR_SIZE), err.value)
+    if landmarks:
+        _check(fn("avm_solve_file_to_clip")(src, o, ctypes.byref(clip._h), err, _ERR_SIZE),
+               err.value)
     else:
-        if options:
-            raise InvalidArgumentError("convert_file: solver options (%s) apply to a "
-                                       "*.landmarks.jsonl input only" % ", ".join(sorted(options)),
-                                       1)
         _check(fn("avm_clip_read")(src, ctypes.byref(clip._h), err, _ERR_SIZE), err.value)
     with clip:
-        _write_clip(clip, out_path, fps, avatar, mapping)
+        target.write(clip)
         return int(fn("avm_clip_frame_count")(clip._h))

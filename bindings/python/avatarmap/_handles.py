@@ -14,7 +14,8 @@ from ._data import (PARTS, Landmarks, PathLike, Poses, _check, _ERR_SIZE, _Handl
                     _path, solver_options)
 from ._errors import InvalidArgumentError
 from ._lib import (FACE_POINTS, FACE_POINTS_NO_IRIS, POSE_DTYPE, AvmCaptureSummary,
-                   AvmEstimatorOptions, AvmFrame, AvmImage, AvmLandmark, AvmLiveStats, fn, text)
+                   AvmEstimatorOptions, AvmFrame, AvmImage, AvmLandmark, AvmLiveStats, c_value,
+                   fn, set_field, text)
 
 FrameLike = Union[Landmarks, Mapping[str, Any]]
 
@@ -48,18 +49,21 @@ def _c_frame(frame: FrameLike) -> Tuple[AvmFrame, List[np.ndarray]]:
         raise InvalidArgumentError("push: expected Landmarks or a dict, got %s"
                                    % type(frame).__name__, 1)
     c = AvmFrame()
-    try:
-        c.t = float(t)
-    except (TypeError, ValueError):
-        raise InvalidArgumentError("push: t must be a number, got %r" % (t,), 1) from None
+    set_field(c, "t", t, "push: t (capture time, seconds)")
     keep: List[np.ndarray] = []
     for name, points in PARTS:
         value = get(name)
         if value is None:
             continue
-        a = _part_array(np.asarray(value, dtype=np.float32)[None], 1, name, points)[0]
-        if np.isnan(a[0, 0]):
+        try:
+            raw = np.asarray(value)
+        except (TypeError, ValueError) as e:  # e.g. ragged lists
+            raise InvalidArgumentError("landmarks.%s: not an array of numbers (%s)" % (name, e),
+                                       1) from None
+        block = _part_array(raw[None], 1, name, points)
+        if block is None or np.isnan(block[0, 0, 0]):
             continue  # not seen
+        a = block[0]
         if name == "face":
             c.face_count = FACE_POINTS_NO_IRIS if np.isnan(a[FACE_POINTS_NO_IRIS, 0]) \
                 else FACE_POINTS
@@ -92,19 +96,19 @@ class Solver(_Handle):
     """A per-frame solver (avm_solver): push frames in capture order, get each solved and
     One-Euro-filtered pose, sample the pose at render times. ``options`` as solve()'s
     (avm_solver_options' fields). Calls are serialised by a lock, so a Solver may be shared
-    between threads; different solvers run in parallel (the library releases the GIL)."""
+    between threads; close() waits for a call in flight, and calls after it raise
+    InvalidArgumentError("Solver is closed"). Different solvers run in parallel (the library
+    releases the GIL)."""
 
     _destroy_name = "avm_solver_destroy"
 
     def __init__(self, **options: Any) -> None:
         super().__init__()
-        self._lock = threading.Lock()
         o = solver_options(options)
         _check(fn("avm_solver_create")(o, ctypes.byref(self._h)), fn("avm_last_create_error")())
 
     def _call(self, name: str, *args: Any) -> None:
-        with self._lock:
-            h = self._handle()
+        with self._use() as h:
             st = fn(name)(h, *args)
             if st != _lib.OK:
                 _check(st, fn("avm_solver_last_error")(h))
@@ -115,8 +119,7 @@ class Solver(_Handle):
         previous one resets the solver first."""
         c, _keep = _c_frame(frame)
         rec = _rest_records()
-        with self._lock:
-            h = self._handle()
+        with self._use() as h:
             st = fn("avm_solver_push")(h, ctypes.byref(c))
             if st != _lib.OK:
                 _check(st, fn("avm_solver_last_error")(h))
@@ -127,7 +130,7 @@ class Solver(_Handle):
         """The pose at render time t (interpolated between the last frames, extrapolated a
         little past the newest, then held); Poses of length 1 with t = t."""
         rec = _rest_records()
-        self._call("avm_solver_sample", float(t), rec.ctypes.data)
+        self._call("avm_solver_sample", c_value(ctypes.c_double, t, "sample: t"), rec.ctypes.data)
         return Poses.from_records(rec)
 
     def reset(self) -> None:
@@ -141,13 +144,13 @@ class Solver(_Handle):
 class Retargeter(_Handle):
     """An avatar's rig bound to the proxy bones (avm_retargeter): proxy poses -> the rig's
     local joint rotations. ``mapping``: None / "auto" (the avatar's humanoid map, else the
-    best table), a table name ("mixamo", ...) or a ``.json`` table path."""
+    best table), a table name ("mixamo", ...) or a ``.json`` table path. Calls are serialised
+    (a lock); close() waits for a call in flight."""
 
     _destroy_name = "avm_retargeter_destroy"
 
     def __init__(self, avatar_path: PathLike, mapping: Optional[str] = None) -> None:
         super().__init__()
-        self._lock = threading.Lock()
         m = None if mapping is None else _path(mapping, "mapping")
         _check(fn("avm_retargeter_create")(_path(avatar_path, "avatar_path"), m,
                                            ctypes.byref(self._h)),
@@ -167,8 +170,9 @@ class Retargeter(_Handle):
     def bone_joint(self, bone: Union[int, str]) -> int:
         """The joint driven by proxy bone ``bone`` (index or VRM name), -1 when none."""
         from . import bone_index
-        b = bone_index(bone) if isinstance(bone, str) else int(bone)
-        return int(fn("avm_retargeter_bone_joint")(self._handle(), b))
+        b = bone_index(bone) if isinstance(bone, str) else c_value(ctypes.c_int, bone, "bone")
+        with self._use() as h:
+            return int(fn("avm_retargeter_bone_joint")(h, b))
 
     def apply(self, poses: Poses) -> Tuple[np.ndarray, np.ndarray]:
         """(rotations (N, J, 4) {x, y, z, w} local to each joint's parent, hips joint's
@@ -181,8 +185,7 @@ class Retargeter(_Handle):
         rot = np.empty((n, self.joint_count, 4), dtype=np.float32)
         hips = np.empty((n, 3), dtype=np.float32)
         if n:
-            with self._lock:
-                h = self._handle()
+            with self._use() as h:
                 st = fn("avm_retargeter_apply_poses")(h, rec.ctypes.data, n, rot.ctypes.data,
                                                       hips.ctypes.data)
                 if st != _lib.OK:
@@ -209,25 +212,24 @@ def _estimator_options(models: Optional[PathLike], hands: bool, face: bool, thre
     if folder is not None:
         o._models = _path(folder, "models")  # type: ignore[attr-defined]  # keep alive
         o.models_dir = o._models  # type: ignore[attr-defined]
-    if model not in _MODELS:
-        raise InvalidArgumentError("model %r: expected \"lite\", \"full\" or \"heavy\"" % model, 1)
-    if hand_model not in _HAND_MODELS:
-        raise InvalidArgumentError("hand_model %r: expected \"lite\" or \"full\"" % hand_model, 1)
+    if not isinstance(model, str) or model not in _MODELS:
+        raise InvalidArgumentError("model %r: expected \"lite\", \"full\" or \"heavy\""
+                                   % (model,), 1)
+    if not isinstance(hand_model, str) or hand_model not in _HAND_MODELS:
+        raise InvalidArgumentError("hand_model %r: expected \"lite\" or \"full\""
+                                   % (hand_model,), 1)
     o.model_complexity = _MODELS[model]
     o.hand_model_complexity = _HAND_MODELS[hand_model]
-    o.hands, o.face = bool(hands), bool(face)
-    o.mirrored, o.static_images = bool(mirrored), bool(static_images)
-    try:
-        o.threads = int(threads)
-    except (TypeError, ValueError):
-        raise InvalidArgumentError("threads: expected an integer, got %r" % (threads,), 1) \
-            from None
+    for name, value in (("hands", hands), ("face", face), ("mirrored", mirrored),
+                        ("static_images", static_images), ("threads", threads)):
+        set_field(o, name, value)
     return o
 
 
 def _c_image(image: Any) -> Tuple[AvmImage, np.ndarray]:
     """An avm_image over an (H, W, 3) RGB or (H, W, 4) RGBA uint8 array (rows may be
-    padded; anything else is copied to a contiguous array first)."""
+    padded; anything else is copied to a contiguous array first). A width, height or row
+    stride beyond int32_t raises InvalidArgumentError (ctypes would keep its low 32 bits)."""
     a = np.asarray(image)
     if a.dtype != np.uint8 or a.ndim != 3 or a.shape[2] not in (3, 4):
         raise InvalidArgumentError("image: expected an (H, W, 3) RGB or (H, W, 4) RGBA uint8 "
@@ -236,8 +238,9 @@ def _c_image(image: Any) -> Tuple[AvmImage, np.ndarray]:
         a = np.ascontiguousarray(a)
     c = AvmImage()
     c.data = a.ctypes.data
-    c.height, c.width = a.shape[0], a.shape[1]
-    c.stride_bytes = a.strides[0]
+    set_field(c, "height", a.shape[0], "image height (shape[0])")
+    set_field(c, "width", a.shape[1], "image width (shape[1])")
+    set_field(c, "stride_bytes", a.strides[0], "image row stride (strides[0], bytes)")
     c.format = _lib.PIXEL_RGB8 if a.shape[2] == 3 else _lib.PIXEL_RGBA8
     return c, a
 
@@ -247,7 +250,8 @@ class Estimator(_Handle):
     steps on images you provide). ``models``: the converted models folder (default
     $AVATARMAP_MODELS/onnx, else the one recorded at install time); ``model`` "lite" |
     "full" | "heavy", ``hand_model`` "lite" | "full"; ``threads`` ONNX Runtime threads;
-    ``solver_options`` as solve()'s (their filter fields set the live filter)."""
+    ``solver_options`` as solve()'s (their filter fields set the live filter). Calls are
+    serialised (a lock); close() waits for a call in flight."""
 
     _destroy_name = "avm_estimator_destroy"
 
@@ -256,7 +260,6 @@ class Estimator(_Handle):
                  hand_model: str = "full", mirrored: bool = False, static_images: bool = False,
                  **solver_options_: Any) -> None:
         super().__init__()
-        self._lock = threading.Lock()
         eo = _estimator_options(models, hands, face, threads, model, hand_model, mirrored,
                                 static_images)
         so = solver_options(solver_options_)
@@ -267,15 +270,15 @@ class Estimator(_Handle):
         """Estimates the landmarks of one image (capture time t, increasing) and solves them:
         (Landmarks of one frame, NaN for parts not seen; Poses of one)."""
         c_image, _keep = _c_image(image)
+        t = c_value(ctypes.c_double, t, "process: t")
         frame = AvmFrame()
         rec = _rest_records()
-        with self._lock:
-            h = self._handle()
-            st = fn("avm_estimator_process")(h, ctypes.byref(c_image), float(t),
+        with self._use() as h:
+            st = fn("avm_estimator_process")(h, ctypes.byref(c_image), t,
                                              ctypes.byref(frame), rec.ctypes.data)
             if st != _lib.OK:
                 _check(st, fn("avm_estimator_last_error")(h))
-            landmarks = _landmarks_of(frame, float(t))
+            landmarks = _landmarks_of(frame, t)
         landmarks.image_width, landmarks.image_height = c_image.width, c_image.height
         return landmarks, Poses.from_records(rec)
 
@@ -294,11 +297,14 @@ class LiveStats:
 
 
 class Live(_Handle):
-    """A live capture (avm_live): a camera thread push()es images (copied, never waiting); a
-    worker thread processes the newest; any thread sample()s the pose. Options as
-    Estimator's. push() from one thread at a time; sample(), latest() and stats() from any."""
+    """A live capture (avm_live): a camera thread push()es images (copied, never waiting for
+    the worker); a worker thread processes the newest; any thread sample()s the pose. Options
+    as Estimator's. Any method from any thread: pushes from several threads take turns (a
+    lock), sample(), latest() and stats() run beside them. close() waits for the calls in
+    flight; calls after it raise InvalidArgumentError("Live is closed")."""
 
     _destroy_name = "avm_live_destroy"
+    _serial = False  # avm_live's functions are for different threads at once
 
     def __init__(self, models: Optional[PathLike] = None, *, hands: bool = True,
                  face: bool = True, threads: int = 2, model: str = "full",
@@ -312,30 +318,33 @@ class Live(_Handle):
         _check(fn("avm_live_create")(eo, so, ctypes.byref(self._h)),
                fn("avm_last_create_error")())
 
-    def _error(self, st: int) -> None:
+    @staticmethod
+    def _error(h: ctypes.c_void_p, st: int) -> None:
         buf = ctypes.create_string_buffer(_ERR_SIZE)
-        _check(st, fn("avm_live_last_error")(self._h, buf, _ERR_SIZE))
+        _check(st, fn("avm_live_last_error")(h, buf, _ERR_SIZE))
 
     def push(self, image: Any, t: float) -> None:
         """Hands an (H, W, 3|4) uint8 image with capture time t (increasing) to the worker."""
         c_image, _keep = _c_image(image)
-        with self._push_lock:
-            st = fn("avm_live_push")(self._handle(), ctypes.byref(c_image), float(t))
-        if st != _lib.OK:
-            self._error(st)
+        t = c_value(ctypes.c_double, t, "push: t")
+        with self._push_lock, self._use() as h:
+            st = fn("avm_live_push")(h, ctypes.byref(c_image), t)
+            if st != _lib.OK:
+                self._error(h, st)
 
     def _pose(self, name: str, *args: Any) -> Optional[Poses]:
         rec = _rest_records()
-        st = fn(name)(self._handle(), *args, rec.ctypes.data)
-        if st == _lib.ERROR_END_OF_FILE:
-            return None
-        if st != _lib.OK:
-            self._error(st)
+        with self._use() as h:
+            st = fn(name)(h, *args, rec.ctypes.data)
+            if st == _lib.ERROR_END_OF_FILE:
+                return None
+            if st != _lib.OK:
+                self._error(h, st)
         return Poses.from_records(rec)
 
     def sample(self, t: float) -> Optional[Poses]:
         """The pose at capture time t (Poses of one), None before the first processed image."""
-        return self._pose("avm_live_sample", float(t))
+        return self._pose("avm_live_sample", c_value(ctypes.c_double, t, "sample: t"))
 
     def latest(self) -> Optional[Poses]:
         """The newest processed pose, None before the first."""
@@ -343,15 +352,17 @@ class Live(_Handle):
 
     def stats(self) -> LiveStats:
         s = AvmLiveStats()
-        st = fn("avm_live_get_stats")(self._handle(), ctypes.byref(s))
-        if st != _lib.OK:
-            self._error(st)
+        with self._use() as h:
+            st = fn("avm_live_get_stats")(h, ctypes.byref(s))
+            if st != _lib.OK:
+                self._error(h, st)
         return LiveStats(**{name: getattr(s, name) for name, _ in AvmLiveStats._fields_})
 
     def last_error(self) -> str:
         """The message of the last image the worker failed on ("" when none)."""
         buf = ctypes.create_string_buffer(_ERR_SIZE)
-        return text(fn("avm_live_last_error")(self._handle(), buf, _ERR_SIZE))
+        with self._use() as h:
+            return text(fn("avm_live_last_error")(h, buf, _ERR_SIZE))
 
 
 @dataclass

@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import math
+import numbers
 import os
-from typing import Callable, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -37,6 +39,8 @@ FILE_FILTERS = {"offline": 0, "live": 1, "none": 2}
 # avm_pixel_format
 PIXEL_RGB8 = 0
 PIXEL_RGBA8 = 2
+
+BOOL = "bool"  # a _kinds_ value: an int32_t field that holds 0 or 1
 
 _I32, _F32, _F64, _I64, _U32 = (ctypes.c_int32, ctypes.c_float, ctypes.c_double,
                                 ctypes.c_int64, ctypes.c_uint32)
@@ -73,7 +77,8 @@ POSE_DTYPE = np.dtype([("t", "<f8"), ("hips_position", "<f4", (3,)),
 
 
 class AvmSolverOptions(ctypes.Structure):
-    # Field order as in the header; new fields are only ever appended there.
+    # Field order as in the header; new fields are only ever appended there. _kinds_ and
+    # _ranges_ say how set_field() checks a value (see c_value()).
     _fields_ = [
         ("struct_size", _U32),
         ("mirror", _I32), ("image_width", _F32), ("image_height", _F32),
@@ -94,6 +99,10 @@ class AvmSolverOptions(ctypes.Structure):
         ("file_filter", _I32), ("file_smoothing", _F32), ("file_threads", _I32),
         ("fit_hand_shape", _I32),
     ]
+    _kinds_ = {name: BOOL for name in (
+        "mirror", "solve_body", "solve_hands", "solve_face", "solve_hips_translation",
+        "filter_rotations", "filter_position", "filter_expressions", "fit_hand_shape")}
+    _ranges_ = {"file_filter": (0, 2)}  # avm_file_filter
 
 
 class AvmFrameBlock(ctypes.Structure):
@@ -112,6 +121,8 @@ class AvmEstimatorOptions(ctypes.Structure):
                 ("model_complexity", _I32), ("hands", _I32), ("face", _I32),
                 ("hand_model_complexity", _I32), ("threads", _I32), ("mirrored", _I32),
                 ("static_images", _I32)]
+    _kinds_ = {name: BOOL for name in ("hands", "face", "mirrored", "static_images")}
+    _ranges_ = {"model_complexity": (0, 2), "hand_model_complexity": (0, 1)}
 
 
 class AvmLiveStats(ctypes.Structure):
@@ -126,6 +137,118 @@ class AvmCaptureSummary(ctypes.Structure):
                 ("face_frames", _I64), ("frames_not_decoded", _I64),
                 ("image_width", _I32), ("image_height", _I32), ("fps", _F64),
                 ("seconds", _F64)]
+
+
+# ---- Python values into C fields and arguments --------------------------------------------
+# One check for every number the package hands to C: ctypes itself stores 2**32 in an int32_t
+# as 0 and 1e39 in a float as inf, without a word.
+
+def _int_range(ctype: Any) -> Tuple[int, int]:
+    bits = 8 * ctypes.sizeof(ctype)
+    if ctype(-1).value == -1:  # signed
+        return -(1 << (bits - 1)), (1 << (bits - 1)) - 1
+    return 0, (1 << bits) - 1
+
+
+_C_NAMES = {ctypes.c_int8: "int8_t", ctypes.c_int16: "int16_t", ctypes.c_int32: "int32_t",
+            ctypes.c_int64: "int64_t", ctypes.c_uint8: "uint8_t", ctypes.c_uint16: "uint16_t",
+            ctypes.c_uint32: "uint32_t", ctypes.c_uint64: "uint64_t", ctypes.c_float: "float",
+            ctypes.c_double: "double"}
+_FLOAT_MAX = {ctypes.c_float: float(np.finfo(np.float32).max),
+              ctypes.c_double: float(np.finfo(np.float64).max)}
+
+
+_INT_LIMITS = {t: _int_range(t) for t in (ctypes.c_int8, ctypes.c_int16, ctypes.c_int32,
+                                           ctypes.c_int64, ctypes.c_uint8, ctypes.c_uint16,
+                                           ctypes.c_uint32, ctypes.c_uint64, ctypes.c_size_t,
+                                           ctypes.c_int)}
+
+
+def _c_name(ctype: Any) -> str:
+    if ctype is ctypes.c_size_t:  # an alias of c_ulong or c_ulonglong
+        return "size_t"
+    return _C_NAMES.get(ctype, ctype.__name__)
+
+
+def _shown(value: Any) -> str:
+    """A value for a message: short (a hostile int may have thousands of digits)."""
+    if isinstance(value, numbers.Integral) and not isinstance(value, (bool, np.bool_)) \
+            and int(value).bit_length() > 64:
+        return "an integer of %d bits" % int(value).bit_length()
+    try:
+        text = repr(value)
+    except Exception:  # noqa: BLE001 - any object's repr may fail
+        text = "a %s" % type(value).__name__
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def c_value(ctype: Any, value: Any, what: str, kind: Optional[str] = None,
+            low: Optional[float] = None, high: Optional[float] = None) -> Any:
+    """`value` as ctypes type `ctype` will hold it unchanged, or InvalidArgumentError naming
+    `what` and the allowed range:
+
+    - kind BOOL (an int32_t flag): True/False (NumPy's too) or the integers 0 and 1;
+    - an integer type: an integer (int or NumPy integer; not a bool, not a float) within the
+      type's range (int32_t, uint32_t, int64_t, size_t, ...) and [low, high] when given;
+    - float or double: a real number (not a bool), finite, within the type's range (a float
+      holds at most 3.4e38) and [low, high] when given. The C API takes no NaN or infinity in
+      any scalar field or argument (non-finite landmarks are arrays, not these).
+    """
+    if kind is None and low is None and high is None:  # the common cases, fast
+        if type(value) is float and ctype in _FLOAT_MAX and -_FLOAT_MAX[ctype] <= value <= \
+                _FLOAT_MAX[ctype]:
+            return value  # (NaN fails the comparison)
+        if type(value) is int and ctype in _INT_LIMITS and \
+                _INT_LIMITS[ctype][0] <= value <= _INT_LIMITS[ctype][1]:
+            return value
+    from ._errors import InvalidArgumentError
+    is_bool = isinstance(value, (bool, np.bool_))
+    if kind == BOOL:
+        if is_bool:
+            return int(bool(value))
+        if isinstance(value, numbers.Integral) and int(value) in (0, 1):
+            return int(value)
+        raise InvalidArgumentError("%s: expected a bool (True or False, or 0 or 1), got %s"
+                                   % (what, _shown(value)), 1)
+    if ctype in _FLOAT_MAX:
+        if is_bool or not isinstance(value, numbers.Real):
+            raise InvalidArgumentError("%s: expected a number, got %s (%s)"
+                                       % (what, _shown(value), type(value).__name__), 1)
+        top = _FLOAT_MAX[ctype]
+        try:
+            v = float(value)
+        except OverflowError:  # an int beyond a double's range
+            v = math.inf if value > 0 else -math.inf
+        lo = -top if low is None else low
+        hi = top if high is None else high
+        if not (math.isfinite(v) and lo <= v <= hi):
+            raise InvalidArgumentError(
+                "%s: expected a finite number in [%.9g, %.9g] (the C field is a %s), got %s"
+                % (what, lo, hi, _c_name(ctype), _shown(value)), 1)
+        return v
+    if is_bool or not isinstance(value, numbers.Integral):
+        raise InvalidArgumentError("%s: expected an integer, got %s (%s)"
+                                   % (what, _shown(value), type(value).__name__), 1)
+    v = int(value)
+    t_lo, t_hi = _int_range(ctype)
+    lo = t_lo if low is None else max(t_lo, int(low))
+    hi = t_hi if high is None else min(t_hi, int(high))
+    if not lo <= v <= hi:
+        raise InvalidArgumentError("%s: expected an integer in [%d, %d] (the C field is %s), "
+                                   "got %s" % (what, lo, hi, _c_name(ctype), _shown(v)), 1)
+    return v
+
+
+def set_field(struct: ctypes.Structure, name: str, value: Any,
+              what: Optional[str] = None) -> None:
+    """struct.name = value, checked by c_value() against the field's C type and the
+    struct's _kinds_ (BOOL) and _ranges_ ((low, high)); `what` names it in the error
+    (default: the field's name)."""
+    cls = type(struct)
+    ctype = dict(cls._fields_)[name]
+    low, high = getattr(cls, "_ranges_", {}).get(name, (None, None))
+    setattr(struct, name, c_value(ctype, value, what or name,
+                                  getattr(cls, "_kinds_", {}).get(name), low, high))
 
 
 PROGRESS_FN = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int64, ctypes.c_int64)

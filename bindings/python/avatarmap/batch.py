@@ -1,7 +1,7 @@
 """Batch conversion of many recordings on Dask distributed.
 
     python3 -m avatarmap.batch INPUTS... -o OUTDIR --to vrma|glb|bvh|pose [--avatar A]
-                               [--scheduler tcp://HOST:8786] [options]
+                               [--scheduler tcp://HOST:8786 | --dashboard [HOST:]PORT] [options]
 
 Each input file is one task: a video or image is captured (landmarks), landmarks are solved
 (proxy poses, offline smoothing) and the poses are written in the asked format; a
@@ -11,13 +11,22 @@ capture, one inference thread) at a time each; with ``--scheduler`` the same tas
 workers of an existing cluster, which must see the inputs and OUTDIR at the same paths and
 have this package installed.
 
+The local cluster listens on 127.0.0.1 only: its scheduler, its workers and their HTTP
+endpoints (``--host`` changes the scheduler's and workers' address); the dashboard is off
+unless ``--dashboard [HOST:]PORT`` asks for it (on 127.0.0.1 unless HOST says otherwise). An
+address beyond loopback, asked for with these options or as a remote ``--scheduler``, is
+named in a warning: Dask's connections are neither authenticated nor encrypted without TLS,
+and whoever reaches a scheduler runs code on its workers.
+
 Outputs are ``OUTDIR/STEM.EXT``. A task writes in a folder of its own under
 ``OUTDIR/.avatarmap-batch/`` and renames the finished file into place, so OUTDIR never holds
 a partial output, even when a worker dies (Dask then runs the task again elsewhere). A run
 skips the outputs that already exist (``--force`` redoes them), so a stopped batch is resumed
 by running the same command again. A file that fails is reported with its reason and the
 others go on. The closing table lists every file, its frames and speed, and the failures;
-the exit status is 0 when nothing failed, 1 when a file failed, 2 on bad usage.
+the exit status is 0 when nothing failed, 1 when a file failed (or the scheduler could not
+be reached), 2 on bad usage (options, OUTDIR a file or not creatable, an address Dask cannot
+use). Messages name every address with its password masked (``user:***@``).
 See docs/python.md.
 """
 
@@ -25,13 +34,17 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import ipaddress
 import logging
 import os
+import re
 import shutil
+import socket
+import stat
 import sys
 import time
 import uuid
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 VIDEO_SUFFIXES = (".mp4", ".mkv", ".avi", ".mov", ".webm", ".m4v", ".mpg", ".mpeg", ".ts",
                   ".flv", ".wmv", ".y4m")
@@ -40,6 +53,145 @@ LANDMARKS_SUFFIX = ".landmarks.jsonl"
 POSE_SUFFIX = ".pose.jsonl"
 OUTPUT_SUFFIXES = {"vrma": ".vrma", "glb": ".glb", "bvh": ".bvh", "pose": POSE_SUFFIX}
 WORK_FOLDER = ".avatarmap-batch"
+LOOPBACK = "127.0.0.1"
+PROG = "avatarmap.batch"
+
+
+class UsageError(Exception):
+    """Bad usage: the message is printed as "avatarmap.batch: error: ..." and the exit status
+    is 2."""
+
+
+# ---- messages -----------------------------------------------------------------------------
+
+_CREDENTIALS = re.compile(r"(?P<scheme>\b[A-Za-z][A-Za-z0-9+.-]*:/+)(?P<user>[^\s/@:]*):"
+                          r"(?P<password>[^\s/@]*)@")
+
+
+def redact(text: str) -> str:
+    """`text` with the password of every URL in it masked: scheme://user:***@host."""
+    return _CREDENTIALS.sub(lambda m: "%s%s:***@" % (m.group("scheme"), m.group("user")),
+                            str(text))
+
+
+def warn(message: str) -> None:
+    print("%s: warning: %s" % (PROG, redact(message)), file=sys.stderr, flush=True)
+
+
+class _RedactLogs(logging.Filter):
+    """Masks passwords in log records (Dask's own messages may quote an address)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        try:
+            message = record.getMessage()
+        except Exception:  # noqa: BLE001 - a bad record is logging's to report
+            return True
+        masked = redact(message)
+        if masked != message:
+            record.msg, record.args = masked, None
+        return True
+
+
+def _redact_logs() -> None:
+    """Installs _RedactLogs on the handlers of the root and Dask's loggers (filters on a
+    logger do not apply to its children's records; handlers see them all)."""
+    for name in (None, "distributed", "dask"):
+        for handler in logging.getLogger(name).handlers:
+            if not any(isinstance(f, _RedactLogs) for f in handler.filters):
+                handler.addFilter(_RedactLogs())
+
+
+# ---- addresses ----------------------------------------------------------------------------
+
+
+def _is_loopback(host: str) -> bool:
+    """Whether every address `host` names is a loopback one (a name is resolved; a name that
+    does not resolve counts as not loopback)."""
+    host = host.strip("[]")
+    if host.lower() == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        pass
+    try:
+        infos = socket.getaddrinfo(host, None)
+    except (OSError, UnicodeError):
+        return False
+    return bool(infos) and all(ipaddress.ip_address(i[4][0].split("%")[0]).is_loopback
+                               for i in infos)
+
+
+def _check_host(host: str, option: str) -> str:
+    """A host for the local cluster to listen on: an IPv4 address or a name (Dask's
+    dashboard addresses take no IPv6 literal)."""
+    if not host or ":" in host or "/" in host or any(c.isspace() for c in host):
+        raise UsageError("%s %r: expected an IPv4 address or a host name (e.g. 127.0.0.1)"
+                         % (option, host))
+    return host
+
+
+def parse_dashboard(value: str) -> Tuple[str, int]:
+    """--dashboard [HOST:]PORT -> (host, port); HOST defaults to 127.0.0.1 (also for
+    ":PORT", which Dask itself reads as every interface)."""
+    host, sep, port = value.rpartition(":")
+    if not sep:
+        host = ""
+    try:
+        number = int(port)
+    except ValueError:
+        number = -1
+    if not 0 <= number <= 65535:
+        raise UsageError("--dashboard %r: expected [HOST:]PORT with PORT 0 .. 65535 (0: any "
+                         "free port)" % value)
+    return (_check_host(host, "--dashboard") if host else LOOPBACK), number
+
+
+def check_scheduler(address: str) -> str:
+    """The scheme of a --scheduler address Dask can connect to; UsageError otherwise."""
+    from distributed.comm import parse_address
+    from distributed.comm.addressing import parse_host_port
+    from distributed.comm.registry import get_backend
+    shown = redact(address)
+    try:
+        scheme, location = parse_address(address)
+        get_backend(scheme)
+        if scheme in ("tcp", "tls", "ws", "wss"):
+            if "@" in location:
+                raise ValueError("a Dask address holds no user or password")
+            parse_host_port(location)
+    except ValueError as e:
+        raise UsageError("--scheduler %s: %s (expected tcp://HOST:PORT, tls://HOST:PORT, ...)"
+                         % (shown, redact(str(e)))) from None
+    return scheme
+
+
+def _warn_exposure(args: argparse.Namespace) -> None:
+    """A warning for each address beyond loopback the options ask for."""
+    if args.scheduler:
+        from distributed.comm.addressing import get_address_host
+        scheme = check_scheduler(args.scheduler)
+        try:
+            host = get_address_host(args.scheduler)
+        except ValueError:
+            host = ""
+        if scheme != "inproc" and not _is_loopback(host):
+            warn("the scheduler %s is not on this machine: the tasks (file paths, options) and "
+                 "their results cross the network%s, and whoever can reach that scheduler runs "
+                 "code on its workers" % (args.scheduler, "" if scheme in ("tls", "wss") else
+                                          " unencrypted and unauthenticated (%s://; tls:// "
+                                          "or an SSH tunnel protects them)" % scheme))
+        return
+    if not _is_loopback(args.host):
+        warn("--host %s: the local cluster's scheduler and workers listen on %s, reachable "
+             "from other machines; whoever reaches them runs code as you (Dask has no "
+             "authentication without TLS)" % (args.host, "every interface"
+                                                if args.host == "0.0.0.0" else args.host))
+    if args.dashboard is not None and not _is_loopback(args.dashboard[0]):
+        warn("--dashboard %s:%d: Dask's dashboard (task and file names, the workers' state) "
+             "is served to %s without authentication"
+             % (args.dashboard[0], args.dashboard[1], "every interface"
+                if args.dashboard[0] == "0.0.0.0" else "other machines"))
 
 
 @dataclasses.dataclass
@@ -76,19 +228,54 @@ def input_kind(path: str) -> Optional[Tuple[str, str]]:
     return None
 
 
-def plan(inputs: Sequence[str], outdir: str, to: str) -> Tuple[List[Task], List[Result]]:
+_URL = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
+
+
+def _not_a_file(path: str) -> str:
+    """Why `path` is no regular file we can read ("" when it is one)."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        if os.path.islink(path):
+            return "a dangling symbolic link (to %s, which does not exist)" % os.readlink(path)
+        return "no such file"
+    except OSError as e:
+        return "cannot be read (%s)" % (e.strerror or e)
+    if stat.S_ISREG(st.st_mode):
+        return ""
+    kinds = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISSOCK, "a socket"),
+             (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"))
+    return "not a regular file (%s)" % next((name for test, name in kinds
+                                             if test(st.st_mode)), "special")
+
+
+def plan(inputs: Sequence[str], outdir: str, to: str,
+         warn: Callable[[str], None] = warn) -> Tuple[List[Task], List[Result]]:
     """Tasks for the inputs (folders give the files in them that we read, sorted), and the
-    inputs that cannot be tasks (missing, unknown type, two inputs onto one output) as failed
-    results; a *.pose.jsonl that is its own output (OUTDIR read as input with --to pose) is
-    skipped."""
+    inputs that cannot be tasks (missing, a dangling link, not a regular file, a URL, unknown
+    type, two inputs onto one output) as failed results; a *.pose.jsonl that is its own output
+    (OUTDIR read as input with --to pose) is skipped. Entries of a folder named as inputs
+    that are no regular file (a dangling symbolic link, a FIFO, ...) are skipped with a
+    warning each, through `warn`."""
     tasks: List[Task] = []
     bad: List[Result] = []
     by_output: Dict[str, Task] = {}
     suffix = OUTPUT_SUFFIXES[to]
     for given in inputs:
+        if _URL.match(given):
+            bad.append(Result(given, status="failed",
+                              reason="a URL: the batch reads files (capture it to a file first)"))
+            continue
         if os.path.isdir(given):
-            names = sorted(n for n in os.listdir(given)
-                           if input_kind(n) and os.path.isfile(os.path.join(given, n)))
+            names = []
+            for n in sorted(os.listdir(given)):
+                if not input_kind(n):
+                    continue
+                why = _not_a_file(os.path.join(given, n))
+                if why:
+                    warn("%s: skipped: %s" % (os.path.join(given, n), why))
+                else:
+                    names.append(n)
             if not names:
                 bad.append(Result(given, status="failed",
                                   reason="a folder with no video, image, *.landmarks.jsonl or "
@@ -99,8 +286,9 @@ def plan(inputs: Sequence[str], outdir: str, to: str) -> Tuple[List[Task], List[
         for p in paths:
             path = os.path.abspath(p)
             kind = input_kind(path)
-            if not os.path.isfile(path):
-                bad.append(Result(path, status="failed", reason="no such file"))
+            why = _not_a_file(path)
+            if why:
+                bad.append(Result(path, status="failed", reason=why))
                 continue
             if kind is None:
                 bad.append(Result(path, status="failed",
@@ -192,44 +380,60 @@ def _remove_work_folder(outdir: str) -> None:
 def _format_table(results: List[Result], wall: float, startup: float = 0.0,
                   out=sys.stdout) -> None:
     """The closing table. `wall`: from the first task handed to Dask to the last result;
-    `startup`: connecting to (or starting) the cluster before that."""
+    `startup`: connecting to (or starting) the cluster before that. Passwords in paths and
+    reasons are masked."""
+    def line(text: str = "") -> None:
+        out.write(redact(text) + "\n")
+
     done = [r for r in results if r.status == "ok"]
     skipped = [r for r in results if r.status == "skipped"]
     failed = [r for r in results if r.status == "failed"]
     frames = sum(r.frames for r in done)
     width = max([len(os.path.basename(r.input)) for r in results] + [4])
-    print("", file=out)
-    print("%-*s  %8s  %8s  %9s  %s" % (width, "file", "frames", "seconds", "frames/s", "result"),
-          file=out)
+    line()
+    line("%-*s  %8s  %8s  %9s  %s" % (width, "file", "frames", "seconds", "frames/s", "result"))
     for r in results:
         rate = "%9.1f" % (r.frames / r.seconds) if r.status == "ok" and r.seconds > 0 else \
             "%9s" % "-"
         what = {"ok": "-> " + r.output, "skipped": "skipped: %s exists" % r.output,
                 "failed": "FAILED"}[r.status]
-        print("%-*s  %8s  %8s  %s  %s" % (width, os.path.basename(r.input),
-                                           r.frames if r.status == "ok" else "-",
-                                           "%.2f" % r.seconds if r.status == "ok" else "-",
-                                           rate, what), file=out)
-    print("", file=out)
-    print("batch: %d files: %d converted, %d skipped (already done), %d failed; %d frames in "
-          "%.2f s: %.1f frames/s (cluster start-up %.2f s before)"
-          % (len(results), len(done), len(skipped), len(failed), frames, wall,
-             frames / wall if wall > 0 else 0.0, startup), file=out)
+        line("%-*s  %8s  %8s  %s  %s" % (width, os.path.basename(r.input),
+                                          r.frames if r.status == "ok" else "-",
+                                          "%.2f" % r.seconds if r.status == "ok" else "-",
+                                          rate, what))
+    line()
+    line("batch: %d files: %d converted, %d skipped (already done), %d failed; %d frames in "
+         "%.2f s: %.1f frames/s (cluster start-up %.2f s before)"
+         % (len(results), len(done), len(skipped), len(failed), frames, wall,
+            frames / wall if wall > 0 else 0.0, startup))
     if failed:
-        print("failures:", file=out)
+        line("failures:")
         for r in failed:
-            print("  %s: %s" % (r.input, r.reason), file=out)
+            line("  %s: %s" % (r.input, r.reason))
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # type: ignore[override]
+        self.print_usage(sys.stderr)
+        raise UsageError(message)
 
 
 def _parse(argv: Optional[Sequence[str]]) -> argparse.Namespace:
-    ap = argparse.ArgumentParser(
+    ap = _Parser(
         prog="python3 -m avatarmap.batch",
         description="Convert many recordings (videos, images, *.landmarks.jsonl, *.pose.jsonl) "
                     "to animation files on Dask distributed: one task per file, a local "
                     "cluster unless --scheduler is given. Finished outputs are skipped, so "
-                    "running the same command again resumes a stopped batch.")
+                    "running the same command again resumes a stopped batch.",
+        epilog="The local cluster listens on 127.0.0.1 only (scheduler, workers, their HTTP "
+               "endpoints) and has no dashboard unless --dashboard asks for one; any address "
+               "beyond loopback (--host, --dashboard, a remote --scheduler) is named in a "
+               "warning. Exit status: 0 all converted, 1 a file failed or the scheduler could "
+               "not be reached, 2 bad usage.")
     ap.add_argument("inputs", nargs="+", metavar="INPUT",
-                    help="files, or folders (the files in them that are inputs)")
+                    help="files, or folders (the files in them that are inputs; entries that "
+                         "are no regular file, such as dangling symbolic links, are skipped "
+                         "with a warning)")
     ap.add_argument("-o", "--output", required=True, metavar="OUTDIR",
                     help="folder of the outputs, OUTDIR/STEM.EXT (made when missing)")
     ap.add_argument("--to", required=True, choices=sorted(OUTPUT_SUFFIXES),
@@ -244,8 +448,16 @@ def _parse(argv: Optional[Sequence[str]]) -> argparse.Namespace:
                     help="output frame rate (default 30 as `avatarmap convert`; --to pose: "
                          "the frames' own times)")
     ap.add_argument("--scheduler", metavar="ADDRESS",
-                    help="an existing Dask scheduler (tcp://HOST:8786); default: a local "
-                         "cluster")
+                    help="an existing Dask scheduler (tcp://HOST:8786, tls://HOST:8786); "
+                         "default: a local cluster. A scheduler on another machine gets a "
+                         "warning: without tls:// the tasks cross the network unencrypted")
+    ap.add_argument("--host", default=LOOPBACK, metavar="HOST",
+                    help="local cluster: the address its scheduler and workers listen on "
+                         "(default 127.0.0.1; another one, e.g. 0.0.0.0, gets a warning)")
+    ap.add_argument("--dashboard", metavar="[HOST:]PORT",
+                    help="local cluster: serve Dask's dashboard on HOST:PORT (HOST default "
+                         "127.0.0.1; PORT 0: any free port; needs python3-bokeh). Default: "
+                         "no dashboard")
     ap.add_argument("--workers", type=int, default=0,
                     help="local cluster: worker processes (default: one per core)")
     ap.add_argument("--threads", type=int, default=1,
@@ -272,13 +484,31 @@ def _parse(argv: Optional[Sequence[str]]) -> argparse.Namespace:
         ap.error("--fps is 0 .. 1000 (0: the frames' own times)")
     if a.avatar and not os.path.isfile(a.avatar):
         ap.error("--avatar %s: no such file" % a.avatar)
+    if a.scheduler and (a.dashboard is not None or a.host != LOOPBACK):
+        ap.error("--host and --dashboard are for the local cluster (the scheduler at %s is "
+                 "configured where it runs)" % a.scheduler)
+    a.host = _check_host(a.host, "--host")
+    a.dashboard = parse_dashboard(a.dashboard) if a.dashboard is not None else None
     return a
 
 
+def _outdir(path: str) -> str:
+    """OUTDIR, made when missing; UsageError when it is a file or cannot be made."""
+    outdir = os.path.abspath(path)
+    if os.path.exists(outdir) and not os.path.isdir(outdir):
+        raise UsageError("OUTDIR %s is a file; give a folder (made when missing)" % path)
+    try:
+        os.makedirs(outdir, exist_ok=True)
+    except OSError as e:
+        raise UsageError("OUTDIR %s cannot be created: %s" % (path, e.strerror or e)) from None
+    if not os.access(outdir, os.W_OK | os.X_OK):
+        raise UsageError("OUTDIR %s is not writable" % path)
+    return outdir
+
+
 def run(args: argparse.Namespace, out=sys.stdout) -> int:
-    """The batch for parsed arguments; returns the exit status."""
-    outdir = os.path.abspath(args.output)
-    os.makedirs(outdir, exist_ok=True)
+    """The batch for parsed arguments; returns the exit status (UsageError: bad usage)."""
+    outdir = _outdir(args.output)
     tasks, results = plan(args.inputs, outdir, args.to)
     todo = []
     for t in tasks:
@@ -300,9 +530,38 @@ def run(args: argparse.Namespace, out=sys.stdout) -> int:
     return 1 if any(r.status == "failed" for r in results) else 0
 
 
+class SchedulerError(Exception):
+    """The scheduler given by --scheduler could not be reached (exit status 1)."""
+
+
+def local_cluster(workers: int, host: str = LOOPBACK,
+                  dashboard: Optional[Tuple[str, int]] = None):  # -> distributed.LocalCluster
+    """The batch's local cluster: `workers` single-thread worker processes; the scheduler
+    and the workers listen on `host` (127.0.0.1 unless asked otherwise); every HTTP endpoint
+    (the scheduler's, each worker's) on 127.0.0.1 at a free port, except the scheduler's
+    dashboard when `dashboard` = (host, port) asks for one. Dask's own defaults would serve
+    the scheduler's HTTP on every interface at 8787 and each worker's on every interface."""
+    from distributed import LocalCluster, Nanny
+
+    class QuietNanny(Nanny):
+        """A nanny whose worker has no dashboard (LocalCluster turns a worker's dashboard on
+        whenever its HTTP address is given)."""
+
+        def __init__(self, *a, **kw):  # type: ignore[no-untyped-def]
+            kw["dashboard"] = False
+            super().__init__(*a, **kw)
+
+    http = "%s:%d" % dashboard if dashboard else "%s:0" % LOOPBACK
+    return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                        worker_class=QuietNanny, host=host, scheduler_port=0,
+                        dashboard_address=http, worker_dashboard_address="%s:0" % LOOPBACK,
+                        scheduler_kwargs={"dashboard": dashboard is not None},
+                        silence_logs=logging.ERROR)
+
+
 def _run_on_dask(todo: List[Task], options: dict, args: argparse.Namespace,
                  timing: dict) -> List[Result]:
-    from distributed import Client, LocalCluster, progress
+    from distributed import Client, progress
 
     t0 = time.perf_counter()
     cluster = None
@@ -310,11 +569,20 @@ def _run_on_dask(todo: List[Task], options: dict, args: argparse.Namespace,
         try:
             client = Client(args.scheduler, timeout=15)
         except (OSError, TimeoutError) as e:
-            raise SystemExit("batch: cannot reach the scheduler at %s: %s" % (args.scheduler, e))
+            raise SchedulerError("cannot reach the scheduler at %s: %s"
+                                 % (args.scheduler, e)) from None
     else:
-        workers = args.workers or os.cpu_count() or 1
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR)
+        cluster = local_cluster(args.workers or os.cpu_count() or 1, args.host, args.dashboard)
+        _redact_logs()
+        if args.host != LOOPBACK:
+            print("%s: scheduler at %s" % (PROG, cluster.scheduler_address), file=sys.stderr)
+        if args.dashboard:
+            print("%s: dashboard at %s" % (PROG, cluster.dashboard_link), file=sys.stderr)
+            try:
+                import bokeh  # noqa: F401
+            except ImportError:
+                warn("--dashboard: Bokeh is not installed (Debian: python3-bokeh); the "
+                     "dashboard's page only says so")
         client = Client(cluster)
     try:
         t1 = time.perf_counter()
@@ -347,12 +615,26 @@ def _run_on_dask(todo: List[Task], options: dict, args: argparse.Namespace,
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    args = _parse(argv)
     try:
+        args = _parse(argv)
+        _outdir(args.output)  # before Dask's import: a bad OUTDIR is said at once
+        try:
+            import distributed  # noqa: F401 - sets up Dask's log handlers, filtered below
+        except ImportError as e:
+            raise UsageError("Dask distributed is needed (Debian: python3-distributed): %s"
+                             % e) from None
+        _redact_logs()
+        _warn_exposure(args)
         return run(args)
+    except UsageError as e:
+        print("%s: error: %s" % (PROG, redact(str(e))), file=sys.stderr)
+        return 2
+    except SchedulerError as e:
+        print("%s: error: %s" % (PROG, redact(str(e))), file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
-        print("batch: interrupted; finished outputs are kept, run the same command to go on",
-              file=sys.stderr)
+        print("%s: interrupted; finished outputs are kept, run the same command to go on"
+              % PROG, file=sys.stderr)
         return 130
 
 
