@@ -45,10 +45,13 @@ struct option_spec {
   const char* name;
   bool has_value;
 };
+// Every estimator option `capture` takes (capture_setup's parse_estimator_options), which
+// `animate --help` lists; tests/cli/cli_test.sh checks each listed option is accepted.
 constexpr option_spec k_capture_options[] = {
-    {"--model", true},   {"--hand-model", true}, {"--threads", true},   {"--models", true},
-    {"--overlay", true}, {"--static", false},    {"--hands", false},    {"--no-hands", false},
-    {"--face", false},   {"--no-face", false},   {"--mirrored", false}, {"--progress", false},
+    {"--model", true},     {"--hand-model", true}, {"--threads", true},   {"--models", true},
+    {"--overlay", true},   {"--static", false},    {"--hands", false},    {"--no-hands", false},
+    {"--face", false},     {"--no-face", false},   {"--mirrored", false}, {"--progress", false},
+    {"--precision", true}, {"--lanes", true},      {"--spin", false},
 };
 constexpr option_spec k_convert_options[] = {
     {"--avatar", true},          {"--rig", true},       {"--bind", true},       {"--fps", true},

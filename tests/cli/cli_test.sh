@@ -285,6 +285,14 @@ open('black.png','wb').write(b'\\x89PNG\\r\\n\\x1a\\n'+chunk(b'IHDR',struct.pack
     expect_in err.txt "--avatar"
     run 2 animate in.mp4 -o out.vrma --bogus
     expect_in err.txt "unknown option --bogus"
+    # Every option `animate --help` lists is taken (it kept an older copy of capture's flags:
+    # --precision, --lanes and --spin were refused as unknown).
+    run 0 animate --help
+    for opt in $(grep -E '^  +-' out.txt | grep -oE -- '--[a-z][a-z-]*' | sort -u); do
+      [ "$opt" = --help ] && continue
+      "$exe" animate missing.mp4 -o out.vrma "$opt" x >opt_out.txt 2>opt_err.txt
+      grep -q "unknown option" opt_err.txt && fail "animate refuses $opt, which its --help lists"
+    done
     run 1 animate missing.mp4 -o out.vrma
     [ -e out.vrma ] && fail "a failed animate wrote its output"
     models="${AVATARMAP_MODELS:-}/onnx"
