@@ -50,7 +50,7 @@ if [ -n "$data" ] && [ -f "$avatar" ]; then
   run 0 convert clip.landmarks.jsonl -o Avatar.GLB --avatar "$avatar" --quiet
   if [ "$(head -c 4 Avatar.GLB)" = "glTF" ]; then ok; else fail "Avatar.GLB is not a GLB"; fi
 else
-  echo "AVATARMAP_TEST_DATA is not set: the avatar cases are skipped"
+  skip_part "AVATARMAP_TEST_DATA is not set: the avatar cases"
 fi
 no_temp
 

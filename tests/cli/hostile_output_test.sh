@@ -155,7 +155,7 @@ if [ -n "${AVATARMAP_TEST_DATA:-}" ] && [ -f "$avatar" ]; then
   rm -f .old.glb.tmp.XXXXXX  # ours, planted above: not a leftover
   no_temp .
 else
-  echo "note: AVATARMAP_TEST_DATA unset: .glb cases skipped" >&2
+  skip_part "AVATARMAP_TEST_DATA is not set: the .glb cases"
 fi
 
 # ---- guessable temporary names: a user's files untouched, symlinks not followed ------------

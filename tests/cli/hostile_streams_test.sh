@@ -69,7 +69,7 @@ if [ -n "${AVATARMAP_MODELS:-}" ] && [ -f "$video" ] && [ -d "$AVATARMAP_MODELS/
   [ "$status" -eq 0 ] && pass || fail "live --fps 0.01 --seconds 1 exited $status: $(head -c 500 err.txt)"
   [ -f slow.pose.jsonl ] && pass || fail "live --fps 0.01 wrote no output"
 else
-  echo "note: live --fps 0.01 not checked (needs AVATARMAP_MODELS with onnx/ and AVATARMAP_TEST_DATA)"
+  skip_part "live --fps 0.01 (needs AVATARMAP_MODELS with onnx/ and AVATARMAP_TEST_DATA)"
 fi
 
 finish

@@ -35,7 +35,7 @@ expect_in err.txt "junk.vrm"
 data="${AVATARMAP_TEST_DATA:-}"
 robot="$data/avatars/vrm1_debug_robot.vrm"
 if [ -z "$data" ] || [ ! -f "$robot" ]; then
-  echo "note: AVATARMAP_TEST_DATA unset: the cases with a real avatar are skipped"
+  skip_part "AVATARMAP_TEST_DATA is not set: the cases with a real avatar"
   finish
   exit
 fi
@@ -58,7 +58,7 @@ timeout 60 "$exe" view --avatar "$robot" --port 0 --seconds 20 --quiet >first.tx
 first=$!
 for _ in $(seq 100); do [ -s first.txt ] && break; sleep 0.1; done
 if grep -q "fetch_viewer_modules" first.err; then
-  echo "note: the viewer's modules are missing: the port-in-use case is skipped ($modules)"
+  skip_part "the viewer's modules are missing ($modules): the port-in-use case and those after it"
   wait "$first"
   finish
   exit

@@ -64,7 +64,7 @@ if [ -n "${AVATARMAP_TEST_DATA:-}" ] && [ -d "$AVATARMAP_TEST_DATA/avatars" ]; t
   expect_in err.txt "avatarmap inspect $avatars/gltf_cesium_man.glb"
   absent man.glb
 else
-  echo "AVATARMAP_TEST_DATA is not set: the mapping-table and rig cases are skipped"
+  skip_part "AVATARMAP_TEST_DATA is not set: the mapping-table and rig cases"
 fi
 
 finish
