@@ -23,6 +23,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "io/pose_text.hpp"
@@ -315,17 +316,20 @@ struct machine_names {
         add_name(a);
     }
   }
-  void add_name(std::string_view n) {
+  // A name as compared: lower case, without a trailing dot ("VM." names the same as "vm").
+  static std::string normalised(std::string_view n) {
     std::string l = lower(n);
     while (!l.empty() && l.back() == '.') l.pop_back();
-    if (!l.empty()) names.push_back(l);
+    return l;
+  }
+  void add_name(std::string_view n) {
+    if (std::string l = normalised(n); !l.empty()) names.push_back(std::move(l));
   }
   bool has(std::string_view host) const {
     ip_address ip;
     if (parse_ip(host, ip))
       return std::find(addresses.begin(), addresses.end(), ip) != addresses.end();
-    std::string l = lower(host);
-    while (!l.empty() && l.back() == '.') l.pop_back();
+    const std::string l = normalised(host);
     return !l.empty() && std::find(names.begin(), names.end(), l) != names.end();
   }
 };

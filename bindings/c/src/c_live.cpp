@@ -65,11 +65,13 @@ class live_call {
   ~live_call() {
     if (!entered_) return;
     live_registry& r = registry();
+    bool idle = false;
     {
       std::lock_guard<std::mutex> lock(r.m);
-      --r.in_flight[live_];
+      // Still registered: destroy takes a handle out only once its count is zero.
+      idle = --r.in_flight.find(live_)->second == 0;
     }
-    r.idle.notify_all();
+    if (idle) r.idle.notify_all();  // only destroy waits, and only for zero
   }
   live_call(const live_call&) = delete;
   live_call& operator=(const live_call&) = delete;

@@ -156,8 +156,6 @@ _C_NAMES = {ctypes.c_int8: "int8_t", ctypes.c_int16: "int16_t", ctypes.c_int32: 
             ctypes.c_double: "double"}
 _FLOAT_MAX = {ctypes.c_float: float(np.finfo(np.float32).max),
               ctypes.c_double: float(np.finfo(np.float64).max)}
-
-
 _INT_LIMITS = {t: _int_range(t) for t in (ctypes.c_int8, ctypes.c_int16, ctypes.c_int32,
                                            ctypes.c_int64, ctypes.c_uint8, ctypes.c_uint16,
                                            ctypes.c_uint32, ctypes.c_uint64, ctypes.c_size_t,
@@ -230,7 +228,7 @@ def c_value(ctype: Any, value: Any, what: str, kind: Optional[str] = None,
         raise InvalidArgumentError("%s: expected an integer, got %s (%s)"
                                    % (what, _shown(value), type(value).__name__), 1)
     v = int(value)
-    t_lo, t_hi = _int_range(ctype)
+    t_lo, t_hi = _INT_LIMITS.get(ctype) or _int_range(ctype)
     lo = t_lo if low is None else max(t_lo, int(low))
     hi = t_hi if high is None else min(t_hi, int(high))
     if not lo <= v <= hi:
