@@ -10,7 +10,7 @@
 #include <memory>
 #include <string>
 
-#include "../tests/onnx/onnx_support.hpp"
+#include "../tests/capture/onnx/onnx_support.hpp"
 #include "avatarmap/avatarmap.h"
 #include "avatarmap/capture/capture_pipeline.hpp"
 #include "support/test_data.hpp"

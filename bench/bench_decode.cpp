@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "avatarmap/capture/video_source.hpp"
+#include "avatarmap/media/video_source.hpp"
 #include "support/test_data.hpp"
 
 namespace avatarmap {

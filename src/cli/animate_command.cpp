@@ -15,7 +15,7 @@
 #include "avatarmap/jobs/clip_output.hpp"
 #include "cli/capture_setup.hpp"
 #include "cli/commands.hpp"
-#include "io/atomic_file.hpp"
+#include "common/atomic_file.hpp"
 
 namespace avatarmap::cli {
 namespace {

@@ -7,9 +7,9 @@
 #include <cstdio>
 #include <string>
 
+#include "avatarmap/capture/capture_file.hpp"
 #include "avatarmap/capture/estimator.hpp"
-#include "avatarmap/capture/video_source.hpp"
-#include "avatarmap/jobs/capture_file.hpp"
+#include "avatarmap/media/video_source.hpp"
 #include "cli/capture_setup.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"

@@ -2,7 +2,7 @@
 
 #include <cstdlib>
 
-#include "avatarmap/jobs/capture_file.hpp"
+#include "avatarmap/capture/capture_file.hpp"
 
 namespace avatarmap::cli {
 

@@ -8,7 +8,7 @@
 
 #include "avatarmap/capture/capture_pipeline.hpp"
 #include "avatarmap/capture/estimator.hpp"
-#include "avatarmap/capture/video_source.hpp"
+#include "avatarmap/media/video_source.hpp"
 #include "cli/cli_args.hpp"
 
 namespace avatarmap::cli {

@@ -22,7 +22,7 @@
 #include "cli/filter_option.hpp"
 #include "cli/rig_select.hpp"
 #include "cli/solve_job.hpp"
-#include "io/atomic_file.hpp"
+#include "common/atomic_file.hpp"
 
 namespace avatarmap::cli {
 namespace {

@@ -18,9 +18,9 @@
 #include <thread>
 
 #include "avatarmap/capture/capture_pipeline.hpp"
-#include "avatarmap/capture/live_capture.hpp"
-#include "avatarmap/capture/video_source.hpp"
 #include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/live/live_capture.hpp"
+#include "avatarmap/media/video_source.hpp"
 #include "avatarmap/stream/pose_server.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
 #include "cli/capture_setup.hpp"

@@ -11,7 +11,7 @@
 
 #include "avatarmap/version.hpp"
 #include "cli/commands.hpp"
-#include "io/atomic_file.hpp"
+#include "common/atomic_file.hpp"
 
 namespace {
 

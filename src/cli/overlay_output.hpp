@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "avatarmap/capture/estimator.hpp"
-#include "avatarmap/capture/video_writer.hpp"
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/media/video_writer.hpp"
 
 namespace avatarmap::cli {
 

@@ -6,9 +6,9 @@
 #include <cstring>
 #include <string_view>
 
+#include "common/text_output.hpp"
 #include "io/json_scan.hpp"
 #include "io/jsonl_reader_core.hpp"
-#include "io/text_output.hpp"
 
 #if AVATARMAP_HAVE_SIMDJSON
 #include <simdjson.h>

@@ -6,10 +6,10 @@
 #include <string_view>
 
 #include "avatarmap/core/rotation.hpp"
+#include "common/pose_text.hpp"
+#include "common/text_output.hpp"
 #include "io/json_scan.hpp"
 #include "io/jsonl_reader_core.hpp"
-#include "io/pose_text.hpp"
-#include "io/text_output.hpp"
 
 namespace avatarmap {
 

@@ -5,13 +5,13 @@
 #include <nlohmann/json.hpp>
 
 #include "avatarmap/io/landmark_file.hpp"
-#include "io/json_text.hpp"
+#include "common/json_text.hpp"
 
 namespace avatarmap {
 
 namespace {
 
-// The recordings are a few MB; the limits (io/json_limits.hpp) keep a hostile file from
+// The recordings are a few MB; the limits (common/json_limits.hpp) keep a hostile file from
 // nesting nlohmann's recursion into a stack overflow or reading without bound.
 status load_json(const std::string& path, nlohmann::json& out) {
   if (status s = io_detail::read_json_file(path, out); !s) return s;

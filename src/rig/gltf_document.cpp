@@ -16,7 +16,7 @@
 #include <new>
 #include <vector>
 
-#include "io/json_limits.hpp"
+#include "common/json_limits.hpp"
 
 namespace avatarmap::gltf_detail {
 namespace {

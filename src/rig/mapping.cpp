@@ -10,7 +10,7 @@
 #include <optional>
 
 #include "avatarmap/skeleton/expression.hpp"
-#include "io/json_text.hpp"
+#include "common/json_text.hpp"
 
 namespace avatarmap {
 
@@ -374,7 +374,7 @@ int mapping_table::mapped_count() const {
 status load_mapping_json(std::string_view text, const std::string& name, mapping_table& out) {
   out = mapping_table{};
   context c{name.empty() ? std::string("<mapping>") : name};
-  // Depth and size limits first, then the parse, errors in our words (io/json_text.hpp).
+  // Depth and size limits first, then the parse, errors in our words (common/json_text.hpp).
   json doc;
   if (status s = io_detail::parse_json_text(text, c.file, doc); !s) return s;
   return table_from_json(c, doc, name, out);

@@ -26,7 +26,7 @@
 #include <utility>
 #include <vector>
 
-#include "io/pose_text.hpp"
+#include "common/pose_text.hpp"
 
 #if defined(AVATARMAP_HAVE_WEBSOCKETS)
 #include <libwebsockets.h>

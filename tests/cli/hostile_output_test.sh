@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Hostile output paths: hostile_output_test.sh AVATARMAP_EXE WORK_DIR.
-# Every output goes through one atomic writer (src/io/atomic_file.hpp). Checks, through the
+# Every output goes through one atomic writer (src/common/atomic_file.hpp). Checks, through the
 # CLI: a missing folder, a folder as the output, a read-only folder and a file-size limit give
 # exit status 1 or 2 with the reason (errno text); a failed run never replaces an existing
 # output and never leaves a temporary file; a user's files at guessable temporary names are

@@ -27,7 +27,7 @@
 #include "avatarmap/capture/hand_pipeline.hpp"
 #include "avatarmap/capture/image_crop.hpp"
 #include "avatarmap/capture/pose_pipeline.hpp"
-#include "avatarmap/capture/video_source.hpp"
+#include "avatarmap/media/video_source.hpp"
 
 namespace avatarmap {
 namespace {

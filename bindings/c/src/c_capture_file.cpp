@@ -4,9 +4,9 @@
 #include <string>
 
 #include "avatarmap/avatarmap.h"
+#include "avatarmap/capture/capture_file.hpp"
 #include "avatarmap/capture/capture_pipeline.hpp"
-#include "avatarmap/capture/video_source.hpp"
-#include "avatarmap/jobs/capture_file.hpp"
+#include "avatarmap/media/video_source.hpp"
 #include "c_capture_options.hpp"
 #include "c_guard.hpp"
 

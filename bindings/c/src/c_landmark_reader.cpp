@@ -10,7 +10,7 @@
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "c_frame_block.hpp"
 #include "c_guard.hpp"
-#include "jobs/frame_prefetcher.hpp"
+#include "common/frame_prefetcher.hpp"
 
 namespace am = avatarmap;
 using namespace avatarmap::c_api;

@@ -8,7 +8,7 @@
 #include <unordered_map>
 
 #include "avatarmap/avatarmap.h"
-#include "avatarmap/capture/live_session.hpp"
+#include "avatarmap/live/live_session.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "c_capture_options.hpp"
 #include "c_frames.hpp"

@@ -11,36 +11,9 @@
 
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/media/image.hpp"
 
 namespace avatarmap {
-
-enum class pixel_format : std::uint8_t { rgb8, bgr8, rgba8, bgra8, gray8 };
-
-/// Bytes per pixel of `format` (0 for a value that is not one of them).
-constexpr int image_bytes_per_pixel(pixel_format format) {
-  switch (format) {
-    case pixel_format::rgb8:
-    case pixel_format::bgr8:
-      return 3;
-    case pixel_format::rgba8:
-    case pixel_format::bgra8:
-      return 4;
-    case pixel_format::gray8:
-      return 1;
-  }
-  return 0;
-}
-
-/// A view of pixels owned by the caller, valid for the duration of the call. Rows are
-/// `stride_bytes` apart (>= width * bytes per pixel). May be empty (data == nullptr) for
-/// backends that need no pixels (replay).
-struct image_view {
-  const std::uint8_t* data = nullptr;
-  int width = 0;
-  int height = 0;
-  int stride_bytes = 0;
-  pixel_format format = pixel_format::rgb8;
-};
 
 /// Arguments of one estimate() call; a struct so that fields can be added compatibly.
 struct estimate_args {

@@ -5,7 +5,7 @@
 // The first session of a model saves the graph ORT optimised (ORT_ENABLE_ALL) as an .onnx
 // whose weights sit in a separate data file; later sessions load that with the optimisers
 // off, and ORT maps the data file instead of parsing and copying it. Outputs are bitwise
-// the same as from the source model (tests/onnx/model_cache_test.cpp).
+// the same as from the source model (tests/capture/onnx/model_cache_test.cpp).
 //
 // Layout: <cache dir>/<stem>.<key>.onnx refers to its own <stem>.<key>.<unique>.data. The
 // key (16 hex digits) hashes what makes a saved graph valid: this cache's format, the ONNX
