@@ -4,6 +4,8 @@
 #include <cctype>
 #include <cstddef>
 
+#include "avatarmap/media/video_source.hpp"  // shown_input
+
 namespace avatarmap {
 
 namespace {

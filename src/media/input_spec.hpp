@@ -35,9 +35,6 @@ struct input_spec {
 ///  6. otherwise a path (a missing one: open() says so).
 input_spec classify_input(const std::string& text, bool exists);
 
-/// `text` as messages and logs show it: a URL's password (and a user name without one) is
-/// replaced by "***" ("rtsp://cam:secret@10.0.0.5/live" -> "rtsp://cam:***@10.0.0.5/live"),
-/// since what users paste from a camera's settings often carries them. Other texts unchanged.
-std::string shown_input(const std::string& text);
+// shown_input(): avatarmap/media/video_source.hpp (public: the capture job uses it).
 
 }  // namespace avatarmap

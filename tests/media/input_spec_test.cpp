@@ -7,6 +7,8 @@
 #include <string>
 #include <utility>
 
+#include "avatarmap/media/video_source.hpp"  // shown_input
+
 namespace avatarmap {
 namespace {
 

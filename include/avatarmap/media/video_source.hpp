@@ -179,4 +179,9 @@ video_source_inputs video_source_supported_inputs();
 /// call it from one thread, before decoding. No effect in a build without FFmpeg.
 void video_source_quiet_log(bool quiet);
 
+/// `text` as messages and logs show it: a URL's password (and a user name without one) is
+/// replaced by "***" ("rtsp://cam:secret@10.0.0.5/live" -> "rtsp://cam:***@10.0.0.5/live"),
+/// since what users paste from a camera's settings often carries them. Other texts unchanged.
+std::string shown_input(const std::string& text);
+
 }  // namespace avatarmap

@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "avatarmap/io/landmark_file.hpp"
+#include "avatarmap/media/video_source.hpp"  // shown_input
 #include "common/prefetch_ring.hpp"
-#include "media/input_spec.hpp"
 
 namespace avatarmap {
 
