@@ -50,9 +50,6 @@ class build_py_with_library(build_py):
             f.write('"""Written by setup.py when the package was built."""\n')
             f.write("LIBRARY = None  # the copy beside this file is used\n")
             f.write("BUILT_FROM = %r\n" % source)
-            f.write("MODELS_DIR = %r\n"
-                    % os.path.join(ROOT, ".cache", "avatarmap", "models", "onnx"))
-            f.write("MAPPINGS_DIR = %r\n" % os.path.join(ROOT, "mappings"))
 
 
 class BinaryDistribution(Distribution):

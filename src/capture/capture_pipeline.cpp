@@ -22,16 +22,33 @@ status check_image(const image_view& image) {
   return {};
 }
 
+namespace {
+// The stream of a capture pipeline: the live filter (or none), one pose per image.
+pose_stream_options stream_options(const capture_pipeline_options& o) {
+  pose_stream_options so;
+  so.solver = o.solver;
+  so.filters.filter_mode = pose_filter_mode::live;  // filter.enabled = false: none
+  so.filters.filter = o.filter;
+  so.resampler = o.resampler;
+  so.name = "capture";
+  return so;
+}
+}  // namespace
+
 status capture_pipeline_options::validate() const {
   if (status st = solver.validate(); !st.ok()) return st;
+  if (status st = stream_options(*this).validate(); !st.ok())
+    return status::error("capture_pipeline_options." + st.message());
   const estimator_backend_list list = estimator_backends();
   std::string names;
   for (int i = 0; i < list.count; ++i) {
     if (list.items[i].name == backend) return {};
     names += (i > 0 ? ", " : "") + std::string(list.items[i].name);
   }
-  return status::error("capture_pipeline_options.backend '" + backend +
-                       "' is not built in (this build has: " + names + ")");
+  // "onnx" is a backend a build without ONNX Runtime lacks (unsupported); others are unknown.
+  const std::string message = "capture_pipeline_options.backend '" + backend +
+                              "' is not built in (this build has: " + names + ")";
+  return backend == "onnx" ? status::unsupported(message) : status::invalid_argument(message);
 }
 
 status capture_pipeline::create(const capture_pipeline_options& options,
@@ -42,8 +59,7 @@ status capture_pipeline::create(const capture_pipeline_options& options,
   p->options_ = options;
   if (status st = create_estimator(options.backend, options.estimator, p->estimator_); !st.ok())
     return st;
-  p->solver_ = frame_solver(options.solver);
-  p->filter_ = pose_filter(options.filter);
+  p->stream_ = std::make_unique<pose_stream>(stream_options(options));
   p->args_.body = true;
   p->args_.hands = options.estimator.hands;
   p->args_.face = options.estimator.face;
@@ -55,6 +71,12 @@ capture_pipeline::~capture_pipeline() = default;
 
 status capture_pipeline::process(const image_view& image, double t, landmark_frame& frame,
                                  proxy_pose& pose) {
+  if (status st = estimate(image, t, frame); !st.ok()) return st;
+  solve(frame, pose);
+  return {};
+}
+
+status capture_pipeline::estimate(const image_view& image, double t, landmark_frame& frame) {
   if (!std::isfinite(t)) return status::error("capture time must be finite");
   // The replay backend needs no pixels; every other one does.
   if (options_.backend != "replay")
@@ -66,8 +88,7 @@ status capture_pipeline::process(const image_view& image, double t, landmark_fra
     solver_options so = options_.solver;
     so.image_width = static_cast<float>(image.width);
     so.image_height = static_cast<float>(image.height);
-    solver_ = frame_solver(so);
-    filter_.reset();
+    stream_->restart(so);
     solver_width_ = image.width;
     solver_height_ = image.height;
   }
@@ -75,19 +96,22 @@ status capture_pipeline::process(const image_view& image, double t, landmark_fra
   args_.t = t;
   if (status st = estimator_->estimate(args_, frame); !st.ok()) return st;
   frame.t = t;
-  solver_.solve(frame, pose);
-  filter_.apply(pose, pose);
-  pose.t = t;
   return {};
+}
+
+void capture_pipeline::solve(const landmark_frame& frame, proxy_pose& pose) {
+  // One pose per frame (the live filter or none, no grid): emit is called once.
+  stream_->push(frame, [&pose](const proxy_pose& p) {
+    pose = p;
+    return status{};
+  });
+  pose.t = frame.t;
 }
 
 const estimator_timings* capture_pipeline::last_timings() const {
   return estimator_->last_timings();
 }
 
-void capture_pipeline::reset() {
-  solver_.reset();
-  filter_.reset();
-}
+void capture_pipeline::reset() { stream_->reset(); }
 
 }  // namespace avatarmap

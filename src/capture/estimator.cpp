@@ -46,7 +46,7 @@ status replay_estimator::estimate(const estimate_args& args, landmark_frame& out
       out.clear();
       return status::error("end of recording");
     }
-    if (r == read_result::error) return status::error(reader_.error());
+    if (r == read_result::error) return status::failure(reader_.error_code(), reader_.error());
     break;
   }
   if (!args.body) {
@@ -101,8 +101,10 @@ status create_estimator(std::string_view name, const estimator_options& options,
     if (!names.empty()) names += ", ";
     names += list.items[i].name;
   }
-  return status::error("unknown estimator backend '" + std::string(name) +
-                       "' (available: " + names + ")");
+  // "onnx" names a backend that a build without ONNX Runtime lacks: unsupported, not unknown.
+  const std::string message =
+      "unknown estimator backend '" + std::string(name) + "' (available: " + names + ")";
+  return name == "onnx" ? status::unsupported(message) : status::invalid_argument(message);
 }
 
 }  // namespace avatarmap

@@ -1,6 +1,8 @@
 // `avatarmap animate VIDEO --avatar A -o OUT`: capture and convert chained in one command.
 // The landmarks go to a temporary file (or --keep-landmarks PATH), which `convert` then solves
-// and retargets; both stages keep their own options and messages.
+// and retargets; both stages keep their own options and messages. The flags each stage takes
+// are the ones it declares (its option tables and own flags: add_*_command_flag_specs), so
+// every flag `capture` or `convert` has is an `animate` flag too.
 #include <unistd.h>
 
 #include <cerrno>
@@ -15,6 +17,7 @@
 #include "avatarmap/jobs/clip_output.hpp"
 #include "cli/capture_setup.hpp"
 #include "cli/commands.hpp"
+#include "cli/option_flags.hpp"
 #include "common/atomic_file.hpp"
 
 namespace avatarmap::cli {
@@ -24,121 +27,115 @@ const char* k_animate_help =
     "Usage: avatarmap animate VIDEO -o OUT [--avatar AVATAR] [options]\n"
     "\n"
     "Video in, animation out, in one command: `avatarmap capture` (body, hands and face by\n"
-    "default) followed by `avatarmap convert` on its landmarks.\n"
+    "default) followed by `avatarmap convert` on its landmarks; each takes its own options\n"
+    "(below, as each command declares them) and prints its own messages.\n"
     "OUT: *.vrma (VRM Animation), *.glb (AVATAR with the motion), *.bvh (AVATAR's rig, or the\n"
     "proxy skeleton without --avatar), *.pose.jsonl\n"
     "\n"
-    "Options:\n"
-    "  -o, --output PATH        the animation (required; written atomically)\n"
-    "  --avatar FILE            the avatar to drive (.vrm, .glb, .gltf; required for .glb)\n"
-    "  --keep-landmarks PATH    keep the captured landmarks (*.landmarks.jsonl) there\n"
-    "  --overlay PATH           as for `capture`\n"
-    "  --rig, --bind, --fps, --ground, --no-root-motion, --filter, --smoothing, --mirror\n"
-    "                           as for `convert`\n"
-    "  --body-only              neither hands nor face (same as --no-hands --no-face)\n"
-    "  --quiet                  no progress and no summaries\n"
-    "\n"
-    "Capture options (--hands and --face are on unless turned off):\n";
+    "Options:\n";
 
-// Options of each stage: name -> takes a value.
-struct option_spec {
-  const char* name;
-  bool has_value;
-};
-// Every estimator option `capture` takes (capture_setup's parse_estimator_options), which
-// `animate --help` lists; tests/cli/cli_test.sh checks each listed option is accepted.
-constexpr option_spec k_capture_options[] = {
-    {"--model", true},     {"--hand-model", true}, {"--threads", true},   {"--models", true},
-    {"--overlay", true},   {"--static", false},    {"--hands", false},    {"--no-hands", false},
-    {"--face", false},     {"--no-face", false},   {"--mirrored", false}, {"--progress", false},
-    {"--precision", true}, {"--lanes", true},      {"--spin", false},
-};
-constexpr option_spec k_convert_options[] = {
-    {"--avatar", true},          {"--rig", true},       {"--bind", true},       {"--fps", true},
-    {"--filter", true},          {"--smoothing", true}, {"--image-size", true}, {"--ground", false},
-    {"--no-root-motion", false}, {"--mirror", false},
+// animate's own flags; every other flag is capture's or convert's.
+const cli_flag k_animate_flags[] = {
+    {"--output", "-o", "PATH", "the animation (required; written atomically)"},
+    {"--keep-landmarks", nullptr, "PATH", "keep the captured landmarks (*.landmarks.jsonl) there"},
+    {"--body-only", nullptr, nullptr, "neither hands nor face (same as --no-hands --no-face)"},
+    {"--quiet", nullptr, nullptr, "no progress and no summaries"},
 };
 
-// Whether `arg` is option `o` ("--name" or "--name=value").
-bool is_option(const std::string& arg, const option_spec& o) {
-  const std::string n = o.name;
-  return arg == n || (o.has_value && arg.rfind(n + "=", 0) == 0);
+// A flag of `specs` that `arg` is ("--name" or "--name=value"), or nullptr.
+const flag_spec* find_flag(const std::vector<flag_spec>& specs, const std::string& arg) {
+  for (const flag_spec& f : specs)
+    if (arg == f.name || (f.takes_value && arg.rfind(f.name + "=", 0) == 0)) return &f;
+  return nullptr;
+}
+
+// The flags handed to each stage: capture's and convert's own declarations, less animate's.
+struct stage_flags {
+  std::vector<flag_spec> own, capture, convert;
+  stage_flags() {
+    add_flag_specs(k_animate_flags, own);
+    std::vector<flag_spec> all;
+    add_capture_command_flag_specs(true, all);
+    for (flag_spec& f : all)
+      if (!find_flag(own, f.name)) capture.push_back(std::move(f));
+    all.clear();
+    add_convert_command_flag_specs(all);
+    for (flag_spec& f : all)
+      if (!find_flag(own, f.name) && !find_flag(capture, f.name)) convert.push_back(std::move(f));
+  }
+};
+
+std::string help_of(const std::vector<flag_spec>& specs) {
+  std::string out;
+  for (const flag_spec& f : specs) out += f.help;
+  return out;
 }
 
 }  // namespace
 
 int run_animate(int argc, char** argv) {
+  const stage_flags flags;
   std::vector<std::string> cap = {"avatarmap", "capture"};
   std::vector<std::string> conv = {"avatarmap", "convert"};
   std::string out_path, keep, input;
-  bool quiet = false, body_only = false, hands_given = false, face_given = false;
+  bool quiet = false, body_only = false, hands_given = false, face_given = false, avatar = false;
   for (int i = 2; i < argc; ++i) {
     const std::string s = argv[i];
     if (s == "--help" || s == "-h") {
       std::fputs(k_animate_help, stdout);
-      std::fputs(k_estimator_options_help, stdout);
+      std::fputs(help_of(flags.own).c_str(), stdout);
+      std::fputs(
+          "\nCapture options (as for `avatarmap capture`; hands and face on unless turned "
+          "off):\n",
+          stdout);
+      std::fputs(help_of(flags.capture).c_str(), stdout);
+      std::fputs("\nConvert options (as for `avatarmap convert`):\n", stdout);
+      std::fputs(help_of(flags.convert).c_str(), stdout);
       return 0;
     }
-    auto take_value = [&](std::string& dst) {
-      const size_t eq = s.find('=');
-      if (eq != std::string::npos && s.rfind("--", 0) == 0) {
-        dst = s.substr(eq + 1);
-        return true;
+    // A flag and, when it takes one, its value: "--name value" or "--name=value".
+    auto take = [&](const flag_spec& f, std::vector<std::string>* to, std::string* value) {
+      std::string v;
+      const bool joined = s.size() > f.name.size() && s[f.name.size()] == '=';
+      if (f.takes_value && joined) {
+        v = s.substr(f.name.size() + 1);
+      } else if (f.takes_value) {
+        if (i + 1 >= argc) {
+          std::fprintf(stderr, "avatarmap animate: %s needs a value\n", s.c_str());
+          return false;
+        }
+        v = argv[++i];
       }
-      if (i + 1 >= argc) return false;
-      dst = argv[++i];
+      if (to) {
+        to->push_back(f.name);
+        if (f.takes_value) to->push_back(v);
+      }
+      if (value) *value = v;
       return true;
     };
-    if (s == "-o" || s == "--output" || s.rfind("--output=", 0) == 0) {
-      if (!take_value(out_path)) {
-        std::fprintf(stderr, "avatarmap animate: %s needs a value\n", s.c_str());
-        return 2;
+    if (const flag_spec* f = find_flag(flags.own, s)) {
+      if (f->name == "--output" || f->name == "-o") {
+        if (!take(*f, nullptr, &out_path)) return 2;
+      } else if (f->name == "--keep-landmarks") {
+        if (!take(*f, nullptr, &keep)) return 2;
+      } else if (f->name == "--quiet") {
+        quiet = true;
+      } else if (f->name == "--body-only") {
+        body_only = true;
       }
       continue;
     }
-    if (s == "--keep-landmarks" || s.rfind("--keep-landmarks=", 0) == 0) {
-      if (!take_value(keep)) {
-        std::fprintf(stderr, "avatarmap animate: --keep-landmarks needs a path\n");
-        return 2;
-      }
+    if (const flag_spec* f = find_flag(flags.capture, s)) {
+      hands_given |= f->name == "--hands" || f->name == "--no-hands";
+      face_given |= f->name == "--face" || f->name == "--no-face";
+      if (!take(*f, &cap, nullptr)) return 2;
       continue;
     }
-    if (s == "--quiet") {
-      quiet = true;
+    if (const flag_spec* f = find_flag(flags.convert, s)) {
+      avatar |= f->name == "--avatar";
+      if (!take(*f, &conv, nullptr)) return 2;
       continue;
     }
-    if (s == "--body-only") {
-      body_only = true;
-      continue;
-    }
-    bool matched = false;
-    for (const option_spec& o : k_capture_options) {
-      if (!is_option(s, o)) continue;
-      matched = true;
-      hands_given |= s == "--hands" || s == "--no-hands";
-      face_given |= s == "--face" || s == "--no-face";
-      cap.push_back(s);
-      if (o.has_value && s.find('=') == std::string::npos) {
-        if (i + 1 >= argc) {
-          std::fprintf(stderr, "avatarmap animate: %s needs a value\n", s.c_str());
-          return 2;
-        }
-        cap.push_back(argv[++i]);
-      }
-    }
-    for (const option_spec& o : k_convert_options) {
-      if (matched || !is_option(s, o)) continue;
-      matched = true;
-      conv.push_back(s);
-      if (o.has_value && s.find('=') == std::string::npos) {
-        if (i + 1 >= argc) {
-          std::fprintf(stderr, "avatarmap animate: %s needs a value\n", s.c_str());
-          return 2;
-        }
-        conv.push_back(argv[++i]);
-      }
-    }
-    if (matched) continue;
     if (s.rfind("-", 0) == 0 && s != "-") {
       std::fprintf(stderr, "avatarmap animate: unknown option %s (see --help)\n", s.c_str());
       return 2;
@@ -161,9 +158,7 @@ int run_animate(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap animate: %s\n", st.message().c_str());
     return 2;
   }
-  bool has_avatar = false;
-  for (const std::string& c : conv) has_avatar |= c == "--avatar" || c.rfind("--avatar=", 0) == 0;
-  if (format->needs_avatar && !has_avatar) {
+  if (format->needs_avatar && !avatar) {
     std::fprintf(stderr, "avatarmap animate: .glb output needs --avatar AVATAR\n");
     return 2;
   }

@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "avatarmap/capture/capture_file.hpp"
 #include "avatarmap/capture/estimator.hpp"
@@ -13,6 +14,7 @@
 #include "cli/capture_setup.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
+#include "cli/option_flags.hpp"
 #include "cli/overlay_output.hpp"
 
 namespace avatarmap::cli {
@@ -30,27 +32,37 @@ const char* k_capture_help =
     "is read until it ends, stalls (--stall-seconds) or --seconds have passed; what was\n"
     "captured is written.\n"
     "\n"
-    "Options:\n"
-    "  -o, --output PATH     where to write the landmarks (required; written atomically)\n"
-    "  --overlay PATH        also draw the landmarks on the frames: PATH.mp4/.mkv/.avi writes\n"
-    "                        a video, PATH.png one image (the first frame) and a pattern like\n"
-    "                        overlay_%05d.png one image per frame\n"
-    "  --loop N              run over INPUT N times (times keep increasing; for soak tests;\n"
-    "                        files only)\n"
-    "  --seconds S           stop after S seconds of input (frame times)\n"
-    "  --progress / --quiet  force / silence the progress line (default: on a terminal)\n"
-    "\n";
-const char* k_capture_estimator_help = "Estimator options:\n";
+    "Options:\n";
+
+// capture's own flags (beside the estimator and input tables).
+const cli_flag k_capture_flags[] = {
+    {"--output", "-o", "PATH", "where to write the landmarks (required; written atomically)"},
+    {"--overlay", nullptr, "PATH",
+     "also draw the landmarks on the frames: PATH.mp4/.mkv/.avi writes a video, PATH.png one "
+     "image (the first frame) and a pattern like overlay_%05d.png one image per frame"},
+    {"--loop", nullptr, "N",
+     "run over INPUT N times (times keep increasing; for soak tests; files only)"},
+    {"--seconds", nullptr, "S", "stop after S seconds of input (frame times)"},
+    {"--progress", nullptr, nullptr, "force the progress line (default: on a terminal)"},
+    {"--quiet", nullptr, nullptr, "no progress line and no summary"},
+};
+const char* k_capture_estimator_help = "Estimator options (hands and face off unless asked):\n";
 
 }  // namespace
+
+void add_capture_command_flag_specs(bool hands_face_default, std::vector<flag_spec>& out) {
+  add_flag_specs(k_capture_flags, out);
+  add_capture_flag_specs(hands_face_default, out);
+}
 
 int run_capture(int argc, char** argv) {
   args a(argc, argv, 2);
   if (a.flag("--help") || a.flag("-h")) {
     std::fputs(k_capture_help, stdout);
-    std::fputs(k_input_options_help, stdout);
+    std::fputs((cli_flags_help(k_capture_flags) + "\n").c_str(), stdout);
+    std::fputs(input_options_help().c_str(), stdout);
     std::fputs(k_capture_estimator_help, stdout);
-    std::fputs(k_estimator_options_help, stdout);
+    std::fputs(estimator_options_help(false).c_str(), stdout);
     return 0;
   }
   std::string out_path, overlay_path, error;
@@ -102,7 +114,7 @@ int run_capture(int argc, char** argv) {
     job.on_open = [&](const video_info& info) {
       const status st =
           overlay.open(overlay_path, info.width, info.height, info.fps > 0 ? info.fps : 30.0);
-      return st.ok() ? st : status::error("--overlay: " + st.message());
+      return st.prefixed("--overlay: ");
     };
     job.on_frame = [&](const image_view& image, const landmark_frame& frame) {
       return overlay.write(image, frame);

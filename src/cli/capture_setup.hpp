@@ -5,36 +5,45 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "avatarmap/capture/capture_pipeline.hpp"
 #include "avatarmap/capture/estimator.hpp"
+#include "avatarmap/live/live_session.hpp"
 #include "avatarmap/media/video_source.hpp"
 #include "cli/cli_args.hpp"
+#include "cli/option_flags.hpp"
 
 namespace avatarmap::cli {
 
-/// The options' help lines (for the commands' --help texts).
-extern const char* const k_estimator_options_help;
+/// The estimator options' help lines (k_estimator_option_table's flags, with the command's
+/// defaults: `hands_face_default` is what --hands/--face default to).
+std::string estimator_options_help(bool hands_face_default);
 
-/// Reads --model, --hand-model, --threads, --models, --static, --hands, --face, --body-only,
-/// --mirrored. `hands_face_default` is what --hands/--face default to (animate: on). Returns
-/// false with a message for a bad value.
+/// Reads the flags of k_estimator_option_table (--model, --hands/--no-hands, --models, ...)
+/// over the table's defaults; `hands_face_default` is what --hands/--face default to (capture
+/// and live: off, animate: on). The models folder is find_resource()'s (io/resources.hpp) with
+/// --models as its explicit folder. Returns false with a message for a bad value.
 bool parse_estimator_options(args& a, bool hands_face_default, estimator_options& out,
                              std::string& error);
 
-/// The input options' help lines: what INPUT may be, and the device and live-input options.
-extern const char* const k_input_options_help;
+/// The input options' help lines: what INPUT may be, and the device and live-input options
+/// (k_video_source_option_table's flags).
+std::string input_options_help();
 
-/// Reads --video-size, --framerate, --input-format, --open-seconds and --stall-seconds into
-/// `out` (checked by video_source::open). False with a message for a value that is not a
-/// number.
+/// Reads the flags of k_video_source_option_table (--video-size, --framerate, --input-format,
+/// --open-seconds, --stall-seconds) into `out`. False with a message for a malformed or
+/// out-of-range value.
 bool parse_input_options(args& a, video_source_options& out, std::string& error);
+
+/// Appends the input and estimator flags (for animate, which hands them to capture), with the
+/// hands and face defaulting to `hands_face_default` in their help.
+void add_capture_flag_specs(bool hands_face_default, std::vector<flag_spec>& out);
 
 /// Creates the ONNX estimator; the error says how to get the models.
 status make_estimator(const estimator_options& options, std::unique_ptr<estimator>& out);
-/// The same for a capture pipeline (estimator + solver + live filter), with the same hint.
-status make_capture_pipeline(const capture_pipeline_options& options,
-                             std::unique_ptr<capture_pipeline>& out);
+/// The same for a live session (its capture pipeline's estimator), with the same hint.
+status make_live_session(const live_session_options& options, std::unique_ptr<live_session>& out);
 
 /// Sums of estimator_timings over frames, for the summary line.
 struct timing_totals {

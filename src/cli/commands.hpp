@@ -2,6 +2,10 @@
 // 1 failure while working (I/O, bad data), 2 wrong usage.
 #pragma once
 
+#include <vector>
+
+#include "cli/option_flags.hpp"
+
 namespace avatarmap::cli {
 
 int run_solve(int argc, char** argv);
@@ -17,5 +21,12 @@ int run_inspect(int argc, char** argv);
 int run_eval_pose(int argc, char** argv);
 int run_avatar(int argc, char** argv);
 int run_view(int argc, char** argv);
+int run_options(int argc, char** argv);
+
+/// Every flag `capture` takes (its own and its option tables'), as `animate` hands them on;
+/// the help says --hands/--face default to `hands_face_default`.
+void add_capture_command_flag_specs(bool hands_face_default, std::vector<flag_spec>& out);
+/// Every flag `convert` takes (its own and its option tables').
+void add_convert_command_flag_specs(std::vector<flag_spec>& out);
 
 }  // namespace avatarmap::cli

@@ -1,26 +1,21 @@
 // `avatarmap convert IN -o OUT [--avatar AVATAR] [--rig auto|NAME|FILE.json] [--fps N]`:
 // landmarks, proxy poses or VRM Animation in; VRMA, animated GLB, BVH or proxy poses out.
-#include <algorithm>
 #include <array>
-#include <chrono>
 #include <cstdio>
-#include <optional>
 #include <string>
 #include <vector>
 
-#include "avatarmap/export/vrma.hpp"
-#include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/core/limits.hpp"
 #include "avatarmap/jobs/clip_output.hpp"
-#include "avatarmap/jobs/solve_file.hpp"
-#include "avatarmap/rig/avatar_loader.hpp"
+#include "avatarmap/jobs/convert_file.hpp"
+#include "avatarmap/rig/bound_avatar.hpp"
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/skeleton/proxy_skeleton.hpp"
-#include "avatarmap/time/resample_clip.hpp"
 #include "avatarmap/time/seconds_text.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/filter_option.hpp"
-#include "cli/rig_select.hpp"
+#include "cli/option_flags.hpp"
 #include "cli/solve_job.hpp"
 #include "common/atomic_file.hpp"
 
@@ -35,77 +30,34 @@ const char* k_convert_help =
     "     *.bvh (centimetres, ZXY: the avatar's own rig with --avatar, else the proxy\n"
     "     skeleton), *.pose.jsonl\n"
     "\n"
-    "Options:\n"
-    "  -o, --output PATH     output file (required; written atomically)\n"
-    "  --avatar FILE         the avatar (.vrm, .glb, .gltf) to drive (required for .glb;\n"
-    "                        with .bvh: write its rig instead of the proxy skeleton)\n"
-    "  --rig auto|NAME|FILE.json\n"
-    "                        how the avatar's joints map to the proxy: auto (default) uses a\n"
-    "                        VRM's own humanoid map, else the best shipped table (mixamo,\n"
-    "                        unity_humanoid, ue4_mannequin, ue5_mannequin, character_creator,\n"
-    "                        ...); NAME picks a shipped table; FILE.json a table of yours\n"
-    "  --fps N               output frame rate (default 30; .pose.jsonl: the input's frames)\n"
-    "  --bind BONE=JOINT     bind a proxy bone (VRM 1.0 name) to an avatar joint, or to\n"
-    "                        none; repeatable; overrides --rig, and alone drives a rig no\n"
-    "                        table fits\n"
-    "  --ground              keep the avatar's lowest foot on the floor every frame\n"
-    "  --no-root-motion      keep the hips where they are at rest\n"
-    "  --mirror, --image-size WxH, --filter offline|live|none, --smoothing S\n"
-    "                        as for `avatarmap solve` (landmark input only)\n"
-    "  --quiet               no summary\n";
+    "Options:\n";
 
-// Whether `s` ends with the lower-case `suffix`, ignoring ASCII case (as output names are).
-bool ends_with_nocase(const std::string& s, const std::string& suffix) {
-  if (s.size() < suffix.size()) return false;
-  for (std::size_t i = 0; i < suffix.size(); ++i) {
-    char c = s[s.size() - suffix.size() + i];
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-    if (c != suffix[i]) return false;
-  }
-  return true;
-}
-
-status load_motion(const std::string& in, const solve_file_job& solve, std::vector<proxy_pose>& out,
-                   double& source_fps) {
-  out.clear();
-  source_fps = 0.0;
-  if (ends_with_nocase(in, ".vrma")) {
-    vrma_clip clip;
-    status st = read_vrma(in, clip);
-    if (!st.ok()) return st;
-    out = std::move(clip.frames);
-    return {};
-  }
-  if (ends_with_nocase(in, ".pose.jsonl")) {
-    pose_reader reader;
-    status st = reader.open(in);
-    if (!st.ok()) return st;
-    source_fps = reader.header().fps;
-    proxy_pose p;
-    for (;;) {
-      read_result r = reader.next(p);
-      if (r == read_result::end) break;
-      if (r == read_result::error) return status::error(reader.error());
-      out.push_back(p);
-    }
-    return {};
-  }
-  if (ends_with_nocase(in, ".jsonl") || in == "-") {
-    solve_file_job job = solve;
-    job.input = in;
-    job.sink = [&](const proxy_pose& p) {
-      out.push_back(p);
-      return status{};
-    };
-    solve_file_summary summary;
-    // A progress line on a terminal.
-    status st = run_solve_job(job, progress_mode::automatic, summary);
-    source_fps = summary.fps;  // the landmarks' nominal rate, as `avatarmap solve` writes it
-    return st;
-  }
-  return status::error(in +
-                       ": unknown input type (give *.landmarks.jsonl, *.pose.jsonl or *.vrma)");
-}
+// convert's own flags; the landmark solve's come from the solver and solve-file tables
+// (k_convert_solve_flags).
+const cli_flag k_convert_flags[] = {
+    {"--output", "-o", "PATH", "output file (required; written atomically)"},
+    {"--avatar", nullptr, "FILE",
+     "the avatar (.vrm, .glb, .gltf) to drive (required for .glb; with .bvh: write its rig "
+     "instead of the proxy skeleton)"},
+    {"--rig", nullptr, "auto|NAME|FILE.json",
+     "how the avatar's joints map to the proxy: auto (default) uses a VRM's own humanoid map, "
+     "else the best shipped table (mixamo, unity_humanoid, ue4_mannequin, ue5_mannequin, "
+     "character_creator, ...); NAME picks a shipped table; FILE.json a table of yours"},
+    {"--bind", nullptr, "BONE=JOINT",
+     "bind a proxy bone (VRM 1.0 name) to an avatar joint, or to none; repeatable; overrides "
+     "--rig, and alone drives a rig no table fits"},
+    {"--fps", nullptr, "N",
+     "output frame rate (default 30; .pose.jsonl: the input's frames; 0: the frames' own "
+     "times; at most 1000)"},
+    {"--ground", nullptr, nullptr, "keep the avatar's lowest foot on the floor every frame"},
+    {"--no-root-motion", nullptr, nullptr, "keep the hips where they are at rest"},
+    {"--image-size", nullptr, "WxH", "landmark input: image size in pixels, as for solve"},
+    {"--filter", nullptr, "offline|live|none", "landmark input: the filter, as for solve"},
+    {"--quiet", nullptr, nullptr, "no summary"},
+};
+// The solve-file table's flags convert takes for a landmark input (its --fps is the output's).
+#define AVATARMAP_CONVERT_SOLVE_FLAGS \
+  { "--smoothing", "--min-cutoff", "--beta", "--threads", "--skip-bad-lines" }
 
 void append_position(std::string& s, const std::string& name, glm::dvec3 p, bool first) {
   char buf[96];
@@ -157,188 +109,143 @@ status dump_positions(const std::string& path, double fps, const std::vector<pro
   return io_detail::write_file_atomically(path, s);
 }
 
+// What to do when the avatar's binding failed on its tables (parse: the table, or every
+// table, lacks bones the rig needs, or a table is malformed): the library says what did not
+// fit, the command line says which options change it.
+std::string binding_hint(const convert_file_job& job, const convert_file_summary& done,
+                         const status& st) {
+  if (!done.avatar || done.avatar->failed_step != bind_avatar_step::select ||
+      st.code() != status_code::parse)
+    return {};
+  const std::string& folder = done.avatar->mappings_folder;
+  return "\nTo drive this rig with convert or animate: name a table that fits with --rig NAME (" +
+         (folder.empty() ? std::string("a shipped table") : "a table in " + folder) +
+         ") or --rig FILE.json (your own, see docs/mappings.md), or bind the bones yourself with "
+         "--bind BONE=JOINT (repeatable, e.g. --bind hips=Pelvis; `avatarmap inspect " +
+         job.avatar + "` lists the joints)";
+}
+
 }  // namespace
+
+void add_convert_command_flag_specs(std::vector<flag_spec>& out) {
+  const solve_file_job start = make_cli_solve_job();
+  add_flag_specs(k_convert_flags, out);
+  add_flag_specs(k_solver_option_table, start.options, out);
+  add_flag_specs(k_solve_file_option_table, start, out, AVATARMAP_CONVERT_SOLVE_FLAGS);
+}
 
 int run_convert(int argc, char** argv) {
   args a(argc, argv, 2);
   if (a.flag("--help") || a.flag("-h")) {
+    const solve_file_job start = make_cli_solve_job();
     std::fputs(k_convert_help, stdout);
+    std::fputs(cli_flags_help(k_convert_flags).c_str(), stdout);
+    std::fputs("\nLandmark input (solved as by `avatarmap solve`):\n", stdout);
+    std::fputs(option_flags_help(k_solver_option_table, start.options).c_str(), stdout);
+    std::fputs(
+        option_flags_help(k_solve_file_option_table, start, AVATARMAP_CONVERT_SOLVE_FLAGS).c_str(),
+        stdout);
     return 0;
   }
-  std::string out_path, avatar, rig_option = "auto", value;
-  a.value("--output", out_path, "-o");
-  a.value("--avatar", avatar);
-  a.value("--rig", rig_option);
-  std::vector<std::string> binds;  // --bind BONE=JOINT, repeatable
-  while (a.value("--bind", value)) binds.push_back(value);
+  convert_file_job job;
+  job.avatar_name = "--avatar AVATAR";
+  job.binding.overrides_name = "--bind";
+  std::string value;
+  a.value("--output", job.output, "-o");
+  a.value("--avatar", job.avatar);
+  a.value("--rig", job.binding.rig);
+  while (a.value("--bind", value)) {  // --bind BONE=JOINT, repeatable
+    bone_override o;
+    if (status st = parse_bone_override(value, o); !st.ok()) {
+      std::fprintf(stderr, "avatarmap convert: --bind %s\n", st.message().c_str());
+      return 2;
+    }
+    job.binding.overrides.push_back(o);
+  }
   std::string dump_path;  // hidden diagnostic option, see dump_positions()
   a.value("--dump-positions", dump_path);
   double fps = 0.0;
   const bool fps_given = a.number("--fps", fps);
-  const bool ground = a.flag("--ground");
-  const bool root_motion = !a.flag("--no-root-motion");
+  job.keep_feet_on_ground = a.flag("--ground");
+  job.root_motion = !a.flag("--no-root-motion");
   const bool quiet = a.flag("--quiet");
-  solve_file_job solve = make_cli_solve_job();
-  solve.options.mirror = a.flag("--mirror");
+  job.solve = make_cli_solve_job();
+  std::string error;
+  if (!parse_option_flags(a, k_solver_option_table, job.solve.options, error) ||
+      !parse_option_flags(a, k_solve_file_option_table, job.solve, error,
+                          AVATARMAP_CONVERT_SOLVE_FLAGS)) {
+    std::fprintf(stderr, "avatarmap convert: %s\n", error.c_str());
+    return 2;
+  }
   if (a.value("--image-size", value)) {
     int w = 0, h = 0;
     if (!parse_image_size(value, w, h)) {
       std::fprintf(stderr, "avatarmap convert: --image-size wants WxH in pixels, e.g. 1280x720\n");
       return 2;
     }
-    solve.image_width = float(w);
-    solve.image_height = float(h);
+    job.solve.image_width = float(w);
+    job.solve.image_height = float(h);
   }
-  if (a.value("--filter", value) && !apply_filter_option(value, solve)) {
+  if (a.value("--filter", value) && !apply_filter_option(value, job.solve)) {
     std::fprintf(stderr, "avatarmap convert: --filter is %s, got '%s'\n", k_filter_names,
                  value.c_str());
     return 2;
   }
-  double smoothing = 1.0;
-  if (a.number("--smoothing", smoothing) && !apply_smoothing_option(smoothing, solve)) {
-    std::fprintf(stderr, "avatarmap convert: --smoothing is a scale in [0, 10] (1 = default)\n");
-    return 2;
-  }
-  if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 1 || out_path.empty()) {
+  if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 1 || job.output.empty()) {
     std::fprintf(stderr, "avatarmap convert: %s\n",
                  !a.error().empty()     ? a.error().c_str()
                  : a.rest().size() != 1 ? "give exactly one input file (see --help)"
                                         : "give the output with -o OUT (see --help)");
     return 2;
   }
-  if (fps_given && !(fps > 0.0 && fps <= 1000.0)) {
-    std::fprintf(stderr, "avatarmap convert: --fps must be in (0, 1000]\n");
+  if (fps_given && !(fps >= 0.0 && fps <= k_max_fps)) {
+    std::fprintf(stderr, "avatarmap convert: --fps must be 0 or in (0, %s], got %s\n",
+                 limit_text(k_max_fps).c_str(), limit_text(fps).c_str());
     return 2;
   }
-  const clip_format_info* format = nullptr;
-  if (status st = clip_format_for(out_path, format); !st.ok()) {
+  job.input = a.rest()[0];
+  // Without --fps: 30 frames/s, except .pose.jsonl, which keeps the frames' own times.
+  const clip_format_info* format = find_clip_format(job.output);
+  job.fps = fps_given                                                        ? fps
+            : format != nullptr && format->format == clip_format::pose_jsonl ? 0.0
+                                                                             : k_default_rig_fps;
+  if (status st = job.validate(); !st.ok()) {
     std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
     return 2;
   }
-  const bool to_pose = format->format == clip_format::pose_jsonl;
-  if (format->needs_avatar && avatar.empty()) {
-    std::fprintf(stderr,
-                 "avatarmap convert: .glb output needs --avatar AVATAR (the model to animate)\n");
-    return 2;
-  }
-  const auto t_start = std::chrono::steady_clock::now();
-
-  // The avatar first, so that a bad avatar fails before any long work.
-  raw_rig raw;
-  rig r;
-  rig_selection selection;
-  if (!avatar.empty()) {
-    status st = load_avatar(avatar, raw);
-    if (st.ok()) st = build_rig(raw, r);
-    if (st.ok()) {
-      st = select_rig_binding(r, rig_option, selection);
-      // A rig no table fits can still be driven by explicit --bind options alone.
-      if (!st.ok() && !binds.empty() && rig_option == "auto") {
-        selection.table = nullptr;
-        selection.binding.fill(-1);
-        selection.description = "bound by --bind only (no table fits)";
-        st = status{};
-      }
-    }
-    if (!st.ok()) {
-      std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
-      return 1;
-    }
-    for (const std::string& b : binds) {
-      const size_t eq = b.find('=');
-      const auto bone_id = eq == std::string::npos ? std::nullopt : bone_from_name(b.substr(0, eq));
-      if (!bone_id) {
-        std::fprintf(stderr,
-                     "avatarmap convert: --bind wants BONE=JOINT with a VRM 1.0 bone name "
-                     "(hips, leftUpperArm, ...), got '%s'\n",
-                     b.c_str());
-        return 2;
-      }
-      const std::string joint_name = b.substr(eq + 1);
-      const int joint = joint_name == "none" ? -1 : r.find(joint_name);
-      if (joint_name != "none" && joint < 0) {
-        std::fprintf(stderr,
-                     "avatarmap convert: --bind %s: the avatar has no joint '%s' (see `avatarmap "
-                     "inspect %s`)\n",
-                     b.c_str(), joint_name.c_str(), avatar.c_str());
-        return 1;
-      }
-      // A joint drives one bone: taking it from another bone unbinds that one.
-      for (int& j : selection.binding)
-        if (joint >= 0 && j == joint) j = -1;
-      selection.binding[idx(*bone_id)] = joint;
-    }
-    if (!binds.empty())
-      selection.description += "; " + std::to_string(binds.size()) + " binding(s) from --bind";
-  }
-
-  std::vector<proxy_pose> frames;
-  double source_fps = 0.0;
-  status st = load_motion(a.rest()[0], solve, frames, source_fps);
-  if (!st.ok()) {
-    std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
-    return 1;
-  }
-  if (frames.empty()) {
-    std::fprintf(stderr, "avatarmap convert: %s has no frames\n", a.rest()[0].c_str());
-    return 1;
-  }
-  const double out_fps = fps_given ? fps : k_default_rig_fps;
-  // Resampling needs the frames in time order; landmark and pose files need not be (a capture
-  // may end with a frame stamped before its first). Sorted here (stably, so at equal times the
-  // later line wins), with a warning; .pose.jsonl without --fps passes them through as read.
-  const bool pass_through = to_pose && !fps_given;
-  if (!pass_through) {
-    if (const std::size_t moved = sort_clip_by_time(frames); moved > 0)
-      std::fprintf(stderr,
-                   "avatarmap convert: warning: %zu frame(s) of %s were out of time order; "
-                   "sorted by time before resampling\n",
-                   moved, a.rest()[0].c_str());
-  }
-  // The library writes every format (clip_output_job): resampling bounded by resample_clip,
-  // avatar outputs (.glb, and .bvh with --avatar) retargeted onto the rig.
-  clip_output_job out;
-  out.path = out_path;
-  out.frames = &frames;
-  out.fps = pass_through ? 0.0 : out_fps;
-  out.source_fps = source_fps;
-  out.what = a.rest()[0];
-  if (!avatar.empty()) {
-    out.avatar_path = avatar;
-    out.avatar_rig = &r;
-    out.avatar_binding = selection.binding;
-    out.avatar_table = selection.table;
-  }
-  out.keep_feet_on_ground = ground;
-  out.root_motion = root_motion;
-  const bool to_rig = format->uses_avatar && !avatar.empty();
+  const bool show_progress = shows_progress(progress_mode::automatic);
+  if (show_progress) job.solve.progress = print_solve_progress;
+  job.warning = [](const std::string& w) {
+    std::fprintf(stderr, "avatarmap convert: warning: %s\n", w.c_str());
+  };
   const bool dump = !dump_path.empty() && format->uses_avatar;  // .glb and .bvh
   std::vector<proxy_pose> sampled;
   std::vector<rig_pose> poses;
   if (dump) {
-    out.out_frames = &sampled;
-    out.out_rig_poses = &poses;
+    job.out_frames = &sampled;
+    job.out_rig_poses = &poses;
   }
-  clip_output_summary written;
-  st = out.run(written);
+  convert_file_summary done;
+  status st = job.run(done);
+  if (show_progress && done.solve.frames > 0) std::fputs("\r", stderr);
   if (st.ok() && dump)
-    st = dump_positions(dump_path, out_fps, sampled, to_rig ? &r : nullptr, poses);
+    st = dump_positions(dump_path, done.output.fps, sampled,
+                        done.avatar ? &done.avatar->rig : nullptr, poses);
   if (!st.ok()) {
-    std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
+    std::fprintf(stderr, "avatarmap convert: %s%s\n", st.message().c_str(),
+                 binding_hint(job, done, st).c_str());
     return 1;
   }
-  const double secs =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (!quiet) {
     char fps_text[48];  // --fps is within (0, 1000]: "%g" stays short
-    std::snprintf(fps_text, sizeof fps_text, " at %g fps", out_fps);
+    std::snprintf(fps_text, sizeof fps_text, " at %g fps", done.output.fps);
     std::fprintf(stderr, "converted %zu input frames (%s s) into %zu frames%s in %.3f s\n",
-                 frames.size(), seconds_text(frames.back().t - frames.front().t, 2).c_str(),
-                 written.frames_written, pass_through ? "" : fps_text, secs);
-    if (!avatar.empty())
-      std::fprintf(stderr, "avatar %s: %d joints; %s\n", avatar.c_str(), r.joint_count(),
-                   selection.description.c_str());
-    std::fprintf(stderr, "wrote %s\n", out_path.c_str());
+                 done.frames_read, seconds_text(done.t_last - done.t_first, 2).c_str(),
+                 done.output.frames_written, done.output.fps > 0.0 ? fps_text : "", done.seconds);
+    if (done.avatar)
+      std::fprintf(stderr, "avatar %s: %d joints; %s\n", job.avatar.c_str(),
+                   done.avatar->rig.joint_count(), done.avatar->description.c_str());
+    std::fprintf(stderr, "wrote %s\n", job.output.c_str());
   }
   return 0;
 }

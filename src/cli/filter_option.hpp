@@ -1,11 +1,11 @@
-// The CLI's --filter and --smoothing options, shared by `solve` and `convert` (and through
+// The CLI's --filter option, shared by `solve` and `convert` (and through
 // convert by `animate`): one table of names, one message.
 #pragma once
 
-#include <cmath>
 #include <string>
 
 #include "avatarmap/jobs/solve_file.hpp"
+#include "avatarmap/time/filter_rules.hpp"
 
 namespace avatarmap::cli {
 
@@ -39,14 +39,6 @@ inline bool apply_filter_option(const std::string& value, solve_file_job& job) {
   job.filter_mode = mode;
   job.filter.enabled = mode == pose_filter_mode::live;
   job.landmark_filter.enabled = points;
-  return true;
-}
-
-/// Sets the offline filter's strength from --smoothing (a scale on its time constants, 0 = gap
-/// filling only). False when `value` is not finite, negative or above 10.
-inline bool apply_smoothing_option(double value, solve_file_job& job) {
-  if (!(std::isfinite(value) && value >= 0.0 && value <= 10.0)) return false;
-  job.offline.strength = static_cast<float>(value);
   return true;
 }
 

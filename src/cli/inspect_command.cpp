@@ -4,11 +4,10 @@
 #include <string>
 #include <vector>
 
-#include "avatarmap/rig/avatar_loader.hpp"
+#include "avatarmap/rig/bound_avatar.hpp"
 #include "avatarmap/rig/rig.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
-#include "cli/rig_select.hpp"
 
 namespace avatarmap::cli {
 
@@ -119,16 +118,16 @@ int run_inspect(int argc, char** argv) {
   }
   const std::string path = a.rest()[0];
 
-  raw_rig raw;
-  if (status s = load_avatar(path, raw); !s) {
-    std::fprintf(stderr, "avatarmap inspect: %s\n", s.message().c_str());
+  // Loaded, built and bound as `convert --avatar` binds it (--rig auto). A binding that fails
+  // is reported below, not an error: inspect shows what the file is.
+  bound_avatar avatar;
+  const status bound = bind_avatar(path, bind_avatar_options{}, avatar);
+  if (avatar.failed_step == bind_avatar_step::load ||
+      avatar.failed_step == bind_avatar_step::build) {
+    std::fprintf(stderr, "avatarmap inspect: %s\n", bound.message().c_str());
     return 1;
   }
-  rig r;
-  if (status s = build_rig(raw, r); !s) {
-    std::fprintf(stderr, "avatarmap inspect: %s\n", s.message().c_str());
-    return 1;
-  }
+  const rig& r = avatar.rig;
 
   const bool vrm = r.source == rig_source::vrm0 || r.source == rig_source::vrm1;
   int declared = 0;
@@ -178,13 +177,7 @@ int run_inspect(int argc, char** argv) {
   std::printf("joints: %d\n", r.joint_count());
   if (!vrm) {
     std::printf("humanoid: not declared by the file; matching the shipped mapping tables:\n");
-    rig_selection sel;
-    status st = select_rig_binding(r, "auto", sel);
-    if (st.ok()) {
-      std::printf("  %s\n", sel.description.c_str());
-    } else {
-      std::printf("  %s\n", st.message().c_str());
-    }
+    std::printf("  %s\n", bound.ok() ? avatar.description.c_str() : bound.message().c_str());
   } else {
     std::printf("humanoid: declared: %d of %d bones\n", declared, k_bone_count);
     std::string m;

@@ -1,28 +1,24 @@
-// `avatarmap live INPUT`: the latest-frame live loop (capture/live_capture.hpp). A camera, a
-// network stream, or a file paced to its time stamps as a camera would deliver it (devices and
-// URLs deliver at their own pace; docs/live.md); frames the estimator cannot
-// keep up with are dropped. Each processed frame is solved, filtered by the live filter
-// (pose_filter, unless --filter none) and pushed to the pose resampler; an output thread
-// samples it at --fps (a higher rate than capture) into OUT.pose.jsonl and, with --vmc, to a
-// VMC protocol receiver (cli/live_vmc.hpp).
+// `avatarmap live INPUT`: the library's live loop (live/live_session.hpp) fed by its grabber
+// (live/live_capture.hpp). A camera, a network stream, or a file paced to its time stamps as
+// a camera would deliver it (devices and URLs deliver at their own pace; docs/live.md) is
+// pushed into the session; frames the estimator cannot keep up with are dropped. Each
+// processed frame is solved, filtered by the live filter (pose_filter, unless --filter none)
+// and handed to the stream's resampler; the session's output thread samples it at --fps (a
+// higher rate than capture) into this command's outputs: OUT.pose.jsonl, the viewer (--serve)
+// and a VMC protocol receiver (--vmc, cli/live_vmc.hpp). This file only translates the flags
+// and prints.
 #include <unistd.h>
 
-#include <algorithm>
-#include <atomic>
 #include <chrono>
-#include <cmath>
-#include <condition_variable>
 #include <cstdio>
-#include <mutex>
 #include <string>
-#include <thread>
 
-#include "avatarmap/capture/capture_pipeline.hpp"
+#include "avatarmap/core/limits.hpp"
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/live/live_capture.hpp"
+#include "avatarmap/live/live_session.hpp"
 #include "avatarmap/media/video_source.hpp"
 #include "avatarmap/stream/pose_server.hpp"
-#include "avatarmap/time/pose_resampler.hpp"
 #include "cli/capture_setup.hpp"
 #include "cli/commands.hpp"
 #include "cli/live_vmc.hpp"
@@ -66,9 +62,9 @@ int run_live_command(int argc, char** argv) {
   args a(argc, argv, 2);
   if (a.flag("--help") || a.flag("-h")) {
     std::fputs(k_live_help, stdout);
-    std::fputs(k_input_options_help, stdout);
+    std::fputs(input_options_help().c_str(), stdout);
     std::fputs(k_live_estimator_help, stdout);
-    std::fputs(k_estimator_options_help, stdout);
+    std::fputs(estimator_options_help(false).c_str(), stdout);
     std::fputs("\nVMC protocol output (docs/vmc.md):\n", stdout);
     std::fputs(k_live_vmc_help, stdout);
     return 0;
@@ -103,8 +99,9 @@ int run_live_command(int argc, char** argv) {
                  filter_name.c_str());
     return 2;
   }
-  if (!(out_fps > 0 && out_fps <= 1000) || !(seconds >= 0)) {
-    std::fprintf(stderr, "avatarmap live: --fps must be in (0, 1000], --seconds >= 0\n");
+  if (!(out_fps > 0 && out_fps <= k_max_fps) || !(seconds >= 0)) {
+    std::fprintf(stderr, "avatarmap live: --fps must be in (0, %s], --seconds >= 0\n",
+                 limit_text(k_max_fps).c_str());
     return 2;
   }
   pose_server_options serve_options = default_viewer_options("live", "--serve");
@@ -135,23 +132,62 @@ int run_live_command(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap live: %s\n", st.message().c_str());
     return 1;
   }
-  // Each frame: landmarks -> proxy pose -> live filter, the library's capture pipeline (the C
-  // API's estimator and live handles run the same).
+  // The live loop: landmarks -> proxy pose -> live filter -> resampler on the session's
+  // worker (the C API's live handle runs the same), the outputs on its output thread.
+  using clock_type = std::chrono::steady_clock;
   const video_info info = source.info();
-  capture_pipeline_options po;
-  po.estimator = ec;
-  po.solver.image_width = static_cast<float>(info.width);
-  po.solver.image_height = static_cast<float>(info.height);
-  po.filter.enabled = filter_name == "live";
-  std::unique_ptr<capture_pipeline> pipeline;
-  st = make_capture_pipeline(po, pipeline);
+  live_session_options lso;
+  lso.pipeline.estimator = ec;
+  lso.pipeline.solver.image_width = static_cast<float>(info.width);
+  lso.pipeline.solver.image_height = static_cast<float>(info.height);
+  lso.pipeline.filter.enabled = filter_name == "live";
+  lso.latency_samples = 1 << 16;
+  lso.output_fps = out_fps;
+  // Worker thread: the estimator's timings, frames with a body, progress; an estimator error
+  // stops the loop (reported below).
+  timing_totals timings;
+  long with_body = 0;
+  status est_status;
+  auto last_progress = clock_type::now();
+  lso.on_frame = [&](const live_frame_report& r) {
+    if (r.error != nullptr) {
+      est_status = *r.error;
+      return false;
+    }
+    if (r.timings != nullptr) timings.add(*r.timings);
+    with_body += r.frame->has(frame_part::pose);
+    if (progress) {
+      const auto now = clock_type::now();
+      if (std::chrono::duration<double>(now - last_progress).count() > 0.5) {
+        last_progress = now;
+        std::fprintf(stderr, "\rlive: t %.1f s, %ld dropped so far   ", r.t, r.dropped_so_far);
+        std::fflush(stderr);
+      }
+    }
+    return true;
+  };
+  // Output thread: the outputs, in order (each pose written, published, sent).
+  pose_writer writer;
+  const bool writing = !out_path.empty();
+  status write_status;
+  if (writing)
+    lso.outputs.push_back([&](const proxy_pose& p, const live_output_report&) {
+      if (write_status.ok()) write_status = writer.write(p);
+    });
+  if (!serve.empty())
+    lso.outputs.push_back(
+        [&](const proxy_pose& p, const live_output_report&) { server.publish(p); });
+  if (vmc.enabled())
+    lso.outputs.push_back(
+        [&](const proxy_pose& p, const live_output_report& r) { vmc.send(p, r); });
+  std::unique_ptr<live_session> session;
+  st = make_live_session(lso, session);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap live: %s\n", st.message().c_str());
     return 1;
   }
-  pose_writer writer;
-  const bool writing = !out_path.empty();
-  if (!out_path.empty()) {
+  // Opened before the first frame is pushed: no output runs before a pose exists.
+  if (writing) {
     pose_file_header h;
     h.fps = out_fps;
     st = writer.open(out_path, h);
@@ -161,101 +197,20 @@ int run_live_command(int argc, char** argv) {
     }
   }
 
-  // Stream time: the capture clock of the newest processed frame, advanced by wall time.
-  using clock_type = std::chrono::steady_clock;
-  std::mutex m;
-  pose_resampler resampler;
-  bool have_pose = false;
-  double stream_t = 0.0;                 // capture time of the newest pose
-  clock_type::time_point stream_wall{};  // when it was pushed
-  std::atomic<bool> done{false};
-  // The output thread waits for its next period on this, so a stop is seen at once whatever
-  // --fps is (a plain sleep of one period made `--fps 0.05 --seconds 2` last 20 s).
-  std::mutex stop_m;
-  std::condition_variable stop_cv;
-  long written = 0;
-  status write_status;
-  std::thread output([&] {
-    proxy_pose p;
-    const auto period = std::chrono::duration_cast<clock_type::duration>(
-        std::chrono::duration<double>(1.0 / out_fps));
-    auto next = clock_type::now();
-    double last_t = -INFINITY;  // output times always increase (processing time varies)
-    while (!done.load()) {
-      next += period;
-      {
-        std::unique_lock<std::mutex> lock(stop_m);
-        if (stop_cv.wait_until(lock, next, [&] { return done.load(); })) break;
-      }
-      {
-        std::lock_guard<std::mutex> lock(m);
-        if (!have_pose) continue;
-        const double t = std::max(
-            last_t + 1e-6,
-            stream_t + std::chrono::duration<double>(clock_type::now() - stream_wall).count());
-        if (!resampler.sample(t, p)) continue;
-        last_t = t;
-        p.t = t;
-        if (writing && write_status.ok()) write_status = writer.write(p);
-        ++written;
-        if (!serve.empty()) server.publish(p);
-        vmc.pose_sampled();
-      }
-      vmc.send(p);  // outside the lock: never blocks, but need not hold up the capture side
-    }
-  });
-
-  landmark_frame frame;
-  proxy_pose pose;
-  timing_totals timings;
-  long with_body = 0;
-  auto last_progress = clock_type::now();
-  live_options lo;
+  live_feed_options fo;
   // Devices and live streams deliver at their own pace: pacing them would only add latency.
   // A stream with a duration is a file on a server (HTTP, HLS on demand): paced like a file.
-  const video_source_kind kind = source.info().kind;
+  const video_source_kind kind = info.kind;
   const bool live_input = kind == video_source_kind::camera ||
-                          (kind == video_source_kind::stream && source.info().duration <= 0);
-  lo.pace_to_timestamps = !unpaced && !live_input;
-  lo.wake_grabber = [&] { source.interrupt(); };
-  lo.max_seconds = seconds;
-  live_stats stats;
-  status est_status;
-  st = run_live([&](image_view& v, double& t) { return source.next(v, t); },
-                [&](const image_view& img, const live_frame_info& info_) {
-                  const auto arrived = clock_type::now() -
-                                       std::chrono::duration_cast<clock_type::duration>(
-                                           std::chrono::duration<double, std::milli>(info_.age_ms));
-                  est_status = pipeline->process(img, info_.t, frame, pose);
-                  if (!est_status.ok()) return false;
-                  if (const estimator_timings* et = pipeline->last_timings()) timings.add(*et);
-                  with_body += frame.has(frame_part::pose);
-                  {
-                    std::lock_guard<std::mutex> lock(m);
-                    resampler.push(pose);
-                    have_pose = true;
-                    stream_t = pose.t;
-                    stream_wall = clock_type::now();
-                    vmc.frame_pushed(arrived);
-                  }
-                  if (progress) {
-                    const auto now = clock_type::now();
-                    if (std::chrono::duration<double>(now - last_progress).count() > 0.5) {
-                      last_progress = now;
-                      std::fprintf(stderr, "\rlive: t %.1f s, %ld dropped so far   ", info_.t,
-                                   info_.dropped_so_far);
-                      std::fflush(stderr);
-                    }
-                  }
-                  return true;
-                },
-                lo, stats);
-  {
-    std::lock_guard<std::mutex> lock(stop_m);
-    done.store(true);
-  }
-  stop_cv.notify_all();
-  output.join();
+                          (kind == video_source_kind::stream && info.duration <= 0);
+  fo.pace_to_timestamps = !unpaced && !live_input;
+  fo.wake_grabber = [&] { source.interrupt(); };
+  fo.max_seconds = seconds;
+  live_feed_stats feed;
+  st = feed_live_session([&](image_view& v, double& t) { return source.next(v, t); }, *session, fo,
+                         feed);
+  // The session has stopped: its counts and latency are final.
+  const live_session_stats stats = session->stats();
   if (!source.end_reason().empty())  // a device or stream that stalled or ended
     std::fprintf(stderr, "%slive: %s\n", progress ? "\n" : "", source.end_reason().c_str());
   if (st.ok()) st = est_status;
@@ -270,8 +225,8 @@ int run_live_command(int argc, char** argv) {
   std::fprintf(stderr,
                "live: %ld frames delivered in %.2f s, %ld processed (%.1f/s), %ld dropped; body in "
                "%ld\n",
-               stats.grabbed, stats.wall_seconds, stats.processed,
-               stats.processed / (stats.wall_seconds > 0 ? stats.wall_seconds : 1.0), stats.dropped,
+               feed.grabbed, feed.wall_seconds, stats.processed,
+               stats.processed / (feed.wall_seconds > 0 ? feed.wall_seconds : 1.0), stats.dropped,
                with_body);
   std::fprintf(stderr,
                "latency (frame delivered -> pose ready): mean %.1f ms, median %.1f, p95 %.1f, "
@@ -279,7 +234,7 @@ int run_live_command(int argc, char** argv) {
                stats.latency_mean_ms, stats.latency_p50_ms, stats.latency_p95_ms,
                stats.latency_max_ms);
   timings.print(stderr);
-  std::fprintf(stderr, "output: %ld poses at %.0f fps%s%s\n", written, out_fps,
+  std::fprintf(stderr, "output: %ld poses at %.0f fps%s%s\n", stats.outputs, out_fps,
                out_path.empty() ? "" : " -> ", out_path.c_str());
   vmc.print_summary(stderr);
   return 0;

@@ -2,11 +2,10 @@
 
 #include <algorithm>
 
-#include "avatarmap/rig/avatar_loader.hpp"
+#include "avatarmap/rig/bound_avatar.hpp"
 #include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/stream/host_port.hpp"
 #include "avatarmap/stream/vmc_skeleton.hpp"
-#include "cli/rig_select.hpp"
 
 namespace avatarmap::cli {
 
@@ -20,12 +19,6 @@ const char* const k_live_vmc_help =
     "                        --fps 60 on a 2-core machine (body only)\n"
     "  --avatar FILE         the receiver's model (.vrm, .glb): its bones and rest positions\n"
     "                        are sent (default: every bone of a 1.70 m proxy skeleton)\n";
-
-namespace {
-
-constexpr std::size_t k_latency_samples = 1 << 16;
-
-}  // namespace
 
 int live_vmc::read_options(args& a) {
   given_ = a.value("--vmc", destination_);
@@ -57,20 +50,15 @@ int live_vmc::open() {
     skeleton = make_vmc_skeleton(make_proxy_skeleton());
     rest_source_ = "the 1.70 m proxy skeleton";
   } else {
-    raw_rig raw;
-    rig r;
-    rig_selection sel;
-    st = load_avatar(avatar_path_, raw);
-    if (st.ok()) st = build_rig(raw, r);
-    if (st.ok()) {
-      st = select_rig_binding(r, "auto", sel);
-      if (!st.ok())
-        st = status::error(st.message() +
+    bound_avatar avatar;
+    st = bind_avatar(avatar_path_, bind_avatar_options{}, avatar);
+    if (avatar.failed_step == bind_avatar_step::select)
+      st = st.with_message(st.message() +
                            "\nFor --vmc, --avatar takes a VRM model or a rig one of the shipped "
                            "tables fits; leave it out to send the proxy skeleton's proportions.");
-    }
     // The performer's standing hips height is not known live: the solver's default stands in.
-    if (st.ok()) st = make_vmc_skeleton(r, sel.binding, k_default_hips_height, skeleton);
+    if (st.ok())
+      st = make_vmc_skeleton(avatar.rig, avatar.binding, k_default_hips_height, skeleton);
     if (!st.ok()) {
       std::fprintf(stderr, "avatarmap live: --avatar: %s\n", st.message().c_str());
       return 1;
@@ -86,19 +74,15 @@ int live_vmc::open() {
   }
   if (!stream_->warning().empty())
     std::fprintf(stderr, "avatarmap live: --vmc: warning: %s\n", stream_->warning().c_str());
-  latencies_ms_.assign(k_latency_samples, 0.0);
   return 0;
 }
 
-void live_vmc::send(const proxy_pose& pose) {
+void live_vmc::send(const proxy_pose& pose, const live_output_report& report) {
   if (!stream_) return;
   stream_->send(pose, static_cast<float>(pose.t));
-  if (!carrying_) return;
-  carrying_ = false;
-  const double ms =
-      std::chrono::duration<double, std::milli>(clock_type::now() - carrying_arrival_).count();
-  latencies_ms_[static_cast<std::size_t>(latency_count_) % latencies_ms_.size()] = ms;
-  ++latency_count_;
+  if (!report.carries_new_frame) return;
+  latencies_.add(
+      std::chrono::duration<double, std::milli>(clock_type::now() - report.pushed_at).count());
 }
 
 void live_vmc::print_summary(std::FILE* out) const {
@@ -111,15 +95,12 @@ void live_vmc::print_summary(std::FILE* out) const {
                stream_->blend_messages(),
                static_cast<double>(stream_->last_bundle_bytes()) / 1024.0, rest_source_.c_str(),
                s.dropped, s.refused, s.errors + stream_->encode_failures());
-  if (latency_count_ == 0) return;
-  const std::size_t n = static_cast<std::size_t>(
-      std::min<long>(latency_count_, static_cast<long>(latencies_ms_.size())));
-  std::vector<double> sorted(latencies_ms_.begin(), latencies_ms_.begin() + static_cast<long>(n));
-  std::sort(sorted.begin(), sorted.end());
+  if (latencies_.count() == 0) return;
+  const latency_summary l = latencies_.summary();
   std::fprintf(out,
-               "vmc latency (frame delivered -> first packet with its pose, %zu frames): median "
+               "vmc latency (frame delivered -> first packet with its pose, %ld frames): median "
                "%.1f ms, p95 %.1f, max %.1f\n",
-               n, sorted[n / 2], sorted[std::min(n - 1, n * 95 / 100)], sorted[n - 1]);
+               l.kept, l.p50_ms, l.p95_ms, l.max_ms);
 }
 
 }  // namespace avatarmap::cli

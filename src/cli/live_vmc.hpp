@@ -1,8 +1,8 @@
 // `avatarmap live --vmc HOST[:PORT] [--avatar FILE]`: the live loop's VMC protocol output
-// (stream/vmc_stream.hpp, docs/vmc.md). The live command reads the options through it, tells it
-// when a frame's pose reaches the resampler and when the output thread samples, and the output
+// (stream/vmc_stream.hpp, docs/vmc.md). The live command reads the options through it and
+// makes send() one of the live session's outputs (live/live_session.hpp): the session's output
 // thread sends each sampled pose through it. It measures the latency from a frame's arrival to
-// the first packet whose pose includes it.
+// the first packet whose pose includes it (time/latency_stats.hpp).
 #pragma once
 
 #include <chrono>
@@ -11,8 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "avatarmap/live/live_session.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "avatarmap/stream/vmc_stream.hpp"
+#include "avatarmap/time/latency_stats.hpp"
 #include "cli/cli_args.hpp"
 
 namespace avatarmap::cli {
@@ -31,20 +33,10 @@ class live_vmc {
   int open();
   bool enabled() const { return stream_ != nullptr; }
 
-  /// A frame that arrived at `arrived` has reached the resampler (call under the loop's lock).
-  void frame_pushed(clock_type::time_point arrived) {
-    pending_ = true;
-    pending_arrival_ = arrived;
-  }
-  /// The output thread sampled a pose, which includes every frame pushed so far (call under the
-  /// loop's lock, before send()).
-  void pose_sampled() {
-    carrying_ = pending_;
-    carrying_arrival_ = pending_arrival_;
-    pending_ = false;
-  }
-  /// Sends the sampled pose (output thread, outside the lock). Never blocks, never allocates.
-  void send(const proxy_pose& pose);
+  /// The session's output: sends the sampled pose and, when it is the first to carry a newly
+  /// processed frame, records that frame's push -> packet latency. Never blocks, never
+  /// allocates.
+  void send(const proxy_pose& pose, const live_output_report& report);
 
   /// The summary lines of `live` (nothing without --vmc).
   void print_summary(std::FILE* out) const;
@@ -55,12 +47,7 @@ class live_vmc {
   std::string avatar_path_;
   std::string rest_source_;  // where the rest positions come from, for the summary
   std::unique_ptr<vmc_stream> stream_;
-  bool pending_ = false;
-  clock_type::time_point pending_arrival_{};
-  bool carrying_ = false;
-  clock_type::time_point carrying_arrival_{};
-  std::vector<double> latencies_ms_;  // a ring, allocated by open()
-  long latency_count_ = 0;
+  latency_stats latencies_{1 << 16};
 };
 
 }  // namespace avatarmap::cli

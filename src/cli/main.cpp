@@ -41,7 +41,9 @@ const char* k_usage =
     "  avatarmap import-tfjs IMAGE.json WORLD.json --size WxH --fps F -o OUT.landmarks.jsonl\n"
     "      Converts tfjs-models' reference pose landmarks (pixels + world) to our format.\n"
     "  avatarmap backends\n"
-    "      Lists the landmark estimator backends in this build.\n"
+    "      Lists the landmark estimator backends and the folders found (mappings, models).\n"
+    "  avatarmap options [--json]\n"
+    "      Prints the option tables: each option's C name, range, default and flag.\n"
     "  avatarmap inspect AVATAR [--json]\n"
     "      Prints an avatar file's format, joints, humanoid bones, hips height, expressions.\n"
     "  avatarmap avatar -o OUT.vrm [--height M]\n"
@@ -63,6 +65,7 @@ int dispatch(const std::string& cmd, int argc, char** argv) {
   if (cmd == "eval-pose") return avatarmap::cli::run_eval_pose(argc, argv);
   if (cmd == "avatar") return avatarmap::cli::run_avatar(argc, argv);
   if (cmd == "view") return avatarmap::cli::run_view(argc, argv);
+  if (cmd == "options") return avatarmap::cli::run_options(argc, argv);
   return -1;
 }
 

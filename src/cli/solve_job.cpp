@@ -14,21 +14,25 @@ solve_file_job make_cli_solve_job() {
   return job;
 }
 
+bool shows_progress(progress_mode mode) {
+  return mode == progress_mode::on || (mode == progress_mode::automatic && isatty(STDERR_FILENO));
+}
+
+void print_solve_progress(const solve_file_progress& p) {
+  std::fprintf(stderr, "\rsolve: %ld frames, %s s of capture, %.0f frames/s   ", p.frames,
+               seconds_text(p.capture_seconds, 1).c_str(),
+               p.frames / std::max(p.elapsed_seconds, 1e-9));
+  std::fflush(stderr);
+}
+
 status run_solve_job(solve_file_job job, progress_mode progress, solve_file_summary& out) {
-  const bool show_progress = progress == progress_mode::on ||
-                             (progress == progress_mode::automatic && isatty(STDERR_FILENO));
-  if (show_progress)
-    job.progress = [](const solve_file_progress& p) {
-      std::fprintf(stderr, "\rsolve: %ld frames, %s s of capture, %.0f frames/s   ", p.frames,
-                   seconds_text(p.capture_seconds, 1).c_str(),
-                   p.frames / std::max(p.elapsed_seconds, 1e-9));
-      std::fflush(stderr);
-    };
+  const bool show_progress = shows_progress(progress);
+  if (show_progress) job.progress = print_solve_progress;
   job.warning = [](const std::string& w) { std::fprintf(stderr, "warning: %s\n", w.c_str()); };
   status st = job.run(out);
   if (!st.ok()) {
-    if (out.failure == job_failure::input_parse && !job.skip_bad_lines)
-      return status::error(st.message() + " (use --skip-bad-lines to go on)");
+    if (st.code() == status_code::parse && out.input_opened && !job.skip_bad_lines)
+      return st.with_message(st.message() + " (use --skip-bad-lines to go on)");
     return st;
   }
   if (show_progress) std::fputs("\r", stderr);

@@ -15,6 +15,13 @@ enum class progress_mode { automatic, on, off };
 /// A solve_file_job whose messages use the CLI's option names (--fps).
 solve_file_job make_cli_solve_job();
 
+/// Whether `mode` shows a progress line (automatic: when stderr is a terminal).
+bool shows_progress(progress_mode mode);
+
+/// The progress line of a landmark solve on stderr ("\rsolve: N frames, ..."), for
+/// solve_file_job::progress; end it with "\r" when the run is over.
+void print_solve_progress(const solve_file_progress& p);
+
 /// Runs `job` with a progress line on stderr (`progress`: automatic = when stderr is a
 /// terminal) and its warnings on stderr ("warning: ..."); a malformed line's error gets the
 /// --skip-bad-lines hint.

@@ -7,13 +7,13 @@
 #include <string>
 
 #include "avatarmap/avatar/builtin_avatar.hpp"
+#include "avatarmap/core/limits.hpp"
 #include "avatarmap/export/vrma.hpp"
 #include "avatarmap/io/landmark_file.hpp"
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/io/tfjs_import.hpp"
 #include "avatarmap/jobs/clip_output.hpp"
-#include "avatarmap/rig/avatar_loader.hpp"
-#include "avatarmap/rig/rig_binding.hpp"
+#include "avatarmap/rig/bound_avatar.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
 #include "avatarmap/synth/synth_recording.hpp"
@@ -230,7 +230,8 @@ bool parse_synth(args& a, synth_settings& s, std::string& err) {
     return false;
   }
   if (!(s.seconds > 0 && s.seconds <= 36000)) err = "--seconds must be in (0, 36000]";
-  if (!(s.fps > 0 && s.fps <= 1000)) err = "--fps must be in (0, 1000]";
+  if (!(s.fps > 0 && s.fps <= k_max_fps))
+    err = "--fps must be in (0, " + limit_text(k_max_fps) + "]";
   if (err.empty() && !s.truth.empty() && s.truth == s.output)
     err = "--truth and -o name the same file; give the truth its own file (e.g. X.pose.jsonl)";
   return err.empty();
@@ -242,18 +243,15 @@ bool parse_synth(args& a, synth_settings& s, std::string& err) {
 status write_on_builtin_avatar(const std::vector<proxy_pose>& poses, const std::string& avatar_path,
                                const std::string& glb_path, std::size_t& out_frames) {
   if (status st = write_builtin_avatar(avatar_path); !st) return st;
-  raw_rig raw;
-  rig r;
-  rig_binding_choice binding;
-  if (status st = load_avatar(avatar_path, raw); !st) return st;
-  if (status st = build_rig(raw, r); !st) return st;
-  if (status st = select_binding(r, "auto", "", binding); !st) return st;
+  bound_avatar avatar;  // bound as `convert --avatar` binds it: the file's VRM humanoid
+  if (status st = bind_avatar(avatar_path, bind_avatar_options{}, avatar); !st) return st;
   clip_output_job out;
   out.path = glb_path;
   out.frames = &poses;
   out.avatar_path = avatar_path;
-  out.avatar_rig = &r;
-  out.avatar_binding = binding.binding;
+  out.avatar_rig = &avatar.rig;
+  out.avatar_binding = avatar.binding;
+  out.avatar_table = avatar.table();
   clip_output_summary summary;
   if (status st = out.run(summary); !st) return st;
   out_frames = summary.frames_written;
@@ -444,7 +442,7 @@ int run_import_tfjs(int argc, char** argv) {
                   ? import_tfjs_pose(a.rest()[0], a.rest()[1], w, h, fps, out)
                   : import_tfjs_hand(a.rest()[0], a.rest()[1], w, h, fps, hand == "left", out);
   if (!st.ok() && hand.empty() && st.message().find("array of 21") != std::string::npos)
-    st = status::error(st.message() + " (a hand recording: add --hand left|right)");
+    st = st.with_message(st.message() + " (a hand recording: add --hand left|right)");
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap import-tfjs: %s\n", st.message().c_str());
     return 1;

@@ -1,50 +1,33 @@
 // src/cli/viewer_setup.hpp.
 #include "cli/viewer_setup.hpp"
 
-#include <sys/stat.h>
-
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <vector>
 
 #include "avatarmap/avatar/builtin_avatar.hpp"
+#include "avatarmap/io/resources.hpp"
 
 namespace avatarmap::cli {
 
 namespace {
 
-bool is_dir(const char* p) {
-  struct stat st {};
-  return ::stat(p, &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-std::string page_folder() {
-  if (const char* env = std::getenv("AVATARMAP_VIEWER_PAGE"); env && *env) return env;
-#ifdef AVATARMAP_VIEWER_PAGE_DIR
-  if (is_dir(AVATARMAP_VIEWER_PAGE_DIR)) return AVATARMAP_VIEWER_PAGE_DIR;
-#endif
-#ifdef AVATARMAP_INSTALLED_VIEWER_PAGE_DIR
-  if (is_dir(AVATARMAP_INSTALLED_VIEWER_PAGE_DIR)) return AVATARMAP_INSTALLED_VIEWER_PAGE_DIR;
-#endif
-  return "viewer";
-}
-
-std::string modules_folder() {
-  if (const char* env = std::getenv("AVATARMAP_VIEWER_MODULES"); env && *env) return env;
-#ifdef AVATARMAP_DEFAULT_VIEWER_MODULES_DIR
-  return AVATARMAP_DEFAULT_VIEWER_MODULES_DIR;
-#else
-  return ".cache/avatarmap/viewer";
-#endif
+// A folder no rule found is still named (the last candidate looked at: the source tree's, which
+// scripts/fetch_viewer_modules.sh fills), so that the server's message says where it looked.
+std::string folder_or_first_tried(resource kind) {
+  resource_lookup r = find_resource(kind);
+  if (!r.folder.empty() || r.tried.empty()) return r.folder;
+  const std::string& last = r.tried.back();
+  return last.substr(0, last.rfind(" ("));
 }
 
 }  // namespace
 
 pose_server_options default_viewer_options(const char* command, const char* port_option) {
   pose_server_options o;
-  o.page_dir = page_folder();
-  o.modules_dir = modules_folder();
+  o.page_dir = folder_or_first_tried(resource::viewer_page);
+  o.modules_dir = folder_or_first_tried(resource::viewer_modules);
   o.port_option = port_option;
   std::string prefix = std::string(command) + ": ";
   o.on_event = [prefix](std::string_view line) {

@@ -11,9 +11,9 @@
 
 namespace avatarmap::cli {
 
-/// Options with the page folder (AVATARMAP_VIEWER_PAGE, else the source tree's viewer/, else
-/// the installed one), the modules folder (AVATARMAP_VIEWER_MODULES, else the cache that
-/// scripts/fetch_viewer_modules.sh fills), event lines printed as "COMMAND: LINE" and
+/// Options with the page and modules folders (find_resource(): $AVATARMAP_VIEWER_PAGE /
+/// $AVATARMAP_VIEWER_MODULES, else the installed ones, else the source tree's viewer/ and the
+/// cache that scripts/fetch_viewer_modules.sh fills), event lines printed as "COMMAND: LINE" and
 /// `port_option` (the option that sets the port: "--port", "--serve") for the port-in-use
 /// message.
 pose_server_options default_viewer_options(const char* command, const char* port_option);

@@ -169,24 +169,24 @@ bool sync_file(int fd) { return ::fsync(fd) == 0 || errno == EINVAL; }
 status create_temp_file(const std::string& path, int& out_fd, std::string& out_temp_path) {
   out_fd = -1;
   out_temp_path.clear();
-  if (path.empty()) return status::error("cannot write: the output path is empty");
+  if (path.empty()) return status::invalid_argument("cannot write: the output path is empty");
   std::string dir, base;
   split_path(path, dir, base);
   struct stat st;
   if (base.empty() || base == "." || base == ".." ||
       (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)))
-    return status::error(path + ": cannot write: it is a folder (" + errno_text(EISDIR) +
-                         "); give a file name");
+    return status::io_error(path + ": cannot write: it is a folder (" + errno_text(EISDIR) +
+                            "); give a file name");
   if (::stat(dir.c_str(), &st) != 0) {
     const int e = errno;
     if (e == ENOENT)
-      return status::error(path + ": cannot write: folder '" + dir +
-                           "' does not exist; create it first");
-    return status::error(path + ": cannot write: folder '" + dir + "': " + errno_text(e));
+      return status::io_error(path + ": cannot write: folder '" + dir +
+                              "' does not exist; create it first");
+    return status::io_error(path + ": cannot write: folder '" + dir + "': " + errno_text(e));
   }
   if (!S_ISDIR(st.st_mode))
-    return status::error(path + ": cannot write: '" + dir + "' is not a folder (" +
-                         errno_text(ENOTDIR) + ")");
+    return status::io_error(path + ": cannot write: '" + dir + "' is not a folder (" +
+                            errno_text(ENOTDIR) + ")");
 
   // `.BASE.tmp.XXXXXX`: hidden, and never a name a user or another tool would pick. The base
   // is shortened (at a UTF-8 character boundary) so that the name stays within NAME_MAX
@@ -207,10 +207,10 @@ status create_temp_file(const std::string& path, int& out_fd, std::string& out_t
   if (fd < 0) {
     const int e = errno;
     if (e == EACCES || e == EPERM || e == EROFS)
-      return status::error(path + ": cannot write: folder '" + dir + "' is not writable (" +
-                           errno_text(e) + ")");
-    return status::error(path + ": cannot create a temporary file in folder '" + dir +
-                         "': " + errno_text(e));
+      return status::io_error(path + ": cannot write: folder '" + dir + "' is not writable (" +
+                              errno_text(e) + ")");
+    return status::io_error(path + ": cannot create a temporary file in folder '" + dir +
+                            "': " + errno_text(e));
   }
   out_fd = fd;
   out_temp_path.assign(name.data());
@@ -222,17 +222,17 @@ status commit_temp_file(const std::string& temp_path, const std::string& path) {
   const bool existed = ::lstat(path.c_str(), &st) == 0;
   const int fd = ::open(temp_path.c_str(), O_WRONLY | O_NOFOLLOW | O_CLOEXEC);
   if (fd < 0)
-    return status::error(path + ": cannot reopen " + temp_path + ": " + errno_text(errno) +
-                         outcome(existed));
+    return status::io_error(path + ": cannot reopen " + temp_path + ": " + errno_text(errno) +
+                            outcome(existed));
   if (!sync_file(fd) || !adopt_target_mode(fd, path)) {
     const int e = errno;
     ::close(fd);
-    return status::error(path + ": cannot finish " + temp_path + ": " + errno_text(e) +
-                         outcome(existed));
+    return status::io_error(path + ": cannot finish " + temp_path + ": " + errno_text(e) +
+                            outcome(existed));
   }
   ::close(fd);
   if (std::rename(temp_path.c_str(), path.c_str()) != 0)
-    return status::error(path + ": cannot replace it: " + errno_text(errno) + outcome(existed));
+    return status::io_error(path + ": cannot replace it: " + errno_text(errno) + outcome(existed));
   sync_folder_of(path);
   return {};
 }
@@ -253,7 +253,7 @@ status atomic_file::open(const std::string& path) {
   if (!path.empty() && ::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) &&
       !S_ISDIR(st.st_mode)) {
     const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
-    if (fd < 0) return status::error(path + ": cannot open for writing: " + errno_text(errno));
+    if (fd < 0) return status::io_error(path + ": cannot open for writing: " + errno_text(errno));
     fd_ = fd;
     return {};
   }
@@ -267,12 +267,12 @@ status atomic_file::open(const std::string& path) {
 status atomic_file::fail(const std::string& what, int err) {
   error_ = path_ + ": " + what + ": " + errno_text(err) + outcome(existed_);
   discard();
-  return status::error(error_);
+  return status::io_error(error_);
 }
 
 status atomic_file::write(const void* data, std::size_t n) {
   if (fd_ < 0)
-    return status::error(error_.empty() ? path_ + ": write to a file that is not open" : error_);
+    return status::io_error(error_.empty() ? path_ + ": write to a file that is not open" : error_);
   if (const int e = write_all(fd_, data, n); e != 0) return fail("write failed", e);
   return {};
 }
@@ -294,12 +294,13 @@ int write_all(int fd, const void* data, std::size_t n) {
 
 status atomic_file::commit() {
   if (fd_ < 0)
-    return status::error(error_.empty() ? path_ + ": commit of a file that is not open" : error_);
+    return status::io_error(error_.empty() ? path_ + ": commit of a file that is not open"
+                                           : error_);
   if (temp_path_.empty()) {  // a special file written in place
     const int fd = fd_;
     fd_ = -1;
     if (::close(fd) != 0 && errno != EINTR)
-      return status::error(path_ + ": close failed: " + errno_text(errno));
+      return status::io_error(path_ + ": close failed: " + errno_text(errno));
     return {};
   }
   struct stat st;

@@ -20,6 +20,7 @@
 //   "out/a.glb: cannot write: folder 'out' does not exist; create it first"
 //   "out/a.glb: cannot write: folder 'out' is not writable (Permission denied)"
 //   "out/a.glb: write failed: No space left on device; the previous file is unchanged"
+// Their code is status_code::io (invalid_argument only for an empty path).
 #pragma once
 
 #include <cstddef>

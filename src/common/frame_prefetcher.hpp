@@ -20,7 +20,10 @@ class frame_prefetcher {
             capacity,
             [&reader, stop_at_error](slot& s) {
               s.kind = reader.next(s.frame);
-              if (s.kind == read_result::error) s.error = reader.error();
+              if (s.kind == read_result::error) {
+                s.error = reader.error();
+                s.code = reader.error_code();
+              }
               return !(s.kind == read_result::end ||
                        (s.kind == read_result::error && stop_at_error));
             },
@@ -34,6 +37,7 @@ class frame_prefetcher {
   }
   const landmark_frame& frame() const { return current_->frame; }
   const std::string& error() const { return current_->error; }
+  status_code error_code() const { return current_->code; }
   /// Hands the current item's slot back to the reader.
   void release() { ring_.release(); }
 
@@ -42,6 +46,7 @@ class frame_prefetcher {
     landmark_frame frame;
     read_result kind = read_result::end;
     std::string error;
+    status_code code = status_code::parse;
   };
   prefetch_ring<slot> ring_;
   slot* current_ = nullptr;

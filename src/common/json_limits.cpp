@@ -5,9 +5,10 @@ namespace avatarmap::io_detail {
 status check_json_limits(std::string_view text, const std::string& what,
                          const json_limits& limits) {
   if (text.size() > limits.max_bytes) {
-    return status::error(what + ": JSON text is " + std::to_string(text.size()) +
-                         " bytes, more than the limit of " + std::to_string(limits.max_bytes) +
-                         " bytes; not a file this program reads (is it the right file?)");
+    return status::parse_error(what + ": JSON text is " + std::to_string(text.size()) +
+                               " bytes, more than the limit of " +
+                               std::to_string(limits.max_bytes) +
+                               " bytes; not a file this program reads (is it the right file?)");
   }
   // One pass, no allocation: only brackets outside strings count, so a name like "[[[" or an
   // escaped quote inside a string cannot push the depth. Unbalanced closers are left to the
@@ -34,11 +35,11 @@ status check_json_limits(std::string_view text, const std::string& what,
       case '[':
       case '{':
         if (++depth > limits.max_depth) {
-          return status::error(what + ": JSON nests deeper than " +
-                               std::to_string(limits.max_depth) + " levels (at byte " +
-                               std::to_string(i) +
-                               "); not a valid file of this kind, or an extension/extras value "
-                               "that cannot be read: remove the deep value or use another file");
+          return status::parse_error(
+              what + ": JSON nests deeper than " + std::to_string(limits.max_depth) +
+              " levels (at byte " + std::to_string(i) +
+              "); not a valid file of this kind, or an extension/extras value "
+              "that cannot be read: remove the deep value or use another file");
         }
         break;
       case ']':

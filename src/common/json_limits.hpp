@@ -21,7 +21,8 @@ struct json_limits {
 /// Scans `text` (strings and escapes honoured; not a full validation) and fails when it nests
 /// deeper or is larger than `limits`. The message starts with `what` (usually the file name)
 /// and names the limit and what to do: "FILE: JSON nests deeper than 128 levels (at byte
-/// 4711); not a valid avatar/mapping, or an extension that cannot be read".
+/// 4711); not a valid avatar/mapping, or an extension that cannot be read". Its code is
+/// status_code::parse (the content is not one this program reads).
 status check_json_limits(std::string_view text, const std::string& what,
                          const json_limits& limits = {});
 

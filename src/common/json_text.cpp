@@ -156,7 +156,7 @@ status parse_json_text(std::string_view text, const std::string& what, nlohmann:
     out = nullptr;
     error_finder finder;
     json::sax_parse(text.begin(), text.end(), &finder);
-    return status::error(what + ": " + describe(text, finder));
+    return status::parse_error(what + ": " + describe(text, finder));
   } catch (const std::bad_alloc&) {
     out = nullptr;
     return status::out_of_memory(what + ": not enough memory to read " +
@@ -164,7 +164,7 @@ status parse_json_text(std::string_view text, const std::string& what, nlohmann:
   } catch (const std::exception&) {
     // Not expected with allow_exceptions off; kept so that no library text reaches a user.
     out = nullptr;
-    return status::error(what + ": could not be read as JSON");
+    return status::parse_error(what + ": could not be read as JSON");
   }
 }
 
@@ -173,13 +173,11 @@ status read_json_file(const std::string& path, nlohmann::json& out, const json_l
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
   if (!ec && size > limits.max_bytes)
-    return status::error(path + ": " + std::to_string(size) + " bytes, more than the " +
-                         std::to_string(limits.max_bytes) +
-                         " bytes a JSON file may have here; is it the right file?");
-  // Exactly "PATH: cannot read the file": select_binding tells an unreadable table from a
-  // malformed one by this text.
+    return status::parse_error(path + ": " + std::to_string(size) + " bytes, more than the " +
+                               std::to_string(limits.max_bytes) +
+                               " bytes a JSON file may have here; is it the right file?");
   std::ifstream in(path, std::ios::binary);
-  if (!in) return status::error(path + ": cannot read the file");
+  if (!in) return status::io_error(path + ": cannot read the file");
   // Read in blocks up to the limit: a FIFO or a device has no size to check up front.
   std::string text;
   try {
@@ -187,13 +185,13 @@ status read_json_file(const std::string& path, nlohmann::json& out, const json_l
     while (in.read(block, sizeof block) || in.gcount() > 0) {
       text.append(block, static_cast<std::size_t>(in.gcount()));
       if (text.size() > limits.max_bytes)
-        return status::error(path + ": more than the " + std::to_string(limits.max_bytes) +
-                             " bytes a JSON file may have here; is it the right file?");
+        return status::parse_error(path + ": more than the " + std::to_string(limits.max_bytes) +
+                                   " bytes a JSON file may have here; is it the right file?");
     }
   } catch (const std::bad_alloc&) {
     return status::out_of_memory(path + ": not enough memory to read the file");
   }
-  if (in.bad()) return status::error(path + ": read error");
+  if (in.bad()) return status::io_error(path + ": read error");
   return parse_json_text(text, path, out, limits);
 }
 

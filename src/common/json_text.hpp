@@ -17,12 +17,15 @@ namespace avatarmap::io_detail {
 /// Parses `text` into `out` (null on failure). Fails, with a message starting with `what`
 /// (usually the file name), when the text breaks `limits` (nesting, size), is not valid JSON
 /// (naming the line and column and the token: unexpected character, unclosed string or
-/// bracket, a number beyond a double's range, a bad \u escape), or memory runs out.
+/// bracket, a number beyond a double's range, a bad \u escape): status_code::parse, or memory
+/// runs out: status_code::out_of_memory.
 status parse_json_text(std::string_view text, const std::string& what, nlohmann::json& out,
                        const json_limits& limits = {});
 
 /// Reads the file at `path` and parses it as parse_json_text() does, `path` naming the file in
-/// messages. A file larger than limits.max_bytes is refused before it is read.
+/// messages. A file larger than limits.max_bytes is refused before it is read. Codes: io (the
+/// file cannot be opened or read: "PATH: cannot read the file"), parse (too large, too deep,
+/// not valid JSON), out_of_memory.
 status read_json_file(const std::string& path, nlohmann::json& out, const json_limits& limits = {});
 
 /// "a number", "a string", "an object", "an array", "true or false", "null": what a value is,

@@ -90,11 +90,11 @@ bool text_output::write(std::string_view s) {
 }
 
 status text_output::commit() {
-  if (!open_) return status::error(path_ + ": commit without an open file");
+  if (!open_) return status::io_error(path_ + ": commit without an open file");
   if (!flush()) {
     const std::string e = error_;
     discard();
-    return status::error(e);
+    return status::io_error(e);
   }
   open_ = false;
   if (is_stdout_) {

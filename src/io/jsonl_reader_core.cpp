@@ -23,7 +23,7 @@ status jsonl_reader_core::open_file(const std::string& path, std::string_view& o
                                     bool& out_has_header) {
   name_ = path == "-" ? std::string("<stdin>") : path;
   std::string e;
-  if (!src_.open_file(path, e)) return status::error(name_ + ": " + e);
+  if (!src_.open_file(path, e)) return status::io_error(name_ + ": " + e);
   return after_open(out_header_line, out_has_header);
 }
 
@@ -68,6 +68,7 @@ line_status jsonl_reader_core::next_line(std::string_view& out_line) {
   }
   if (!open_) {
     error_ = "reader is not open (call open() first)";
+    error_code_ = status_code::invalid_argument;
     return line_status::error;
   }
   for (;;) {
@@ -76,6 +77,7 @@ line_status jsonl_reader_core::next_line(std::string_view& out_line) {
     line_ = src_.line_number();
     if (s == line_status::error) {
       set_error(e);
+      if (src_.read_failed()) error_code_ = status_code::io;
       return s;
     }
     if (s == line_status::end) return s;
@@ -84,6 +86,7 @@ line_status jsonl_reader_core::next_line(std::string_view& out_line) {
 }
 
 bool jsonl_reader_core::set_error(std::string_view message) {
+  error_code_ = status_code::parse;
   error_ = name_;
   error_ += ':';
   error_ += std::to_string(line_);

@@ -21,17 +21,22 @@ class jsonl_reader_core {
   status open_memory(const char* data, std::size_t size, const std::string& name,
                      std::string_view& out_header_line, bool& out_has_header);
 
-  /// Next non-blank line. On error() the message is already set (with prefix).
+  /// Next non-blank line. On error() the message is already set (with prefix) and
+  /// error_code() says its kind.
   line_status next_line(std::string_view& out_line);
 
-  /// Sets the error to "NAME:LINE: message" and returns false.
+  /// Sets the error to "NAME:LINE: message" (a malformed line: status_code::parse) and
+  /// returns false.
   bool set_error(std::string_view message);
   status error_status(std::string_view message) {
     set_error(message);
-    return status::error(error_);
+    return status::parse_error(error_);
   }
 
   const std::string& error() const { return error_; }
+  /// The kind of the last error: parse (a malformed or over-long line), io (reading the file
+  /// failed), invalid_argument (not open).
+  status_code error_code() const { return error_code_; }
   long line() const { return line_; }
   const std::string& name() const { return name_; }
   bool is_open() const { return open_; }
@@ -42,6 +47,7 @@ class jsonl_reader_core {
   line_source src_;
   std::string name_;
   std::string error_;
+  status_code error_code_ = status_code::parse;
   std::string_view pending_;
   bool has_pending_ = false;
   bool pending_error_ = false;

@@ -71,6 +71,7 @@ bool line_source::fill(std::string& out_error) {
     if (std::ferror(file_)) {
       out_error = std::string("read error: ") + std::strerror(errno);
       eof_ = true;
+      read_failed_ = true;
       return false;
     }
     eof_ = true;

@@ -52,6 +52,8 @@ class line_source {
   line_status next(std::string_view& out_line, std::string& out_error);
   /// 1-based number of the line last returned (or that failed).
   long line_number() const { return line_; }
+  /// True once reading the file failed (a read error, not a line over the cap).
+  bool read_failed() const { return read_failed_; }
 
  private:
   bool fill(std::string& out_error);  // reads more data after end_; false on read error
@@ -59,6 +61,7 @@ class line_source {
   std::FILE* file_ = nullptr;
   bool owns_file_ = false;
   bool eof_ = false;
+  bool read_failed_ = false;
   bool first_ = true;
   bool skipping_ = false;      // the rest of a line over the cap is still to be dropped
   std::size_t skipped_ = 0;    // bytes of that line seen so far

@@ -290,6 +290,7 @@ read_result pose_reader::next(proxy_pose& out) {
 }
 
 const std::string& pose_reader::error() const { return impl_->core.error(); }
+status_code pose_reader::error_code() const { return impl_->core.error_code(); }
 long pose_reader::line() const { return impl_->core.line(); }
 
 // ---- writer --------------------------------------------------------------------------------
@@ -321,7 +322,7 @@ status pose_writer::open(const std::string& path, const pose_file_header& header
 status pose_writer::write(const proxy_pose& pose) {
   auto& o = impl_->out;
   if (!o.is_open()) return status::error(o.path() + ": write() on a writer that is not open");
-  if (!io_detail::put_pose_line(o, pose, impl_->options)) return status::error(o.error());
+  if (!io_detail::put_pose_line(o, pose, impl_->options)) return status::io_error(o.error());
   return {};
 }
 

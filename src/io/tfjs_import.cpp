@@ -16,9 +16,9 @@ namespace {
 status load_json(const std::string& path, nlohmann::json& out) {
   if (status s = io_detail::read_json_file(path, out); !s) return s;
   if (!out.is_array())
-    return status::error(path +
-                         ": expected a JSON array of frames (tfjs-models test format), got " +
-                         io_detail::json_type_text(out));
+    return status::parse_error(path +
+                               ": expected a JSON array of frames (tfjs-models test format), got " +
+                               io_detail::json_type_text(out));
   return {};
 }
 
@@ -35,17 +35,17 @@ status read_frame(const nlohmann::json& doc, std::size_t i, const std::string& p
                   double (*out)[3]) {
   const nlohmann::json& f = doc[i];
   if (!f.is_array() || f.size() != static_cast<std::size_t>(count))
-    return status::error(path + ": frame " + std::to_string(i) + ": expected an array of " +
-                         std::to_string(count) + " points, got " +
-                         (f.is_array() ? "an array of " + std::to_string(f.size())
-                                       : std::string(io_detail::json_type_text(f))));
+    return status::parse_error(path + ": frame " + std::to_string(i) + ": expected an array of " +
+                               std::to_string(count) + " points, got " +
+                               (f.is_array() ? "an array of " + std::to_string(f.size())
+                                             : std::string(io_detail::json_type_text(f))));
   for (int k = 0; k < count; ++k) {
     const nlohmann::json& p = f[static_cast<std::size_t>(k)];
     if (!p.is_array() || p.size() < 3)
-      return status::error(path + ": frame " + std::to_string(i) + " point " + std::to_string(k) +
-                           ": expected [x, y, z], got " +
-                           (p.is_array() ? "an array of " + std::to_string(p.size())
-                                         : std::string(io_detail::json_type_text(p))));
+      return status::parse_error(path + ": frame " + std::to_string(i) + " point " +
+                                 std::to_string(k) + ": expected [x, y, z], got " +
+                                 (p.is_array() ? "an array of " + std::to_string(p.size())
+                                               : std::string(io_detail::json_type_text(p))));
     for (int c = 0; c < 3; ++c) {
       const nlohmann::json& v = p[static_cast<std::size_t>(c)];
       out[k][c] = v.is_number() ? v.get<double>() : std::numeric_limits<double>::quiet_NaN();
@@ -68,9 +68,9 @@ status import_tfjs(const char* fn, const std::string& image_json, const std::str
   if (status s = load_json(image_json, image); !s) return s;
   if (status s = load_json(world_json, world); !s) return s;
   if (image.size() != world.size())
-    return status::error(image_json + " has " + std::to_string(image.size()) + " frames but " +
-                         world_json + " has " + std::to_string(world.size()) +
-                         " (expected the same number)");
+    return status::parse_error(image_json + " has " + std::to_string(image.size()) +
+                               " frames but " + world_json + " has " +
+                               std::to_string(world.size()) + " (expected the same number)");
   if (!image.empty() && !std::isfinite(static_cast<double>(image.size() - 1) / fps))
     return status::error(name + ": fps " + std::to_string(fps) +
                          " is too small: the last frame's time would not be finite");

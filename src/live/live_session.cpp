@@ -11,7 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/core/limits.hpp"
+#include "avatarmap/time/latency_stats.hpp"
 
 namespace avatarmap {
 
@@ -24,6 +25,7 @@ struct image_copy {
   std::vector<std::uint8_t> pixels;
   image_view view{};
   double t = 0.0;
+  long index = 0;
   clock_type::time_point pushed{};
 
   void copy_from(const image_view& v, double time) {
@@ -40,6 +42,7 @@ struct image_copy {
     pixels.swap(o.pixels);
     std::swap(view, o.view);
     std::swap(t, o.t);
+    std::swap(index, o.index);
     std::swap(pushed, o.pushed);
   }
 };
@@ -47,58 +50,139 @@ struct image_copy {
 }  // namespace
 
 struct live_session::impl {
+  explicit impl(const live_session_options& o) : options(o), latencies(o.latency_samples) {}
+
+  live_session_options options;
   std::unique_ptr<capture_pipeline> pipeline;
-  int latency_capacity = 1;
 
   // Images: `incoming` is the pushing thread's own (under `push_m`: pushes from several
   // threads are serialised); `waiting` is handed over under `m`; `work` is the worker's own.
   std::mutex push_m;
   image_copy incoming, waiting, work;
-  std::mutex m;
-  std::condition_variable cv;
+  mutable std::mutex m;
+  std::condition_variable cv;                  // the worker waits on it
+  mutable std::condition_variable stopped_cv;  // wait_stopped() waits on it
   bool has_waiting = false;
-  bool stop = false;
+  bool finishing = false;  // finish(): no more pushes; the worker drains and stops
+  bool halt = false;       // stop(): the worker stops at once
+  bool worker_done = false;
   long pushed = 0, dropped = 0;
 
-  // Results, under `out_m`.
+  // Results, under `out_m`: the pipeline's stream (solve and sample) and what it produced.
   mutable std::mutex out_m;
-  pose_resampler resampler;
   proxy_pose newest;
   bool has_pose = false;
-  long processed = 0, failed = 0;
-  std::vector<double> latencies;  // a ring of latency_capacity samples
-  long latency_count = 0;
+  long processed = 0, failed = 0, outputs = 0;
+  latency_stats latencies;
   status error;
+  // The stream's clock: the newest pose's capture time at the moment it reached the stream;
+  // whether an output has carried it yet, and when its image was pushed.
+  clock_type::time_point newest_at{};
+  clock_type::time_point newest_pushed{};
+  bool fresh = false;
 
   // The worker's scratch.
   landmark_frame frame;
   proxy_pose pose;
   std::thread worker;
 
-  void run() {
+  // The output thread and what stops it.
+  std::thread output;
+  std::mutex output_m;
+  std::condition_variable output_cv;
+  bool output_stop = false;
+
+  void run_worker() {
     for (;;) {
+      long dropped_so_far = 0;
       {
         std::unique_lock<std::mutex> lock(m);
-        cv.wait(lock, [&] { return stop || has_waiting; });
-        if (stop) return;
+        cv.wait(lock, [&] { return halt || has_waiting || finishing; });
+        if (halt || !has_waiting) break;  // stopped, or finished and drained
         work.swap(waiting);
         has_waiting = false;
+        dropped_so_far = dropped;
       }
-      const status st = pipeline->process(work.view, work.t, frame, pose);
-      const double ms =
-          std::chrono::duration<double, std::milli>(clock_type::now() - work.pushed).count();
-      std::lock_guard<std::mutex> lock(out_m);
-      if (!st.ok()) {
-        ++failed;
-        error = st;
-        continue;
+      // Estimation outside any lock (it is the long part); solving under out_m, so that
+      // sample() never sees the stream half updated.
+      const status st = pipeline->estimate(work.view, work.t, frame);
+      double ms = 0.0;
+      {
+        std::lock_guard<std::mutex> lock(out_m);
+        if (!st.ok()) {
+          ++failed;
+          error = st;
+        } else {
+          pipeline->solve(frame, pose);
+          const clock_type::time_point now = clock_type::now();
+          ms = std::chrono::duration<double, std::milli>(now - work.pushed).count();
+          newest = pose;
+          has_pose = true;
+          ++processed;
+          latencies.add(ms);
+          newest_at = now;
+          newest_pushed = work.pushed;
+          fresh = true;
+        }
       }
-      resampler.push(pose);
-      newest = pose;
-      has_pose = true;
-      ++processed;
-      latencies[static_cast<size_t>(latency_count % latency_capacity)] = ms;
-      ++latency_count;
+      if (options.on_frame) {
+        live_frame_report r;
+        r.index = work.index;
+        r.t = work.t;
+        r.dropped_so_far = dropped_so_far;
+        if (st.ok()) {
+          r.frame = &frame;
+          r.pose = &pose;
+          r.timings = pipeline->last_timings();
+          r.latency_ms = ms;
+        } else {
+          r.error = &st;
+        }
+        if (!options.on_frame(r)) break;
+      }
+    }
+    {
+      std::lock_guard<std::mutex> lock(m);
+      worker_done = true;
+      if (has_waiting) {  // stopped with an image waiting: dropped
+        ++dropped;
+        has_waiting = false;
+      }
+    }
+    stopped_cv.notify_all();
+  }
+
+  void run_output() {
+    const auto period = std::chrono::duration_cast<clock_type::duration>(
+        std::chrono::duration<double>(1.0 / options.output_fps));
+    auto next = clock_type::now();
+    double last_t = -INFINITY;  // output times always increase (processing time varies)
+    proxy_pose p;
+    live_output_report r;
+    for (;;) {
+      next += period;
+      {
+        // Waits for the next period on the condition, so that a stop is seen at once
+        // whatever output_fps is.
+        std::unique_lock<std::mutex> lock(output_m);
+        if (output_cv.wait_until(lock, next, [&] { return output_stop; })) return;
+      }
+      {
+        std::lock_guard<std::mutex> lock(out_m);
+        if (!has_pose) continue;
+        const double t = std::max(
+            last_t + 1e-6,
+            newest.t + std::chrono::duration<double>(clock_type::now() - newest_at).count());
+        if (!pipeline->stream().sample(t, p)) continue;
+        last_t = t;
+        p.t = t;
+        r.carries_new_frame = fresh;
+        r.pushed_at = newest_pushed;
+        fresh = false;
+        ++outputs;
+      }
+      for (const live_output& out : options.outputs)
+        if (out) out(p, r);
     }
   }
 };
@@ -110,29 +194,59 @@ status live_session::create(const live_session_options& options,
   out.reset();
   if (options.latency_samples < 1)
     return status::error("live_session_options.latency_samples must be >= 1");
-  if (!(options.resampler.max_extrapolation_seconds >= 0.0) ||
-      !std::isfinite(options.resampler.max_extrapolation_seconds))
-    return status::error(
-        "live_session_options.resampler.max_extrapolation_seconds must be finite and >= 0");
-  auto p = std::make_unique<impl>();
+  if (!(std::isfinite(options.output_fps) && options.output_fps >= 0.0 &&
+        options.output_fps <= k_max_fps))
+    return status::error("live_session_options.output_fps must be 0 (no output thread) or in (0, " +
+                         limit_text(k_max_fps) + "]");
+  auto p = std::make_unique<impl>(options);
   if (status st = capture_pipeline::create(options.pipeline, p->pipeline); !st.ok()) return st;
-  p->resampler = pose_resampler(options.resampler);
-  p->latency_capacity = options.latency_samples;
-  p->latencies.assign(static_cast<size_t>(options.latency_samples), 0.0);
   p->newest.set_rest();
   impl* raw = p.get();
-  p->worker = std::thread([raw] { raw->run(); });
+  p->worker = std::thread([raw] { raw->run_worker(); });
+  if (options.output_fps > 0.0) p->output = std::thread([raw] { raw->run_output(); });
   out.reset(new live_session(std::move(p)));
   return {};
 }
 
-live_session::~live_session() {
+live_session::~live_session() { stop(); }
+
+void live_session::stop() {
+  impl& s = *impl_;
+  {
+    std::lock_guard<std::mutex> lock(s.m);
+    s.halt = true;
+  }
+  s.cv.notify_all();
+  if (s.worker.joinable()) s.worker.join();
+  {
+    std::lock_guard<std::mutex> lock(s.output_m);
+    s.output_stop = true;
+  }
+  s.output_cv.notify_all();
+  if (s.output.joinable()) s.output.join();
+}
+
+void live_session::finish() {
   {
     std::lock_guard<std::mutex> lock(impl_->m);
-    impl_->stop = true;
+    impl_->finishing = true;
   }
-  impl_->cv.notify_one();
-  if (impl_->worker.joinable()) impl_->worker.join();
+  impl_->cv.notify_all();
+}
+
+bool live_session::stopped() const {
+  std::lock_guard<std::mutex> lock(impl_->m);
+  return impl_->worker_done;
+}
+
+void live_session::wait_stopped() const {
+  std::unique_lock<std::mutex> lock(impl_->m);
+  impl_->stopped_cv.wait(lock, [&] { return impl_->worker_done; });
+}
+
+bool live_session::wait_stopped_until(std::chrono::steady_clock::time_point deadline) const {
+  std::unique_lock<std::mutex> lock(impl_->m);
+  return impl_->stopped_cv.wait_until(lock, deadline, [&] { return impl_->worker_done; });
 }
 
 status live_session::push(const image_view& image, double t) {
@@ -143,7 +257,10 @@ status live_session::push(const image_view& image, double t) {
   s.incoming.copy_from(image, t);
   {
     std::lock_guard<std::mutex> lock(s.m);
+    if (s.halt || s.finishing || s.worker_done)
+      return status::error("live_session::push: the session has stopped");
     if (s.has_waiting) ++s.dropped;
+    s.incoming.index = s.pushed;
     s.waiting.swap(s.incoming);
     s.has_waiting = true;
     ++s.pushed;
@@ -155,7 +272,7 @@ status live_session::push(const image_view& image, double t) {
 bool live_session::sample(double t, proxy_pose& out) const {
   std::lock_guard<std::mutex> lock(impl_->out_m);
   if (!impl_->has_pose) return false;
-  if (!impl_->resampler.sample(t, out)) return false;
+  if (!impl_->pipeline->stream().sample(t, out)) return false;
   out.t = t;
   return true;
 }
@@ -169,29 +286,25 @@ bool live_session::latest(proxy_pose& out) const {
 
 live_session_stats live_session::stats() const {
   live_session_stats s;
-  std::vector<double> kept;
   {
     std::lock_guard<std::mutex> lock(impl_->m);
     s.pushed = impl_->pushed;
     s.dropped = impl_->dropped;
   }
+  std::unique_ptr<latency_stats> kept;
   {
     std::lock_guard<std::mutex> lock(impl_->out_m);
     s.processed = impl_->processed;
     s.failed = impl_->failed;
+    s.outputs = impl_->outputs;
     s.newest_t = impl_->has_pose ? impl_->newest.t : 0.0;
-    const long n = std::min<long>(impl_->latency_count, impl_->latency_capacity);
-    kept.assign(impl_->latencies.begin(), impl_->latencies.begin() + n);
+    kept = std::make_unique<latency_stats>(impl_->latencies);  // sorted outside the lock
   }
-  if (!kept.empty()) {
-    std::sort(kept.begin(), kept.end());
-    auto at = [&](double q) {
-      return kept[std::min(kept.size() - 1, static_cast<size_t>(q * (kept.size() - 1) + 0.5))];
-    };
-    s.latency_p50_ms = at(0.5);
-    s.latency_p95_ms = at(0.95);
-    s.latency_max_ms = kept.back();
-  }
+  const latency_summary l = kept->summary();
+  s.latency_mean_ms = l.mean_ms;
+  s.latency_p50_ms = l.p50_ms;
+  s.latency_p95_ms = l.p95_ms;
+  s.latency_max_ms = l.max_ms;
   return s;
 }
 

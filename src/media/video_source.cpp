@@ -64,10 +64,11 @@ status check_options(const video_source_options& o) {
       return status::error("video_source: video_size is '" + o.video_size +
                            "', wanted WIDTHxHEIGHT, each 1..16384 (e.g. 1280x720)");
   }
-  if (!(o.framerate >= 0.0 && o.framerate <= 1000.0))
+  if (!(o.framerate >= 0.0 && o.framerate <= k_max_fps))
     return status::error(
         "video_source: framerate must be 0 (the device's default) or in "
-        "(0, 1000] frames per second");
+        "(0, " +
+        limit_text(k_max_fps) + "] frames per second");
   if (o.input_format.size() > 32 ||
       !std::all_of(o.input_format.begin(), o.input_format.end(),
                    [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }))
@@ -405,8 +406,9 @@ struct video_source::impl {
     av_dict_set(&fmt_options, "pattern_type", "none", 0);
     const int err = open_input("file:" + name, nullptr, fmt_options, false);
     if (err < 0)
-      return status::error(name + ": cannot be read as media (" + av_error_text(err) +
-                           "): not a media file, or a truncated or corrupt one");
+      return status::failure(err == AVERROR_INVALIDDATA ? status_code::parse : status_code::io,
+                             name + ": cannot be read as media (" + av_error_text(err) +
+                                 "): not a media file, or a truncated or corrupt one");
     return open_decoder(out_info, false);
   }
 
@@ -419,16 +421,17 @@ struct video_source::impl {
     constexpr bool have_devices = false;
 #endif
     if (!have_devices)
-      return status::error(path + ": no such file, and input devices (" + spec.name +
-                           ":DEVICE) are not available: avatarmap was built without "
-                           "libavdevice (install libavdevice-dev and rebuild)");
+      return status::unsupported(path + ": no such file, and input devices (" + spec.name +
+                                 ":DEVICE) are not available: avatarmap was built without "
+                                 "libavdevice (install libavdevice-dev and rebuild)");
     const video_source_inputs inputs = video_source_supported_inputs();
     if (std::find(inputs.devices.begin(), inputs.devices.end(), spec.name) == inputs.devices.end())
       return status::error(path + ": no such file, and '" + spec.name +
                            "' is not a video input device of this FFmpeg (devices: " +
                            join(inputs.devices) + "; URLs are written SCHEME://...)");
     const AVInputFormat* device = av_find_input_format(spec.name.c_str());
-    if (!device) return status::error(path + ": the device '" + spec.name + "' is not available");
+    if (!device)
+      return status::unsupported(path + ": the device '" + spec.name + "' is not available");
     // What the device accepts is in its private options.
     auto takes = [&](const char* option) {
       const AVClass* cls = device->priv_class;
@@ -478,7 +481,7 @@ struct video_source::impl {
       else
         m += ": check the device name, that it is connected, and that no other program "
              "holds it";
-      return status::error(m);
+      return status::io_error(m);
     }
     const status st = open_decoder(info, true);
     clear_deadline();
@@ -531,7 +534,7 @@ struct video_source::impl {
         m += ": what came is not a stream FFmpeg can read";
       else
         m += ": check the URL, and that the stream runs and is reachable from here";
-      return status::error(m);
+      return status::io_error(m);
     }
     status st = open_decoder(info, false);
     if (st && fmt->pb && (deadline_hit || fmt->pb->error == AVERROR(ETIMEDOUT))) {
@@ -544,9 +547,9 @@ struct video_source::impl {
     clear_deadline();
     if (!st) {
       if (deadline_hit)
-        return status::error(path + ": no picture within " +
-                             seconds_text(options.open_timeout_seconds) +
-                             " s (--open-seconds): " + st.message());
+        return status::io_error(path + ": no picture within " +
+                                seconds_text(options.open_timeout_seconds) +
+                                " s (--open-seconds): " + st.message());
       return st;
     }
     info.kind = video_source_kind::stream;
@@ -561,27 +564,27 @@ struct video_source::impl {
     // max_pixels is not given here: the size must come out to be reported against max_size.
     int err = avformat_find_stream_info(fmt, nullptr);
     if (err < 0)
-      return status::error(name + ": cannot read the stream information (" + av_error_text(err) +
-                           ")");
+      return status::parse_error(name + ": cannot read the stream information (" +
+                                 av_error_text(err) + ")");
 
     const AVCodec* codec = nullptr;
     stream = av_find_best_stream(fmt, AVMEDIA_TYPE_VIDEO, -1, -1, &codec, 0);
     if (stream == AVERROR_STREAM_NOT_FOUND)
-      return status::error(name + ": no video stream (" + std::to_string(fmt->nb_streams) +
-                           " other stream(s))");
+      return status::parse_error(name + ": no video stream (" + std::to_string(fmt->nb_streams) +
+                                 " other stream(s))");
     if (stream < 0 || !codec) {
       const AVCodecID id =
           stream >= 0 ? fmt->streams[stream]->codecpar->codec_id : AV_CODEC_ID_NONE;
-      return status::error(name + ": no decoder for the video codec '" + avcodec_get_name(id) +
-                           "' in this FFmpeg build");
+      return status::unsupported(name + ": no decoder for the video codec '" +
+                                 avcodec_get_name(id) + "' in this FFmpeg build");
     }
     AVStream* st = fmt->streams[stream];
     const AVCodecParameters* par = st->codecpar;
     if (par->width <= 0 || par->height <= 0)
-      return status::error(name + ": no picture could be read (size " + std::to_string(par->width) +
-                           "x" + std::to_string(par->height) +
-                           "): a broken or empty image or video, or one over FFmpeg's own " +
-                           "size limit (about 16000x16000)");
+      return status::parse_error(name + ": no picture could be read (size " +
+                                 std::to_string(par->width) + "x" + std::to_string(par->height) +
+                                 "): a broken or empty image or video, or one over FFmpeg's own " +
+                                 "size limit (about 16000x16000)");
     if (par->width > options.max_size || par->height > options.max_size)
       return status::error(name + ": the image is " + std::to_string(par->width) + "x" +
                            std::to_string(par->height) + ", larger than the " +
@@ -589,9 +592,10 @@ struct video_source::impl {
                            std::to_string(options.max_size) + " limit");
 
     dec = avcodec_alloc_context3(codec);
-    if (!dec) return status::error(name + ": out of memory");
+    if (!dec) return status::out_of_memory(name + ": out of memory");
     err = avcodec_parameters_to_context(dec, par);
-    if (err < 0) return status::error(name + ": bad codec parameters (" + av_error_text(err) + ")");
+    if (err < 0)
+      return status::parse_error(name + ": bad codec parameters (" + av_error_text(err) + ")");
     const std::string max_pixels =
         std::to_string(static_cast<std::int64_t>(options.max_size) * options.max_size);
     dec->thread_count = options.max_threads;
@@ -601,8 +605,8 @@ struct video_source::impl {
     err = avcodec_open2(dec, codec, &dec_options);
     av_dict_free(&dec_options);
     if (err < 0)
-      return status::error(name + ": cannot open the '" + codec->name + "' decoder (" +
-                           av_error_text(err) + ")");
+      return status::parse_error(name + ": cannot open the '" + codec->name + "' decoder (" +
+                                 av_error_text(err) + ")");
 
     time_base = av_q2d(st->time_base);
     start_pts = st->start_time != AV_NOPTS_VALUE ? st->start_time : 0;
@@ -867,7 +871,7 @@ status video_source::open(const std::string& path, const video_source_options& o
   p->path = shown;
   p->packet = av_packet_alloc();
   p->frame = av_frame_alloc();
-  if (!p->packet || !p->frame) return status::error(shown + ": out of memory");
+  if (!p->packet || !p->frame) return status::out_of_memory(shown + ": out of memory");
 
   if (spec.kind == input_kind::device || spec.kind == input_kind::url) {
     p->live = true;
@@ -883,12 +887,12 @@ status video_source::open(const std::string& path, const video_source_options& o
   if (fs::is_directory(file, ec)) {
     p->files = folder_images(file);
     if (p->files.empty())
-      return status::error(shown +
-                           ": the folder has no image files (jpg, png, bmp, tif, webp, "
-                           "ppm)");
+      return status::io_error(shown +
+                              ": the folder has no image files (jpg, png, bmp, tif, webp, "
+                              "ppm)");
   } else if (fs::exists(file, ec)) {
-    if (!fs::is_regular_file(file, ec)) return status::error(shown + ": not a regular file");
-    if (fs::file_size(file, ec) == 0) return status::error(shown + ": empty file");
+    if (!fs::is_regular_file(file, ec)) return status::io_error(shown + ": not a regular file");
+    if (fs::file_size(file, ec) == 0) return status::parse_error(shown + ": empty file");
     if (status st = p->open_file(file, p->info); !st) return st;
     p->open = true;
     impl_ = std::move(p);
@@ -896,13 +900,14 @@ status video_source::open(const std::string& path, const video_source_options& o
   } else {
     std::string prefix, suffix;
     int width = 0;
-    if (spec.kind != input_kind::pattern) return status::error(shown + ": no such file or folder");
+    if (spec.kind != input_kind::pattern)
+      return status::io_error(shown + ": no such file or folder");
     if (!parse_frame_pattern(file, prefix, suffix, width))
-      return status::error(shown + ": not a file, and not a pattern with one %d or %0Nd");
+      return status::io_error(shown + ": not a file, and not a pattern with one %d or %0Nd");
     p->files = pattern_images(prefix, suffix, width);
     if (p->files.empty())
-      return status::error(shown + ": no file matches the pattern (looked for numbers 0..4: " +
-                           pattern_name(prefix, suffix, width, 0) + ", ...)");
+      return status::io_error(shown + ": no file matches the pattern (looked for numbers 0..4: " +
+                              pattern_name(prefix, suffix, width, 0) + ", ...)");
   }
 
   // A sequence: the first image gives the size and codec.
@@ -981,10 +986,10 @@ void video_source_quiet_log(bool) {}
 status video_source::open(const std::string& path, const video_source_options& options) {
   close();
   if (status st = check_options(options); !st) return st;
-  return status::error(path +
-                       ": cannot decode video or images: avatarmap was built without FFmpeg "
-                       "(install libavformat-dev libavcodec-dev libavutil-dev libswscale-dev "
-                       "and configure with AVATARMAP_WITH_FFMPEG=ON)");
+  return status::unsupported(path +
+                             ": cannot decode video or images: avatarmap was built without FFmpeg "
+                             "(install libavformat-dev libavcodec-dev libavutil-dev libswscale-dev "
+                             "and configure with AVATARMAP_WITH_FFMPEG=ON)");
 }
 
 read_result video_source::next(image_view&, double&) { return read_result::error; }

@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "avatarmap/core/limits.hpp"
 #include "common/atomic_file.hpp"
 #include "media/frame_pattern.hpp"
 
@@ -43,7 +44,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr double k_min_fps = 0.01;
-constexpr double k_max_fps = 1000.0;
 
 status check_arguments(const std::string& path, int width, int height, double fps,
                        const video_writer_options& o) {
@@ -55,7 +55,7 @@ status check_arguments(const std::string& path, int width, int height, double fp
                          std::to_string(height) + " is outside 1.." + std::to_string(o.max_size) +
                          " per side");
   if (!(fps >= k_min_fps && fps <= k_max_fps))
-    return status::error(path + ": fps must be a number in 0.01..1000");
+    return status::error(path + ": fps must be a number in 0.01.." + limit_text(k_max_fps));
   if (o.crf < 0 || o.crf > 51)
     return status::error(path + ": video_writer crf is " + std::to_string(o.crf) +
                          ", allowed 0..51");
@@ -154,7 +154,7 @@ struct video_writer::impl {
   std::int64_t png_temps = 0;  // temporary PNG files created (including first_fd's)
 
   bool failed = false;
-  std::string failure;
+  status failure;  // the first failure, repeated by later calls
 
   ~impl() { discard(); }
 
@@ -198,11 +198,11 @@ struct video_writer::impl {
   }
   int first_number = 0;
 
-  status fail(std::string message) {
+  status fail(status_code code, std::string message) {
     discard();
     failed = true;
-    failure = std::move(message);
-    return status::error(failure);
+    failure = status::failure(code, std::move(message));
+    return failure;
   }
 
   std::int64_t next_pts(double t) {
@@ -228,22 +228,24 @@ struct video_writer::impl {
   status encode(AVFrame* f) {
     int err = avcodec_send_frame(enc, f);
     if (err < 0 && !(f == nullptr && err == AVERROR_EOF))
-      return fail(path + ": the " + encoder_name + " encoder refused frame " +
-                  std::to_string(frames) + " (" + av_error_text(err) + ")");
+      return fail(status_code::internal, path + ": the " + encoder_name +
+                                             " encoder refused frame " + std::to_string(frames) +
+                                             " (" + av_error_text(err) + ")");
     for (;;) {
       err = avcodec_receive_packet(enc, packet);
       if (err == AVERROR(EAGAIN) || err == AVERROR_EOF) return {};
       if (err < 0)
-        return fail(path + ": the " + encoder_name + " encoder failed at frame " +
-                    std::to_string(frames) + " (" + av_error_text(err) + ")");
+        return fail(status_code::internal,
+                    path + ": the " + encoder_name + " encoder failed at frame " +
+                        std::to_string(frames) + " (" + av_error_text(err) + ")");
       if (kind == video_writer_kind::video) {
         av_packet_rescale_ts(packet, enc->time_base, stream->time_base);
         packet->stream_index = stream->index;
         err = av_interleaved_write_frame(fmt, packet);  // takes the packet's data
         if (err >= 0 && fmt->pb && fmt->pb->error < 0) err = fmt->pb->error;
         if (err < 0)
-          return fail(path + ": cannot write to " + out.temp_path() + " (" + av_error_text(err) +
-                      ")");
+          return fail(status_code::io, path + ": cannot write to " + out.temp_path() + " (" +
+                                           av_error_text(err) + ")");
       } else {
         status st = write_png(packet->data, static_cast<std::size_t>(packet->size));
         if (!st) return st;  // fail() has freed the packet with everything else
@@ -263,15 +265,16 @@ struct video_writer::impl {
       if (fd < 0) {
         const int e = errno;
         temp_registration->set_sequence_count(png_temps);
-        return fail(path + ": cannot create " + png_temp(png_temps) + ": " + std::strerror(e));
+        return fail(status_code::io,
+                    path + ": cannot create " + png_temp(png_temps) + ": " + std::strerror(e));
       }
       ++png_temps;
     }
     const bool ok = write_all(fd, data, size);
     const int saved = errno;
     if (::close(fd) != 0 || !ok)
-      return fail(path + ": cannot write " + png_temp(png_temps - 1) + ": " +
-                  std::strerror(ok ? errno : saved));
+      return fail(status_code::io, path + ": cannot write " + png_temp(png_temps - 1) + ": " +
+                                       std::strerror(ok ? errno : saved));
     return {};
   }
 
@@ -287,11 +290,11 @@ struct video_writer::impl {
         return status::error(path + ": the libx264 encoder is not offered for .avi (use mpeg4)");
       codec = avcodec_find_encoder_by_name("libx264");
       if (!codec && o.encoder == "libx264")
-        return status::error(path + ": this FFmpeg has no libx264 encoder");
+        return status::unsupported(path + ": this FFmpeg has no libx264 encoder");
     }
     if (!codec) {
       codec = avcodec_find_encoder(AV_CODEC_ID_MPEG4);
-      if (!codec) return status::error(path + ": this FFmpeg has no mpeg4 encoder");
+      if (!codec) return status::unsupported(path + ": this FFmpeg has no mpeg4 encoder");
     }
     encoder_name = codec->name;
     const bool x264 = encoder_name == "libx264";
@@ -303,7 +306,7 @@ struct video_writer::impl {
     enc = avcodec_alloc_context3(codec);
     frame = av_frame_alloc();
     packet = av_packet_alloc();
-    if (!enc || !frame || !packet) return status::error(path + ": out of memory");
+    if (!enc || !frame || !packet) return status::out_of_memory(path + ": out of memory");
     enc->width = out_width;
     enc->height = out_height;
     enc->pix_fmt = AV_PIX_FMT_YUV420P;
@@ -323,20 +326,20 @@ struct video_writer::impl {
 
     int err = avformat_alloc_output_context2(&fmt, nullptr, format, nullptr);
     if (err < 0 || !fmt)
-      return status::error(path + ": no '" + format + "' muxer in this FFmpeg (" +
-                           av_error_text(err) + ")");
+      return status::unsupported(path + ": no '" + format + "' muxer in this FFmpeg (" +
+                                 av_error_text(err) + ")");
     if (fmt->oformat->flags & AVFMT_GLOBALHEADER) enc->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
     err = avcodec_open2(enc, codec, nullptr);
     if (err < 0)
-      return status::error(path + ": cannot open the " + encoder_name + " encoder for " +
-                           std::to_string(out_width) + "x" + std::to_string(out_height) +
-                           (x264 ? " (preset '" + o.preset + "')" : std::string()) + " (" +
-                           av_error_text(err) + ")");
+      return status::internal(path + ": cannot open the " + encoder_name + " encoder for " +
+                              std::to_string(out_width) + "x" + std::to_string(out_height) +
+                              (x264 ? " (preset '" + o.preset + "')" : std::string()) + " (" +
+                              av_error_text(err) + ")");
     stream = avformat_new_stream(fmt, nullptr);
-    if (!stream) return status::error(path + ": out of memory");
+    if (!stream) return status::out_of_memory(path + ": out of memory");
     err = avcodec_parameters_from_context(stream->codecpar, enc);
     if (err < 0)
-      return status::error(path + ": bad encoder parameters (" + av_error_text(err) + ")");
+      return status::internal(path + ": bad encoder parameters (" + av_error_text(err) + ")");
     stream->time_base = enc->time_base;
     stream->avg_frame_rate = enc->framerate;
 
@@ -345,10 +348,10 @@ struct video_writer::impl {
     frame->height = out_height;
     frame->colorspace = AVCOL_SPC_SMPTE170M;
     frame->color_range = AVCOL_RANGE_MPEG;
-    if (av_frame_get_buffer(frame, 0) < 0) return status::error(path + ": out of memory");
+    if (av_frame_get_buffer(frame, 0) < 0) return status::out_of_memory(path + ": out of memory");
     sws = sws_getContext(out_width, out_height, AV_PIX_FMT_RGB24, out_width, out_height,
                          AV_PIX_FMT_YUV420P, SWS_BILINEAR, nullptr, nullptr, nullptr);
-    if (!sws) return status::error(path + ": cannot set up the RGB to YUV conversion");
+    if (!sws) return status::internal(path + ": cannot set up the RGB to YUV conversion");
     // RGB is full range; the video limited-range BT.601, as the stream says.
     const int* bt601 = sws_getCoefficients(SWS_CS_ITU601);
     sws_setColorspaceDetails(sws, bt601, 1, bt601, 0, 0, 1 << 16, 1 << 16);
@@ -356,7 +359,7 @@ struct video_writer::impl {
       padded_stride = (out_width * 3 + 63) & ~63;
       padded = static_cast<std::uint8_t*>(
           av_malloc(static_cast<std::size_t>(padded_stride) * out_height + 64));
-      if (!padded) return status::error(path + ": out of memory");
+      if (!padded) return status::out_of_memory(path + ": out of memory");
     }
 
     // The temporary file, then the container's header.
@@ -365,8 +368,8 @@ struct video_writer::impl {
     const std::string url = "file:" + out.temp_path();
     err = avio_open(&fmt->pb, url.c_str(), AVIO_FLAG_WRITE);
     if (err < 0)
-      return status::error(path + ": cannot open " + out.temp_path() + " (" + av_error_text(err) +
-                           ")");
+      return status::io_error(path + ": cannot open " + out.temp_path() + " (" +
+                              av_error_text(err) + ")");
     av_freep(&fmt->url);
     fmt->url = av_strdup(url.c_str());  // +faststart reopens the file by this name
     AVDictionary* mux_options = nullptr;
@@ -375,8 +378,8 @@ struct video_writer::impl {
     err = avformat_write_header(fmt, &mux_options);
     av_dict_free(&mux_options);
     if (err < 0)
-      return status::error(path + ": cannot write the " + format + " header (" +
-                           av_error_text(err) + ")");
+      return status::io_error(path + ": cannot write the " + format + " header (" +
+                              av_error_text(err) + ")");
     header_written = true;
     kind = video_writer_kind::video;
     return {};
@@ -384,14 +387,14 @@ struct video_writer::impl {
 
   status open_png(bool is_numbered) {
     const AVCodec* codec = avcodec_find_encoder(AV_CODEC_ID_PNG);
-    if (!codec) return status::error(path + ": this FFmpeg has no png encoder");
+    if (!codec) return status::unsupported(path + ": this FFmpeg has no png encoder");
     encoder_name = codec->name;
     out_width = width;
     out_height = height;
     enc = avcodec_alloc_context3(codec);
     frame = av_frame_alloc();
     packet = av_packet_alloc();
-    if (!enc || !frame || !packet) return status::error(path + ": out of memory");
+    if (!enc || !frame || !packet) return status::out_of_memory(path + ": out of memory");
     enc->width = width;
     enc->height = height;
     enc->pix_fmt = AV_PIX_FMT_RGB24;
@@ -399,11 +402,11 @@ struct video_writer::impl {
     enc->thread_count = 1;
     int err = avcodec_open2(enc, codec, nullptr);
     if (err < 0)
-      return status::error(path + ": cannot open the png encoder (" + av_error_text(err) + ")");
+      return status::internal(path + ": cannot open the png encoder (" + av_error_text(err) + ")");
     frame->format = AV_PIX_FMT_RGB24;
     frame->width = width;
     frame->height = height;
-    if (av_frame_get_buffer(frame, 0) < 0) return status::error(path + ": out of memory");
+    if (av_frame_get_buffer(frame, 0) < 0) return status::out_of_memory(path + ": out of memory");
 
     numbered = is_numbered;
     final_name.assign(prefix.size() + suffix.size() + 32, '\0');
@@ -483,10 +486,10 @@ status video_writer::open(const std::string& path, int width, int height, double
   const fs::path folder = fs::path(first_final).parent_path();
   std::error_code ec;
   if (!folder.empty() && !fs::is_directory(folder, ec))
-    return status::error(path + ": the folder " + folder.string() +
-                         " does not exist (or is not a folder)");
+    return status::io_error(path + ": the folder " + folder.string() +
+                            " does not exist (or is not a folder)");
   if (fs::is_directory(first_final, ec))
-    return status::error(path + ": " + first_final + " is a folder");
+    return status::io_error(path + ": " + first_final + " is a folder");
 
   status st = video ? p->open_video(ext, options) : p->open_png(numbered);
   if (!st) return st;  // p's destructor removes what was created
@@ -497,7 +500,7 @@ status video_writer::open(const std::string& path, int width, int height, double
 status video_writer::write(const image_view& rgb, double t) {
   if (!impl_) return status::error("video_writer: write() without a successful open()");
   impl& s = *impl_;
-  if (s.failed) return status::error(s.failure);
+  if (s.failed) return s.failure;
   if (rgb.format != pixel_format::rgb8 || !rgb.data || rgb.width != s.width ||
       rgb.height != s.height || rgb.stride_bytes < rgb.width * 3) {
     std::string why;
@@ -517,7 +520,9 @@ status video_writer::write(const image_view& rgb, double t) {
 
   const std::int64_t pts = s.next_pts(t);
   int err = av_frame_make_writable(s.frame);  // the encoder may still hold the last one
-  if (err < 0) return s.fail(s.path + ": out of memory (" + av_error_text(err) + ")");
+  if (err < 0)
+    return s.fail(status_code::out_of_memory,
+                  s.path + ": out of memory (" + av_error_text(err) + ")");
   if (s.kind == video_writer_kind::video) {
     const std::uint8_t* src = rgb.data;
     int src_stride = rgb.stride_bytes;
@@ -530,7 +535,8 @@ status video_writer::write(const image_view& rgb, double t) {
     const int strides[4] = {src_stride, 0, 0, 0};
     if (sws_scale(s.sws, planes, strides, 0, s.out_height, s.frame->data, s.frame->linesize) !=
         s.out_height)
-      return s.fail(s.path + ": cannot convert frame " + std::to_string(s.frames) + " to YUV");
+      return s.fail(status_code::internal,
+                    s.path + ": cannot convert frame " + std::to_string(s.frames) + " to YUV");
   } else {
     s.copy_padded(rgb, s.frame->data[0], s.frame->linesize[0]);
   }
@@ -545,7 +551,7 @@ status video_writer::close() {
   if (!impl_) return {};
   std::unique_ptr<impl> p = std::move(impl_);  // closed afterwards whatever happens
   impl& s = *p;
-  if (s.failed) return status::error(s.failure);
+  if (s.failed) return s.failure;
   if (s.frames == 0) return status::error(s.path + ": no frame was written; no file made");
   if (status st = s.encode(nullptr); !st) return st;
 
@@ -555,9 +561,9 @@ status video_writer::close() {
     const int close_err = avio_closep(&s.fmt->pb);
     if (err >= 0) err = close_err;
     if (err < 0)
-      return s.fail(s.path + ": cannot finish " + s.out.temp_path() + " (" + av_error_text(err) +
-                    ")");
-    if (status st = s.out.commit(); !st) return s.fail(st.message());
+      return s.fail(status_code::io, s.path + ": cannot finish " + s.out.temp_path() + " (" +
+                                         av_error_text(err) + ")");
+    if (status st = s.out.commit(); !st) return s.fail(st.code(), st.message());
     return {};
   }
 
@@ -571,7 +577,7 @@ status video_writer::close() {
       if (i > 0) message += " (" + std::to_string(i) + " file(s) renamed before it stay)";
       for (std::int64_t j = i; j < n; ++j) ::unlink(s.png_temp(j));
       s.png_temps = 0;
-      return s.fail(message);
+      return s.fail(st.code(), message);
     }
   }
   s.png_temps = 0;
@@ -607,10 +613,10 @@ status video_writer::open(const std::string& path, int width, int height, double
                           const video_writer_options& options) {
   impl_.reset();
   if (status st = check_arguments(path, width, height, fps, options); !st) return st;
-  return status::error(path +
-                       ": cannot encode video or images: avatarmap was built without FFmpeg "
-                       "(install libavformat-dev libavcodec-dev libavutil-dev libswscale-dev "
-                       "and configure with AVATARMAP_WITH_FFMPEG=ON)");
+  return status::unsupported(path +
+                             ": cannot encode video or images: avatarmap was built without FFmpeg "
+                             "(install libavformat-dev libavcodec-dev libavutil-dev libswscale-dev "
+                             "and configure with AVATARMAP_WITH_FFMPEG=ON)");
 }
 
 status video_writer::write(const image_view&, double) {

@@ -151,26 +151,27 @@ class humanoid_builder {
   status assign(const std::string& bone_name, const std::string& shown, const json* node) {
     const std::optional<bone> b = bone_from_name(bone_name);
     if (!b)
-      return status::error(where_ + ": humanoid bone " + in_quotes(shown) +
-                           " is not a VRM humanoid bone name");
+      return status::parse_error(where_ + ": humanoid bone " + in_quotes(shown) +
+                                 " is not a VRM humanoid bone name");
     std::int64_t index = -1;
     if (!node || !as_whole_number(*node, index))
-      return status::error(where_ + ": humanoid bone " + in_quotes(shown) +
-                           " has no integer node index");
+      return status::parse_error(where_ + ": humanoid bone " + in_quotes(shown) +
+                                 " has no integer node index");
     const std::int64_t n = static_cast<std::int64_t>(raw_.nodes.size());
     if (index < 0 || index >= n)
-      return status::error(where_ + ": humanoid bone " + in_quotes(shown) + " names node " +
-                           std::to_string(index) + ", out of range (the file has " +
-                           std::to_string(n) + " nodes)");
+      return status::parse_error(where_ + ": humanoid bone " + in_quotes(shown) + " names node " +
+                                 std::to_string(index) + ", out of range (the file has " +
+                                 std::to_string(n) + " nodes)");
     const int bi = idx(*b);
     if (raw_.declared_humanoid[bi] >= 0)
-      return status::error(where_ + ": humanoid bone " + in_quotes(shown) + " is declared twice");
+      return status::parse_error(where_ + ": humanoid bone " + in_quotes(shown) +
+                                 " is declared twice");
     const int other = bone_of_node_[static_cast<size_t>(index)];
     if (other >= 0)
-      return status::error(where_ + ": node " + std::to_string(index) + " " +
-                           in_quotes(raw_.nodes[static_cast<size_t>(index)].name) +
-                           " is assigned to two humanoid bones, " +
-                           std::string(bone_name_of(other)) + " and " + bone_name);
+      return status::parse_error(where_ + ": node " + std::to_string(index) + " " +
+                                 in_quotes(raw_.nodes[static_cast<size_t>(index)].name) +
+                                 " is assigned to two humanoid bones, " +
+                                 std::string(bone_name_of(other)) + " and " + bone_name);
     raw_.declared_humanoid[bi] = static_cast<int>(index);
     bone_of_node_[static_cast<size_t>(index)] = bi;
     return {};
@@ -189,8 +190,8 @@ status read_vrm1_humanoid(const json& ext, const char* ext_name, raw_rig& raw) {
   const json* humanoid = member(ext, "humanoid");
   const json* bones = humanoid ? member(*humanoid, "humanBones") : nullptr;
   if (!bones || !bones->is_object())
-    return status::error(raw.file + ": " + ext_name +
-                         " has no humanoid.humanBones object (expected {name: {node}})");
+    return status::parse_error(raw.file + ": " + ext_name +
+                               " has no humanoid.humanBones object (expected {name: {node}})");
   humanoid_builder builder(raw, raw.file + ": " + ext_name);
   for (auto it = bones->begin(); it != bones->end(); ++it) {
     if (status s = builder.assign(it.key(), it.key(), member(it.value(), "node")); !s) return s;
@@ -220,15 +221,15 @@ status read_vrm0(const json& ext, raw_rig& raw) {
   const json* humanoid = member(ext, "humanoid");
   const json* bones = humanoid ? member(*humanoid, "humanBones") : nullptr;
   if (!bones || !bones->is_array())
-    return status::error(raw.file +
-                         ": VRM has no humanoid.humanBones array (expected [{bone, node}])");
+    return status::parse_error(raw.file +
+                               ": VRM has no humanoid.humanBones array (expected [{bone, node}])");
   humanoid_builder builder(raw, raw.file + ": VRM");
   for (size_t i = 0; i < bones->size(); ++i) {
     const json& entry = (*bones)[i];
     const std::string* name = string_member(entry, "bone");
     if (!name)
-      return status::error(raw.file + ": VRM humanoid.humanBones[" + std::to_string(i) +
-                           "] has no bone name");
+      return status::parse_error(raw.file + ": VRM humanoid.humanBones[" + std::to_string(i) +
+                                 "] has no bone name");
     if (status s = builder.assign(vrm0_to_vrm1_name(*name), *name, member(entry, "node")); !s)
       return s;
   }
@@ -263,7 +264,7 @@ status load(const std::string& path, raw_rig& out) {
   }
   const json* nodes = member(doc.json, "nodes");
   if (nodes && !nodes->is_array())
-    return status::error(path + ": nodes is not an array; not a valid glTF file");
+    return status::parse_error(path + ": nodes is not an array; not a valid glTF file");
   const int n = nodes ? static_cast<int>(nodes->size()) : 0;  // below 2^31: checked on open
 
   // Nodes and their rest transforms.
@@ -272,13 +273,13 @@ status load(const std::string& path, raw_rig& out) {
     const json& node = (*nodes)[static_cast<size_t>(i)];
     raw_rig::node& r = out.nodes[static_cast<size_t>(i)];
     if (!node.is_object())
-      return status::error(path + ": node " + std::to_string(i) + " is not a JSON object");
+      return status::parse_error(path + ": node " + std::to_string(i) + " is not a JSON object");
     const std::string* name = string_member(node, "name");
     r.name = name && !name->empty() ? *name : "node" + std::to_string(i);
     std::string why;
     if (!node_transform(node, r.rest, why))
-      return status::error(path + ": node " + std::to_string(i) + " " + in_quotes(r.name) + ": " +
-                           why);
+      return status::parse_error(path + ": node " + std::to_string(i) + " " + in_quotes(r.name) +
+                                 ": " + why);
   }
   // Parents from the children lists.
   for (int i = 0; i < n; ++i) {
@@ -287,20 +288,20 @@ status load(const std::string& path, raw_rig& out) {
     const std::string who = path + ": node " + std::to_string(i) + " " +
                             in_quotes(out.nodes[static_cast<size_t>(i)].name);
     if (!children->is_array())
-      return status::error(who + ": children must be an array of integer node indices");
+      return status::parse_error(who + ": children must be an array of integer node indices");
     for (const json& child : *children) {
       std::int64_t c = -1;
       if (!(child.is_number_integer() || child.is_number_unsigned()) || !as_whole_number(child, c))
-        return status::error(who + ": children must be an array of integer node indices");
+        return status::parse_error(who + ": children must be an array of integer node indices");
       if (c < 0 || c >= n)
-        return status::error(who + " lists child " + std::to_string(c) +
-                             ", out of range (the file has " + std::to_string(n) + " nodes)");
-      if (c == i) return status::error(who + " lists itself as a child");
+        return status::parse_error(who + " lists child " + std::to_string(c) +
+                                   ", out of range (the file has " + std::to_string(n) + " nodes)");
+      if (c == i) return status::parse_error(who + " lists itself as a child");
       raw_rig::node& ch = out.nodes[static_cast<size_t>(c)];
       if (ch.parent >= 0 && ch.parent != i)
-        return status::error(path + ": node " + std::to_string(c) + " " + in_quotes(ch.name) +
-                             " is the child of two nodes (" + std::to_string(ch.parent) + " and " +
-                             std::to_string(i) + ")");
+        return status::parse_error(path + ": node " + std::to_string(c) + " " + in_quotes(ch.name) +
+                                   " is the child of two nodes (" + std::to_string(ch.parent) +
+                                   " and " + std::to_string(i) + ")");
       ch.parent = i;
     }
   }
@@ -334,9 +335,9 @@ status load_avatar(const std::string& path, raw_rig& out) {
   try {
     s = load(path, out);
   } catch (const std::bad_alloc&) {  // e.g. a huge declared size
-    s = status::error(path + ": not enough memory to load the file");
+    s = status::out_of_memory(path + ": not enough memory to load the file");
   } catch (const std::exception&) {
-    s = status::error(path + ": cannot load the file (unexpected internal error)");
+    s = status::internal(path + ": cannot load the file (unexpected internal error)");
   }
   if (!s) {  // no half-filled rig on failure
     out = raw_rig{};

@@ -89,25 +89,25 @@ status read_regular_file(const std::string& path, const std::string& what, std::
       ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | (no_follow ? O_NOFOLLOW : 0));
   if (fd < 0) {
     const int e = errno;
-    return status::error(what + ": cannot open the file: " + std::strerror(e) +
-                         (e == ENOENT ? " (check the path)" : ""));
+    return status::io_error(what + ": cannot open the file: " + std::strerror(e) +
+                            (e == ENOENT ? " (check the path)" : ""));
   }
   struct stat st {};
   if (::fstat(fd, &st) != 0) {
     const int e = errno;
     ::close(fd);
-    return status::error(what + ": cannot read the file: " + std::strerror(e));
+    return status::io_error(what + ": cannot read the file: " + std::strerror(e));
   }
   if (!S_ISREG(st.st_mode)) {
     ::close(fd);
-    return status::error(what + ": not a regular file (a folder, device or pipe); give a file");
+    return status::io_error(what + ": not a regular file (a folder, device or pipe); give a file");
   }
   const auto size = static_cast<std::uint64_t>(st.st_size);
   if (size > max) {
     ::close(fd);
-    return status::error(what + ": the file is " + std::to_string(size) +
-                         " bytes, more than the limit of " + std::to_string(max) +
-                         " bytes; this program does not read files that large");
+    return status::parse_error(what + ": the file is " + std::to_string(size) +
+                               " bytes, more than the limit of " + std::to_string(max) +
+                               " bytes; this program does not read files that large");
   }
   out.resize(static_cast<std::size_t>(size));
   std::size_t got = 0;
@@ -118,9 +118,9 @@ status read_regular_file(const std::string& path, const std::string& what, std::
       const int e = n < 0 ? errno : 0;
       ::close(fd);
       out.clear();
-      return status::error(what + ": cannot read the file: " +
-                           (n < 0 ? std::string(std::strerror(e))
-                                  : std::string("it became shorter while being read")));
+      return status::io_error(what + ": cannot read the file: " +
+                              (n < 0 ? std::string(std::strerror(e))
+                                     : std::string("it became shorter while being read")));
     }
     got += static_cast<std::size_t>(n);
   }
@@ -142,32 +142,33 @@ status split_glb(gltf_document& doc) {
   const std::string& p = doc.path;
   const std::size_t size = b.size();
   if (size < k_glb_header)
-    return status::error(p + ": binary glTF (GLB) truncated: " + std::to_string(size) +
-                         " bytes, shorter than the 12-byte header");
+    return status::parse_error(p + ": binary glTF (GLB) truncated: " + std::to_string(size) +
+                               " bytes, shorter than the 12-byte header");
   const std::uint32_t version = read_u32(b, 4);
   if (version != 2)
-    return status::error(p + ": GLB version " + std::to_string(version) +
-                         " is not supported (glTF 2.0 files have version 2)");
+    return status::parse_error(p + ": GLB version " + std::to_string(version) +
+                               " is not supported (glTF 2.0 files have version 2)");
   const std::uint32_t length = read_u32(b, 8);
   if (length != size)
-    return status::error(p + ": the GLB header declares " + std::to_string(length) +
-                         " bytes but the file has " + std::to_string(size) +
-                         (length > size ? " (the file is truncated: download or export it again)"
-                                        : " (bytes after the declared end: the file is damaged)"));
+    return status::parse_error(p + ": the GLB header declares " + std::to_string(length) +
+                               " bytes but the file has " + std::to_string(size) +
+                               (length > size
+                                    ? " (the file is truncated: download or export it again)"
+                                    : " (bytes after the declared end: the file is damaged)"));
   if (size < k_glb_header + k_chunk_header)
-    return status::error(p + ": the GLB has no JSON chunk (it ends after its header)");
+    return status::parse_error(p + ": the GLB has no JSON chunk (it ends after its header)");
   const std::uint32_t json_length = read_u32(b, 12);
   const std::uint32_t json_type = read_u32(b, 16);
   if (json_type != k_chunk_json)
-    return status::error(p + ": the GLB's first chunk has type " + hex32(json_type) +
-                         ", not JSON (" + hex32(k_chunk_json) +
-                         "); the JSON chunk must come first");
+    return status::parse_error(p + ": the GLB's first chunk has type " + hex32(json_type) +
+                               ", not JSON (" + hex32(k_chunk_json) +
+                               "); the JSON chunk must come first");
   std::size_t at = k_glb_header + k_chunk_header;
   if (json_length > size - at)
-    return status::error(p + ": the GLB's JSON chunk declares " + std::to_string(json_length) +
-                         " bytes but only " + std::to_string(size - at) +
-                         " follow (the file is truncated or damaged)");
-  if (json_length == 0) return status::error(p + ": the GLB's JSON chunk is empty");
+    return status::parse_error(
+        p + ": the GLB's JSON chunk declares " + std::to_string(json_length) + " bytes but only " +
+        std::to_string(size - at) + " follow (the file is truncated or damaged)");
+  if (json_length == 0) return status::parse_error(p + ": the GLB's JSON chunk is empty");
   doc.json_offset = at;
   doc.json_size = json_length;
   at += json_length;
@@ -175,33 +176,35 @@ status split_glb(gltf_document& doc) {
   // there), then any others, which the glTF spec says to ignore; every length must fit.
   for (int chunk = 1; at < size; ++chunk) {
     if (size - at < k_chunk_header)
-      return status::error(p + ": the GLB has " + std::to_string(size - at) +
-                           " stray bytes after chunk " + std::to_string(chunk - 1) +
-                           ", too few for a chunk header (the file is damaged)");
+      return status::parse_error(p + ": the GLB has " + std::to_string(size - at) +
+                                 " stray bytes after chunk " + std::to_string(chunk - 1) +
+                                 ", too few for a chunk header (the file is damaged)");
     const std::uint32_t length_c = read_u32(b, at);
     const std::uint32_t type_c = read_u32(b, at + 4);
     const std::string name = type_c == k_chunk_bin ? "BIN chunk" : "chunk " + std::to_string(chunk);
     if (length_c > size - at - k_chunk_header)
-      return status::error(p + ": the GLB's " + name + " declares " + std::to_string(length_c) +
-                           " bytes but only " + std::to_string(size - at - k_chunk_header) +
-                           " follow (the file is truncated or damaged)");
+      return status::parse_error(p + ": the GLB's " + name + " declares " +
+                                 std::to_string(length_c) + " bytes but only " +
+                                 std::to_string(size - at - k_chunk_header) +
+                                 " follow (the file is truncated or damaged)");
     if (type_c == k_chunk_json)
-      return status::error(p + ": the GLB has a second JSON chunk (chunk " + std::to_string(chunk) +
-                           "); a GLB has exactly one");
+      return status::parse_error(p + ": the GLB has a second JSON chunk (chunk " +
+                                 std::to_string(chunk) + "); a GLB has exactly one");
     if (type_c == k_chunk_bin) {
       if (chunk != 1)
-        return status::error(p + ": the GLB's BIN chunk is chunk " + std::to_string(chunk) +
-                             "; it must directly follow the JSON chunk (and appear once)");
+        return status::parse_error(p + ": the GLB's BIN chunk is chunk " + std::to_string(chunk) +
+                                   "; it must directly follow the JSON chunk (and appear once)");
       if (length_c == 0 || length_c % 4 != 0)
-        return status::error(p + ": the GLB's BIN chunk length " + std::to_string(length_c) +
-                             " is not a positive multiple of 4 (glTF requires the padding; "
-                             "export the file again)");
+        return status::parse_error(p + ": the GLB's BIN chunk length " + std::to_string(length_c) +
+                                   " is not a positive multiple of 4 (glTF requires the padding; "
+                                   "export the file again)");
       doc.bin_offset = at + k_chunk_header;
       doc.bin_size = length_c;
     } else if (chunk == 1) {
-      return status::error(p + ": the GLB's second chunk has type " + hex32(type_c) +
-                           ", not BIN (" + hex32(k_chunk_bin) +
-                           "); this program reads GLBs whose binary chunk follows the JSON chunk");
+      return status::parse_error(
+          p + ": the GLB's second chunk has type " + hex32(type_c) + ", not BIN (" +
+          hex32(k_chunk_bin) +
+          "); this program reads GLBs whose binary chunk follows the JSON chunk");
     }
     at += k_chunk_header + length_c;
   }
@@ -232,15 +235,15 @@ status check_core_integers(const nlohmann::json& v, std::string& where, const st
   } else if (v.is_number_unsigned()) {
     const auto u = v.get<std::uint64_t>();
     if (u > static_cast<std::uint64_t>(std::numeric_limits<int>::max()))
-      return status::error(p + ": " + where + " is " + std::to_string(u) +
-                           ", out of range (an index or count of a glTF file is below 2^31); "
-                           "the file is damaged or hostile");
+      return status::parse_error(p + ": " + where + " is " + std::to_string(u) +
+                                 ", out of range (an index or count of a glTF file is below 2^31); "
+                                 "the file is damaged or hostile");
   } else if (v.is_number_integer()) {
     const auto i = v.get<std::int64_t>();
     if (i < std::numeric_limits<int>::min() || i > std::numeric_limits<int>::max())
-      return status::error(p + ": " + where + " is " + std::to_string(i) +
-                           ", out of range (an index or count of a glTF file is below 2^31); "
-                           "the file is damaged or hostile");
+      return status::parse_error(p + ": " + where + " is " + std::to_string(i) +
+                                 ", out of range (an index or count of a glTF file is below 2^31); "
+                                 "the file is damaged or hostile");
   }
   return {};
 }
@@ -259,23 +262,25 @@ status parse_json(gltf_document& doc) {
     const std::string what = e.what();
     const std::size_t at = what.find("syntax error");
     const std::size_t byte = doc.json_offset + (e.byte > 0 ? e.byte - 1 : 0);
-    return status::error(p + ": the JSON is malformed at byte " + std::to_string(byte) +
-                         (at == std::string::npos ? std::string() : " (" + what.substr(at) + ")") +
-                         "; the file is damaged or not glTF");
+    return status::parse_error(
+        p + ": the JSON is malformed at byte " + std::to_string(byte) +
+        (at == std::string::npos ? std::string() : " (" + what.substr(at) + ")") +
+        "; the file is damaged or not glTF");
   } catch (const nlohmann::json::out_of_range&) {
-    return status::error(p +
-                         ": the JSON holds a number too large for a double (such as 1e400); "
-                         "the file is damaged or hostile");
+    return status::parse_error(p +
+                               ": the JSON holds a number too large for a double (such as 1e400); "
+                               "the file is damaged or hostile");
   } catch (const nlohmann::json::exception&) {
-    return status::error(p + ": the JSON cannot be read; the file is damaged or not glTF");
+    return status::parse_error(p + ": the JSON cannot be read; the file is damaged or not glTF");
   }
   if (!doc.json.is_object())
-    return status::error(p + ": the JSON's top level is not an object; not a glTF file");
+    return status::parse_error(p + ": the JSON's top level is not an object; not a glTF file");
   const auto asset = doc.json.find("asset");
   if (asset == doc.json.end() || !asset->is_object() || !asset->contains("version") ||
       !(*asset)["version"].is_string() ||
       (*asset)["version"].get_ref<const std::string&>().rfind("2.", 0) != 0)
-    return status::error(p + ": asset.version is missing or not \"2.x\"; not a glTF 2.0 file");
+    return status::parse_error(p +
+                               ": asset.version is missing or not \"2.x\"; not a glTF 2.0 file");
   std::string where;
   return check_core_integers(doc.json, where, p);
 }
@@ -325,11 +330,12 @@ bool percent_decode(std::string_view in, std::string& out) {
 status resolve_relative(const gltf_document& doc, const std::string& relative,
                         const std::string& what, std::string& out_file, bool& missing) {
   missing = false;
-  if (relative.empty()) return status::error(what + " is empty");
+  if (relative.empty()) return status::parse_error(what + " is empty");
   if (relative[0] == '/')
-    return status::error(what +
-                         " is an absolute path; only files inside the avatar's folder are read "
-                         "(put the file next to the avatar and name it relatively)");
+    return status::parse_error(
+        what +
+        " is an absolute path; only files inside the avatar's folder are read "
+        "(put the file next to the avatar and name it relatively)");
   int depth = 0;
   std::size_t start = 0;
   while (start <= relative.size()) {
@@ -338,8 +344,8 @@ status resolve_relative(const gltf_document& doc, const std::string& relative,
     const std::string_view part = std::string_view(relative).substr(start, end - start);
     if (part == "..") {
       if (--depth < 0)
-        return status::error(what + " leaves the avatar's folder (..); only files inside " +
-                             shown(doc.folder) + " are read");
+        return status::parse_error(what + " leaves the avatar's folder (..); only files inside " +
+                                   shown(doc.folder) + " are read");
     } else if (!part.empty() && part != ".") {
       ++depth;
     }
@@ -350,20 +356,21 @@ status resolve_relative(const gltf_document& doc, const std::string& relative,
   if (real == nullptr) {
     const int e = errno;
     missing = e == ENOENT || e == ENOTDIR;
-    return status::error(what + ": " +
-                         (missing ? std::string("no such file in the folder ") + shown(doc.folder)
-                                  : std::string(std::strerror(e))));
+    return status::io_error(what + ": " +
+                            (missing
+                                 ? std::string("no such file in the folder ") + shown(doc.folder)
+                                 : std::string(std::strerror(e))));
   }
   const std::string resolved = real;
   std::free(real);
   const std::string prefix = doc.folder == "/" ? "/" : doc.folder + "/";
   if (resolved.compare(0, prefix.size(), prefix) != 0 || resolved.size() == prefix.size())
-    return status::error(what + " resolves through a symbolic link to " + shown(resolved) +
-                         ", outside the avatar's folder " + shown(doc.folder) +
-                         "; refused (copy the file into the folder)");
+    return status::parse_error(what + " resolves through a symbolic link to " + shown(resolved) +
+                               ", outside the avatar's folder " + shown(doc.folder) +
+                               "; refused (copy the file into the folder)");
   struct stat st {};
   if (::stat(resolved.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
-    return status::error(what + " is not a regular file");
+    return status::io_error(what + " is not a regular file");
   out_file = resolved;
   return {};
 }
@@ -377,23 +384,23 @@ status check_uri(const gltf_document& doc, const std::string& uri, const std::st
   if (starts_with_nocase(uri, "data:")) {
     is_data = true;
     if (uri.size() > doc.limits.max_data_uri_bytes)
-      return status::error(what + ": a data: URI of " + std::to_string(uri.size()) +
-                           " characters, more than the limit of " +
-                           std::to_string(doc.limits.max_data_uri_bytes) +
-                           " (store the data in a .glb instead)");
+      return status::parse_error(what + ": a data: URI of " + std::to_string(uri.size()) +
+                                 " characters, more than the limit of " +
+                                 std::to_string(doc.limits.max_data_uri_bytes) +
+                                 " (store the data in a .glb instead)");
     if (uri.find(";base64,") == std::string::npos)
-      return status::error(what +
-                           ": a data: URI that is not base64; only base64 data URIs are "
-                           "read");
+      return status::parse_error(what +
+                                 ": a data: URI that is not base64; only base64 data URIs are "
+                                 "read");
     return {};
   }
   if (const std::string scheme = scheme_of(uri); !scheme.empty())
-    return status::error(what + ": URIs with a scheme (" + scheme +
-                         ":) are not read; only files inside the avatar's folder (relative "
-                         "paths) and data: URIs are");
+    return status::parse_error(what + ": URIs with a scheme (" + scheme +
+                               ":) are not read; only files inside the avatar's folder (relative "
+                               "paths) and data: URIs are");
   std::string decoded;
   if (!percent_decode(uri, decoded))
-    return status::error(what + " has a malformed %-escape or a NUL byte");
+    return status::parse_error(what + " has a malformed %-escape or a NUL byte");
   return resolve_relative(doc, decoded, what, out_file, missing);
 }
 
@@ -411,7 +418,7 @@ status check_all_uris(const gltf_document& doc) {
       const auto u = entry.find("uri");
       if (u == entry.end()) continue;
       const std::string where = std::string(array) + "[" + std::to_string(i) + "].uri";
-      if (!u->is_string()) return status::error(doc.path + ": " + where + " is not a string");
+      if (!u->is_string()) return status::parse_error(doc.path + ": " + where + " is not a string");
       bool is_data = false, missing = false;
       std::string file;
       const std::string& uri = u->get_ref<const std::string&>();
@@ -420,9 +427,9 @@ status check_all_uris(const gltf_document& doc) {
       if (is_data && std::string(array) == "buffers" &&
           uri.rfind("data:application/octet-stream;base64,", 0) != 0 &&
           uri.rfind("data:application/gltf-buffer;base64,", 0) != 0)
-        return status::error(doc.path + ": " + where + " " + shown(uri.substr(0, 40)) +
-                             ": a buffer's data: URI must be application/octet-stream or "
-                             "application/gltf-buffer (base64)");
+        return status::parse_error(doc.path + ": " + where + " " + shown(uri.substr(0, 40)) +
+                                   ": a buffer's data: URI must be application/octet-stream or "
+                                   "application/gltf-buffer (base64)");
     }
   }
   return {};
@@ -457,20 +464,21 @@ status check_buffer_views(const gltf_document& doc) {
     std::int64_t b = -1, offset = 0, length = -1, buffer_length = -1;
     if (!v.is_object() || !size_member(v, "buffer", -1, b) || b < 0 ||
         static_cast<std::size_t>(b) >= buffer_count)
-      return status::error(p + ": " + where + " names no buffer of the file's " +
-                           std::to_string(buffer_count));
+      return status::parse_error(p + ": " + where + " names no buffer of the file's " +
+                                 std::to_string(buffer_count));
     if (!size_member(v, "byteOffset", 0, offset) || !size_member(v, "byteLength", -1, length) ||
         length < 0)
-      return status::error(p + ": " + where + " has no valid byteOffset/byteLength");
+      return status::parse_error(p + ": " + where + " has no valid byteOffset/byteLength");
     const nlohmann::json& buffer = (*buffers)[static_cast<std::size_t>(b)];
     if (!buffer.is_object() || !size_member(buffer, "byteLength", -1, buffer_length) ||
         buffer_length < 0)
-      return status::error(p + ": buffers[" + std::to_string(b) + "] has no valid byteLength");
+      return status::parse_error(p + ": buffers[" + std::to_string(b) +
+                                 "] has no valid byteLength");
     if (offset + length > buffer_length)
-      return status::error(p + ": " + where + " (bytes " + std::to_string(offset) + " to " +
-                           std::to_string(offset + length) + ") lies outside buffers[" +
-                           std::to_string(b) + "] (" + std::to_string(buffer_length) +
-                           " bytes); the file is damaged");
+      return status::parse_error(p + ": " + where + " (bytes " + std::to_string(offset) + " to " +
+                                 std::to_string(offset + length) + ") lies outside buffers[" +
+                                 std::to_string(b) + "] (" + std::to_string(buffer_length) +
+                                 " bytes); the file is damaged");
   }
   const auto images = j.find("images");
   if (images != j.end() && images->is_array()) {
@@ -479,9 +487,9 @@ status check_buffer_views(const gltf_document& doc) {
       if (!image.is_object() || !image.contains("bufferView")) continue;
       std::int64_t v = -1;
       if (!size_member(image, "bufferView", -1, v) || static_cast<std::size_t>(v) >= view_count)
-        return status::error(p + ": images[" + std::to_string(i) +
-                             "].bufferView names no bufferView of the file's " +
-                             std::to_string(view_count));
+        return status::parse_error(p + ": images[" + std::to_string(i) +
+                                   "].bufferView names no bufferView of the file's " +
+                                   std::to_string(view_count));
     }
   }
   return {};
@@ -622,11 +630,11 @@ status open_gltf_document(const std::string& path, gltf_document& out, const glt
   out.limits = limits;
   if (status s = read_regular_file(path, path, limits.max_file_bytes, false, out.bytes); !s)
     return s;
-  if (out.bytes.empty()) return status::error(path + ": the file is empty, not a glTF file");
+  if (out.bytes.empty()) return status::parse_error(path + ": the file is empty, not a glTF file");
   {
     char* real = ::realpath(folder_of(path).c_str(), nullptr);
     if (real == nullptr)
-      return status::error(path + ": cannot resolve the file's folder: " + std::strerror(errno));
+      return status::io_error(path + ": cannot resolve the file's folder: " + std::strerror(errno));
     out.folder = real;
     std::free(real);
   }
@@ -640,9 +648,10 @@ status open_gltf_document(const std::string& path, gltf_document& out, const glt
                                         out.bytes[start] == '\n' || out.bytes[start] == '\r'))
       ++start;
     if (start >= out.bytes.size() || out.bytes[start] != '{')
-      return status::error(path +
-                           ": not a glTF file (neither binary glTF, which starts with 'glTF', "
-                           "nor a JSON object)");
+      return status::parse_error(
+          path +
+          ": not a glTF file (neither binary glTF, which starts with 'glTF', "
+          "nor a JSON object)");
     out.json_offset = start;
     out.json_size = out.bytes.size() - start;
   }
@@ -679,13 +688,14 @@ status parse_gltf_model(const gltf_document& doc, tinygltf::Model& out) {
   } catch (const std::exception&) {
     ok = false;
   }
-  if (!context.refusal.empty()) return status::error(context.refusal);
+  if (!context.refusal.empty()) return status::parse_error(context.refusal);
   if (!ok) {
-    if (!context.missing.empty()) return status::error(context.missing);
-    return status::error(doc.path + ": not valid glTF 2.0" +
-                         (err.empty() ? std::string(" (the glTF reader gave no reason)")
-                                      : ": " + tidy_tinygltf_error(err, doc)) +
-                         "; export the file again or check it with the Khronos glTF Validator");
+    if (!context.missing.empty()) return status::io_error(context.missing);
+    return status::parse_error(
+        doc.path + ": not valid glTF 2.0" +
+        (err.empty() ? std::string(" (the glTF reader gave no reason)")
+                     : ": " + tidy_tinygltf_error(err, doc)) +
+        "; export the file again or check it with the Khronos glTF Validator");
   }
   return {};
 }
@@ -706,10 +716,12 @@ status read_gltf_uri(const gltf_document& doc, const std::string& uri, const std
   if (is_data) {
     const std::size_t comma = uri.find(";base64,");
     if (!base64_decode(std::string_view(uri).substr(comma + 8), out))
-      return status::error(doc.path + ": " + where + ": the data: URI's base64 text is malformed");
+      return status::parse_error(doc.path + ": " + where +
+                                 ": the data: URI's base64 text is malformed");
     if (out.size() > left)
-      return status::error(doc.path + ": " + where + ": the data goes past the limit of " +
-                           std::to_string(l.max_total_resource_bytes) + " bytes read per file");
+      return status::parse_error(doc.path + ": " + where + ": the data goes past the limit of " +
+                                 std::to_string(l.max_total_resource_bytes) +
+                                 " bytes read per file");
   } else {
     if (status s = read_regular_file(file, doc.path + ": " + where + " " + shown(uri),
                                      std::min(l.max_resource_bytes, left), true, out);

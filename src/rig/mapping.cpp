@@ -76,7 +76,7 @@ bool finite_float(const json& v, float& out) {
 struct context {
   std::string file;
   status error(const std::string& key, const std::string& message) const {
-    return status::error(file + ": " + (key.empty() ? "" : key + ": ") + message);
+    return status::parse_error(file + ": " + (key.empty() ? "" : key + ": ") + message);
   }
 };
 
@@ -396,7 +396,7 @@ status load_mapping_folder(const std::string& folder, std::vector<mapping_table>
     if (e.path().filename() == "schema.json") continue;
     files.push_back(e.path().string());
   }
-  if (ec) return status::error(folder + ": cannot list the folder: " + ec.message());
+  if (ec) return status::io_error(folder + ": cannot list the folder: " + ec.message());
   std::sort(files.begin(), files.end());
   for (const std::string& f : files) {
     mapping_table t;
@@ -508,7 +508,7 @@ status auto_detect(const std::vector<mapping_table>& tables, const rig& r, int& 
   out_best = -1;
   out_match = mapping_match{};
   const std::string what = r.file.empty() ? std::string("the rig") : r.file;
-  if (tables.empty()) return status::error(what + ": no mapping tables to choose from");
+  if (tables.empty()) return status::parse_error(what + ": no mapping tables to choose from");
   int best_score = 0;
   std::string report;
   for (std::size_t i = 0; i < tables.size(); ++i) {
@@ -525,8 +525,8 @@ status auto_detect(const std::vector<mapping_table>& tables, const rig& r, int& 
     }
   }
   if (out_best < 0)
-    return status::error(what + ": no mapping table fits (" + std::to_string(r.joint_count()) +
-                         " joints)" + report);
+    return status::parse_error(what + ": no mapping table fits (" +
+                               std::to_string(r.joint_count()) + " joints)" + report);
   return {};
 }
 

@@ -47,18 +47,18 @@ status retargeter::build(const rig& r, const bone_binding& binding, const retarg
   const int n = r.joint_count();
   const std::string where = r.file.empty() ? std::string("rig") : r.file;
   if (binding[idx(bone::hips)] < 0)
-    return status::error(where + ": no joint is bound to the hips (required)");
+    return status::parse_error(where + ": no joint is bound to the hips (required)");
   bone_of_joint_.assign(static_cast<size_t>(n), -1);
   for (int b = 0; b < k_bone_count; ++b) {
     const int j = binding[b];
     if (j < -1 || j >= n)
-      return status::error(where + ": bone " + std::string(bone_name(static_cast<bone>(b))) +
-                           " is bound to joint " + std::to_string(j) + ", out of range");
+      return status::parse_error(where + ": bone " + std::string(bone_name(static_cast<bone>(b))) +
+                                 " is bound to joint " + std::to_string(j) + ", out of range");
     if (j < 0) continue;
     if (bone_of_joint_[j] >= 0)
-      return status::error(where + ": joint '" + r.names[j] + "' is bound to both " +
-                           std::string(bone_name(static_cast<bone>(bone_of_joint_[j]))) + " and " +
-                           std::string(bone_name(static_cast<bone>(b))));
+      return status::parse_error(where + ": joint '" + r.names[j] + "' is bound to both " +
+                                 std::string(bone_name(static_cast<bone>(bone_of_joint_[j]))) +
+                                 " and " + std::string(bone_name(static_cast<bone>(b))));
     bone_of_joint_[j] = b;
   }
   // Proxy bones must map to rig joints in a consistent hierarchy: a bound bone's joint must
@@ -71,10 +71,10 @@ status retargeter::build(const rig& r, const bone_binding& binding, const retarg
     int j = r.parents[binding[b]];
     while (j >= 0 && j != binding[a]) j = r.parents[j];
     if (j < 0)
-      return status::error(where + ": joint '" + r.names[binding[b]] + "' (" +
-                           std::string(bone_name(static_cast<bone>(b))) + ") is not below joint '" +
-                           r.names[binding[a]] + "' (" +
-                           std::string(bone_name(static_cast<bone>(a))) + ")");
+      return status::parse_error(where + ": joint '" + r.names[binding[b]] + "' (" +
+                                 std::string(bone_name(static_cast<bone>(b))) +
+                                 ") is not below joint '" + r.names[binding[a]] + "' (" +
+                                 std::string(bone_name(static_cast<bone>(a))) + ")");
   }
 
   basis_ = options.basis;

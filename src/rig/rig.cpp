@@ -44,23 +44,24 @@ status build_rig(const raw_rig& raw, rig& out) {
   for (int i = 0; i < n; ++i) {
     const raw_rig::node& node = raw.nodes[i];
     if (node.parent < -1 || node.parent >= n || node.parent == i)
-      return status::error(where + ": node " + std::to_string(i) + " '" + node.name +
-                           "' has an invalid parent " + std::to_string(node.parent));
+      return status::parse_error(where + ": node " + std::to_string(i) + " '" + node.name +
+                                 "' has an invalid parent " + std::to_string(node.parent));
     if (!finite_transform(node.rest))
-      return status::error(where + ": node " + std::to_string(i) + " '" + node.name +
-                           "' has a non-finite rest transform (inf or nan); fix the file");
+      return status::parse_error(where + ": node " + std::to_string(i) + " '" + node.name +
+                                 "' has a non-finite rest transform (inf or nan); fix the file");
     const glm::quat& q = node.rest.rotation;
     if (!(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w > 1e-12f))
-      return status::error(where + ": node " + std::to_string(i) + " '" + node.name +
-                           "' has a zero rotation");
+      return status::parse_error(where + ": node " + std::to_string(i) + " '" + node.name +
+                                 "' has a zero rotation");
     // A zero scale collapses everything below the node to a point: its world matrix has no
     // inverse, and every rotation computed through it (retargeting, BVH offsets) is nan.
     const glm::vec3& sc = node.rest.scale;
     for (int c = 0; c < 3; ++c)
       if (!(std::fabs(sc[c]) >= k_min_rest_scale))
-        return status::error(where + ": node " + std::to_string(i) + " '" + node.name +
-                             "' has a zero (or near-zero) scale " + std::to_string(sc[c]) +
-                             " on axis " + "xyz"[c] + "; a rig bone must have a non-zero scale");
+        return status::parse_error(where + ": node " + std::to_string(i) + " '" + node.name +
+                                   "' has a zero (or near-zero) scale " + std::to_string(sc[c]) +
+                                   " on axis " + "xyz"[c] +
+                                   "; a rig bone must have a non-zero scale");
   }
   // Depth-first order from the roots; a node never reached sits on a cycle.
   std::vector<std::vector<int>> children(static_cast<size_t>(n));
@@ -86,8 +87,8 @@ status build_rig(const raw_rig& raw, rig& out) {
     for (int i : order) seen[static_cast<size_t>(i)] = true;
     for (int i = 0; i < n; ++i)
       if (!seen[static_cast<size_t>(i)])
-        return status::error(where + ": node '" + raw.nodes[i].name +
-                             "' is part of a parent cycle");
+        return status::parse_error(where + ": node '" + raw.nodes[i].name +
+                                   "' is part of a parent cycle");
   }
   std::vector<int> new_index(static_cast<size_t>(n), -1);
   for (int k = 0; k < n; ++k) new_index[static_cast<size_t>(order[k])] = k;
@@ -112,7 +113,7 @@ status build_rig(const raw_rig& raw, rig& out) {
                                   "' has a singular or non-finite world rest transform (the "
                                   "product of its ancestors' scales); fix the file";
       out = rig{};
-      return status::error(message);
+      return status::parse_error(message);
     }
     // Rotation of the world matrix with scale removed (columns normalised).
     glm::mat3 r(out.rest_world[k]);
@@ -127,7 +128,7 @@ status build_rig(const raw_rig& raw, rig& out) {
                                   std::to_string(src) + ", out of range (the rig has " +
                                   std::to_string(n) + " nodes)";
       out = rig{};
-      return status::error(message);
+      return status::parse_error(message);
     }
     out.declared_humanoid[b] = src >= 0 ? new_index[static_cast<size_t>(src)] : -1;
   }

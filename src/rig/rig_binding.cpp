@@ -16,11 +16,6 @@ bool ends_with(const std::string& s, const std::string& suffix) {
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-status fail(rig_binding_choice& out, rig_binding_failure why, std::string message) {
-  out.failure = why;
-  return status::error(std::move(message));
-}
-
 // A table that matched: copies it and its match into `out`.
 void take(rig_binding_choice& out, const mapping_table& t, const mapping_match& m,
           std::string description) {
@@ -48,39 +43,28 @@ status select_binding(const rig& r, const std::string& option, const std::string
   }
   if (ends_with(what, ".json")) {
     mapping_table custom;
-    status st = load_mapping(what, custom);
-    if (!st.ok()) {
-      // load_mapping says "cannot read the file" only when the file cannot be opened.
-      const bool unreadable = st.message() == what + ": cannot read the file";
-      return fail(out, unreadable ? rig_binding_failure::io : rig_binding_failure::bad_table,
-                  st.message());
-    }
+    // load_mapping's code says which: io (cannot be read) or parse (malformed).
+    if (status st = load_mapping(what, custom); !st.ok()) return st;
     mapping_match m;
     if (match_score(custom, r, m) <= 0)
-      return fail(
-          out, rig_binding_failure::no_fit,
-          rig_file + ": the mapping table " + what + " does not fit this rig: " + m.summary());
+      return status::parse_error(rig_file + ": the mapping table " + what +
+                                 " does not fit this rig: " + m.summary());
     take(out, custom, m, "table " + custom.name + " (" + what + "): " + m.summary());
     return {};
   }
   if (mappings_folder.empty())
-    return fail(out, rig_binding_failure::io,
-                "no folder of mapping tables was given (needed for rig '" + what +
-                    "'; set AVATARMAP_MAPPINGS)");
+    return status::io_error("no folder of mapping tables was given (needed for rig '" + what +
+                            "'; set AVATARMAP_MAPPINGS)");
   std::vector<mapping_table> tables;
   status st = load_mapping_folder(mappings_folder, tables);
-  if (!st.ok()) {
-    const bool listing = st.message().rfind(mappings_folder + ": cannot list", 0) == 0;
-    const bool unreadable = ends_with(st.message(), ": cannot read the file");
-    return fail(out,
-                listing || unreadable ? rig_binding_failure::io : rig_binding_failure::bad_table,
-                st.message() + " (set AVATARMAP_MAPPINGS to the folder of the mapping tables)");
-  }
+  if (!st.ok())  // io (cannot list or read) or parse (a malformed table), kept
+    return st.with_message(st.message() +
+                           " (set AVATARMAP_MAPPINGS to the folder of the mapping tables)");
   if (what == "auto") {
     int best = -1;
     mapping_match m;
     st = auto_detect(tables, r, best, m);
-    if (!st.ok()) return fail(out, rig_binding_failure::no_fit, st.message());
+    if (!st.ok()) return st;  // parse: no table fits
     const mapping_table& t = tables[static_cast<std::size_t>(best)];
     take(out, t, m, "detected " + t.name + ": " + m.summary());
     return {};
@@ -90,16 +74,15 @@ status select_binding(const rig& r, const std::string& option, const std::string
     if (t.name == what) {
       mapping_match m;
       if (match_score(t, r, m) <= 0)
-        return fail(out, rig_binding_failure::no_fit,
-                    rig_file + ": table " + what + " does not fit this rig: " + m.summary());
+        return status::parse_error(rig_file + ": table " + what +
+                                   " does not fit this rig: " + m.summary());
       take(out, t, m, "table " + t.name + ": " + m.summary());
       return {};
     }
     names += (names.empty() ? "" : ", ") + t.name;
   }
-  return fail(
-      out, rig_binding_failure::unknown_name,
-      "unknown rig table '" + what + "' (shipped: " + names + "; or give auto or a .json file)");
+  return status::invalid_argument("unknown rig table '" + what + "' (shipped: " + names +
+                                  "; or give auto or a .json file)");
 }
 
 }  // namespace avatarmap

@@ -472,7 +472,7 @@ static void test_clip_poses(void) {
   CHECK(avm_clip_get_poses(r, 0, N, back) == AVM_OK && same_poses(back, many, N));
   avm_clip_destroy(r);
 
-  /* Reading: missing file, bad line, times not increasing. */
+  /* Reading: missing file, bad line, times out of order (sorted). */
   r = a;
   CHECK(avm_clip_read("does/not/exist.pose.jsonl", &r, err, sizeof err) == AVM_ERROR_IO);
   CHECK(r == NULL && contains(err, "does/not/exist"));
@@ -486,13 +486,19 @@ static void test_clip_poses(void) {
     }
     CHECK(avm_clip_read("frames_test_bad.pose.jsonl", &r, err, sizeof err) == AVM_ERROR_PARSE);
     CHECK(r == NULL && contains(err, "frames_test_bad.pose.jsonl:2"));
+    /* Times out of order: sorted by the library's one rule (the reader of avm_convert_file). */
     fp = fopen("frames_test_bad.pose.jsonl", "w");
     if (fp != NULL) {
       fputs("{\"t\":1}\n{\"t\":0.5}\n", fp);
       fclose(fp);
     }
-    CHECK(avm_clip_read("frames_test_bad.pose.jsonl", &r, err, sizeof err) == AVM_ERROR_PARSE);
-    CHECK(r == NULL && contains(err, "frames_test_bad.pose.jsonl:2") && contains(err, "after"));
+    CHECK(avm_clip_read("frames_test_bad.pose.jsonl", &r, err, sizeof err) == AVM_OK && r != NULL);
+    if (r != NULL) {
+      CHECK(avm_clip_frame_count(r) == 2);
+      CHECK(avm_clip_get_poses(r, 0, 2, back) == AVM_OK && back[0].t == 0.5 && back[1].t == 1.0);
+      avm_clip_destroy(r);
+      r = NULL;
+    }
   }
   remove("frames_test_bad.pose.jsonl");
   remove("frames_test_clip.pose.jsonl");

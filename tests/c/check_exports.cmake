@@ -10,7 +10,9 @@ foreach(fn avm_version avm_solver_create avm_solver_push avm_solver_sample avm_s
            avm_landmark_reader_read avm_landmark_reader_last_error avm_landmark_reader_destroy
            avm_solve_frames avm_solve_file_to_clip avm_clip_read avm_clip_get_poses avm_clip_add_poses
            avm_retargeter_apply_poses avm_capture_file avm_solver_options_init
-           avm_solver_options_init_sized avm_estimator_options_init avm_estimator_options_init_sized)
+           avm_solver_options_init_sized avm_estimator_options_init avm_estimator_options_init_sized
+           avm_convert_file avm_convert_options_init avm_convert_options_init_sized
+           avm_motion_input_kind)
   if(NOT symbols MATCHES " ${fn}\n")
     message(FATAL_ERROR "${LIB} does not export ${fn}")
   endif()

@@ -129,7 +129,9 @@ case $case_name in
     expect_in err.txt "--image-size"
     run 2 solve in.landmarks.jsonl -o out.pose.jsonl --fps abc
     expect_in err.txt "--fps"
-    run 2 solve in.landmarks.jsonl -o out.pose.jsonl --fps 0
+    run 2 solve in.landmarks.jsonl -o out.pose.jsonl --fps -1
+    expect_in err.txt "--fps must be 0 or in (0, 1000], got -1"
+    run 2 solve in.landmarks.jsonl -o out.pose.jsonl --fps 1001
     expect_in err.txt "--fps"
     run 2 solve in.landmarks.jsonl -o out.pose.jsonl --parts body,tail
     expect_in err.txt "tail"
@@ -303,14 +305,7 @@ open('black.png','wb').write(b'\\x89PNG\\r\\n\\x1a\\n'+chunk(b'IHDR',struct.pack
     expect_in err.txt "--avatar"
     run 2 animate in.mp4 -o out.vrma --bogus
     expect_in err.txt "unknown option --bogus"
-    # Every option `animate --help` lists is taken (it kept an older copy of capture's flags:
-    # --precision, --lanes and --spin were refused as unknown).
-    run 0 animate --help
-    for opt in $(grep -E '^  +-' out.txt | grep -oE -- '--[a-z][a-z-]*' | sort -u); do
-      [ "$opt" = --help ] && continue
-      "$exe" animate missing.mp4 -o out.vrma "$opt" x >opt_out.txt 2>opt_err.txt
-      grep -q "unknown option" opt_err.txt && fail "animate refuses $opt, which its --help lists"
-    done
+    # Every option `animate --help` lists is taken: case help_options (all commands).
     run 1 animate missing.mp4 -o out.vrma
     [ -e out.vrma ] && fail "a failed animate wrote its output"
     models="${AVATARMAP_MODELS:-}/onnx"
@@ -652,6 +647,49 @@ PY
       expect_in out.txt '"hips":"hips"'
       expect_in out.txt '"missing_required":[]'
     fi
+    ;;
+  help_options)
+    # Every option each command's --help lists is one its parser takes (animate once kept an
+    # older copy of capture's flags: --precision, --lanes and --spin, listed, were refused as
+    # unknown). Each option is given with a dummy value and an input that does not exist, so
+    # that nothing runs for long; any answer but "unknown option" will do.
+    run 0 --help
+    commands=$(grep -oE '^  avatarmap [a-z][a-z-]*' out.txt | awk '{print $2}' | sort -u)
+    [ -n "$commands" ] || fail "avatarmap --help lists no commands"
+    for cmd in $commands; do
+      run 0 "$cmd" --help
+      # The flag column of each option line: "  -o, --output PATH    help..." -> -o --output.
+      opts=$(grep -E '^ {1,4}-' out.txt | sed -E 's/^ +//; s/  .*//' |
+        grep -oE -- '(^| |/|,)--?[a-zA-Z][a-zA-Z0-9-]*' | grep -oE -- '--?[a-zA-Z][a-zA-Z0-9-]*' |
+        sort -u)
+      for opt in $opts; do
+        case "$opt" in --help | -h) continue ;; esac
+        timeout 20 "$exe" "$cmd" missing-input.nothing "$opt" x >opt_out.txt 2>opt_err.txt \
+          </dev/null
+        if grep -qE -- "unknown option $opt( |\$)" opt_err.txt; then
+          fail "$cmd refuses $opt, which its --help lists: $(head -c 300 opt_err.txt)"
+        fi
+      done
+    done
+    ;;
+  options)
+    run 0 options --json
+    python3 -c 'import json
+t = json.load(open("out.txt"))
+assert t["limits"]["max_fps"] == 1000
+assert {s["set"] for s in t["sets"]} >= {"solver", "solve_file", "estimator"}' ||
+      fail "options --json is not the option tables as JSON: $(head -c 300 out.txt)"
+    run 0 options
+    expect_in out.txt "horizontal_fov_degrees"
+    run 2 options --frobnicate
+    expect_in err.txt "unknown option --frobnicate"
+    run 0 backends
+    expect_in out.txt "folders (environment, else installed, else source tree):"
+    expect_in out.txt "mappings"
+    AVATARMAP_MAPPINGS="$PWD/tables" run 0 backends
+    expect_in out.txt "$PWD/tables (environment AVATARMAP_MAPPINGS)"
+    AVATARMAP_MODELS="$PWD/cache" run 0 backends
+    expect_in out.txt "$PWD/cache/onnx (environment AVATARMAP_MODELS)"
     ;;
   *)
     fail "unknown case"

@@ -1,15 +1,18 @@
 // capture_pipeline (image -> landmarks -> pose -> live filter) and live_session (push from one
-// thread, a worker on the newest image, sample from any), driven by the "replay" backend so
-// that no models are needed: the pipeline must give exactly what the solver and the filter give
-// on the same landmarks, and the session must process, drop and report as documented.
+// thread, a worker on the newest image, sample from any, outputs on the session's clock),
+// driven by the "replay" backend so that no models are needed: the pipeline must give exactly
+// what the solver and the filter give on the same landmarks, and the session must process,
+// drop, stop and report as documented.
 #include "avatarmap/live/live_session.hpp"
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -211,6 +214,103 @@ TEST(live_session, bad_pushes_are_refused_and_worker_errors_counted) {
   std::unique_ptr<live_session> none;
   EXPECT_FALSE(live_session::create(bad, none).ok());
   EXPECT_EQ(none, nullptr);
+  bad = o;
+  bad.output_fps = 1001.0;
+  EXPECT_FALSE(live_session::create(bad, none).ok());
+  bad = o;
+  bad.pipeline.resampler.max_extrapolation_seconds = -1.0;
+  EXPECT_FALSE(live_session::create(bad, none).ok());
+}
+
+// The outputs hang off the session: its output thread samples the stream at output_fps on
+// the stream's clock (times always increasing), hands each pose to every output in order, and
+// marks the first output after each processed frame (for the outputs' own latency).
+TEST(live_session, outputs_run_on_the_sessions_clock) {
+  test::temp_dir dir("live_session_outputs");
+  live_session_options o;
+  o.pipeline = replay_options(write_recording(dir));
+  o.output_fps = 200.0;
+  std::mutex m;
+  std::vector<double> times;
+  std::vector<int> order;
+  long carried = 0;
+  o.outputs.push_back([&](const proxy_pose& p, const live_output_report& r) {
+    std::lock_guard<std::mutex> lock(m);
+    times.push_back(p.t);
+    order.push_back(0);
+    if (r.carries_new_frame) {
+      ++carried;
+      EXPECT_LE(r.pushed_at, std::chrono::steady_clock::now());
+    }
+  });
+  o.outputs.push_back([&](const proxy_pose&, const live_output_report&) {
+    std::lock_guard<std::mutex> lock(m);
+    order.push_back(1);
+  });
+  std::unique_ptr<live_session> s;
+  ASSERT_TRUE(live_session::create(o, s).ok());
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  {
+    std::lock_guard<std::mutex> lock(m);
+    EXPECT_TRUE(times.empty()) << "no output before the first pose";
+  }
+  std::vector<std::uint8_t> px(4 * 4 * 3, 0);
+  const image_view img{px.data(), 4, 4, 12, pixel_format::rgb8};
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_TRUE(s->push(img, 2.0 + i / k_fps).ok());
+    settle(*s);
+    std::this_thread::sleep_for(std::chrono::milliseconds(40));
+  }
+  s->stop();
+  const live_session_stats st = s->stats();
+  std::lock_guard<std::mutex> lock(m);
+  ASSERT_GE(times.size(), 5u) << "200 fps for ~0.2 s";
+  EXPECT_EQ(static_cast<long>(times.size()), st.outputs);
+  for (size_t i = 1; i < times.size(); ++i) EXPECT_GT(times[i], times[i - 1]);
+  EXPECT_GE(times.front(), 2.0) << "the stream's clock starts at the first pose's time";
+  for (size_t i = 0; i < order.size(); ++i) EXPECT_EQ(order[i], static_cast<int>(i % 2));
+  EXPECT_GE(carried, 1);
+  EXPECT_LE(carried, st.processed);
+}
+
+// finish() drains the waiting image then stops; on_frame returning false stops the worker;
+// a stopped session refuses pushes and calls nothing after stop().
+TEST(live_session, finish_drains_and_on_frame_stops) {
+  test::temp_dir dir("live_session_stop");
+  live_session_options o;
+  o.pipeline = replay_options(write_recording(dir));
+  std::atomic<int> frames{0};
+  o.on_frame = [&](const live_frame_report& r) {
+    EXPECT_EQ(r.error, nullptr);
+    return ++frames < 3;
+  };
+  std::unique_ptr<live_session> s;
+  ASSERT_TRUE(live_session::create(o, s).ok());
+  std::vector<std::uint8_t> px(4 * 4 * 3, 0);
+  const image_view img{px.data(), 4, 4, 12, pixel_format::rgb8};
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(s->push(img, i / k_fps).ok());
+    settle(*s);
+  }
+  s->wait_stopped();
+  EXPECT_TRUE(s->stopped());
+  EXPECT_FALSE(s->push(img, 1.0).ok());
+  EXPECT_EQ(frames.load(), 3);
+  s->stop();
+  s->stop();  // idempotent
+
+  live_session_options d;
+  d.pipeline = replay_options(write_recording(dir));
+  std::unique_ptr<live_session> drained;
+  ASSERT_TRUE(live_session::create(d, drained).ok());
+  ASSERT_TRUE(drained->push(img, 0.0).ok());
+  drained->finish();
+  EXPECT_FALSE(drained->push(img, 0.1).ok()) << "finishing: no more images";
+  drained->wait_stopped();
+  const live_session_stats st = drained->stats();
+  EXPECT_EQ(st.pushed, 1);
+  EXPECT_EQ(st.processed, 1) << "the waiting image is processed before the stop";
+  EXPECT_EQ(st.dropped, 0);
 }
 
 }  // namespace

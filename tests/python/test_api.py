@@ -49,6 +49,20 @@ def test_exception_classes():
     assert issubclass(am.InvalidArgumentError, ValueError)
     assert issubclass(am.ParseError, am.AvatarmapError)
     assert issubclass(am.UnsupportedError, am.AvatarmapError)
+    assert issubclass(am.OutOfMemoryError, MemoryError)
+    assert issubclass(am.InternalError, am.AvatarmapError)
+
+
+def test_every_failing_status_has_its_own_exception_class():
+    """One class per failing avm_status (the library's error kinds, one to one), each with
+    its status; AVM_ERROR_END_OF_FILE (4) is no failure and has none."""
+    from avatarmap._errors import error_for
+    classes = {1: am.InvalidArgumentError, 2: am.FileIOError, 3: am.ParseError,
+               5: am.UnsupportedError, 6: am.OutOfMemoryError, 7: am.InternalError}
+    for status, cls in classes.items():
+        e = error_for(status, "m")
+        assert type(e) is cls and e.status == status and str(e) == "m"
+    assert len(set(classes.values())) == len(classes)
 
 
 def _t_pose_frame(t):

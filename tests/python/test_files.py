@@ -88,6 +88,75 @@ def test_convert_file_of_landmarks_equals_cli_convert(synth_file, cli, tmp_path,
                         tmp_path / "y.vrma", mirror=True)
 
 
+def _out_of_order(pose_file, path):
+    """`pose_file` with frames 2 and 3 swapped (lines 4 and 5: line 1 is the header)."""
+    lines = pose_file.read_bytes().split(b"\n")
+    lines[3], lines[4] = lines[4], lines[3]
+    path.write_bytes(b"\n".join(lines))
+    return path
+
+
+@pytest.mark.parametrize("ext,fps,avatar", [(".pose.jsonl", 0, False), (".vrma", 30, False),
+                                            (".vrma", 0, False), (".bvh", 30, False),
+                                            (".glb", 30, True)])
+def test_convert_file_sorts_an_out_of_order_pose_file_as_the_cli_does(
+        pose_file, cli, tmp_path, ext, fps, avatar):
+    """A pose file whose frames are out of time order: sorted, with a warning that counts
+    them, for every output; the CLI's bytes (it used to raise ParseError)."""
+    ooo = _out_of_order(pose_file, tmp_path / "ooo.pose.jsonl")
+    extra = []
+    if avatar:
+        cli("avatar", "-o", tmp_path / "builtin.vrm")
+        extra = ["--avatar", tmp_path / "builtin.vrm"]
+    ref = tmp_path / ("cli" + ext)
+    cli("convert", ooo, "-o", ref, *(("--fps", fps) if fps else ()), *extra)
+    mine = tmp_path / ("py" + ext)
+    with pytest.warns(UserWarning, match="1 frame\\(s\\) of .*ooo.pose.jsonl were out of time "
+                                         "order; sorted by time"):
+        n = am.convert_file(ooo, mine, fps=fps,
+                            avatar=tmp_path / "builtin.vrm" if avatar else None)
+    assert n == 120
+    if fps or ext in (".pose.jsonl", ".glb"):  # the CLI's default is 30 but for .pose.jsonl
+        assert mine.read_bytes() == ref.read_bytes()
+    # Sorted, the poses are the in-order file's (read_poses reads with the same reader), and
+    # the output is what the in-order file converts to.
+    np.testing.assert_array_equal(am.read_poses(ooo).rotations, am.read_poses(pose_file).rotations)
+    in_order = tmp_path / ("in_order" + ext)
+    cli("convert", pose_file, "-o", in_order, *(("--fps", fps) if fps else ()), *extra)
+    assert ref.read_bytes() == in_order.read_bytes()
+
+
+@pytest.mark.parametrize("ext,fps", [(".pose.jsonl", 0), (".bvh", 30), (".vrma", 24)])
+def test_convert_file_reads_the_vrma_the_cli_wrote(pose_file, cli, tmp_path, ext, fps):
+    """A .vrma written by `avatarmap convert` converts again, to the CLI's bytes (it used to
+    raise ParseError)."""
+    vrma = tmp_path / "take.vrma"
+    cli("convert", pose_file, "-o", vrma)
+    ref = tmp_path / ("cli" + ext)
+    cli("convert", vrma, "-o", ref, *(("--fps", fps) if fps else ()))
+    mine = tmp_path / ("py" + ext)
+    n = am.convert_file(vrma, mine, fps=fps)
+    assert n == len(am.read_poses(vrma))  # read_poses reads a .vrma with the same reader
+    assert mine.read_bytes() == ref.read_bytes()
+
+
+def test_motion_input_kind_is_the_librarys_rule(pose_file, cli, tmp_path):
+    assert am.motion_input_kind("a/take.landmarks.jsonl") == "landmarks"
+    assert am.motion_input_kind("TAKE.POSE.JSONL") == "poses"
+    assert am.motion_input_kind("clip.Vrma") == "vrma"
+    assert am.motion_input_kind("walk.bvh") is None
+    # A name that says nothing: the content does.
+    odd = tmp_path / "take.json"
+    odd.write_bytes(pose_file.read_bytes())
+    assert am.motion_input_kind(odd) == "poses"
+    out, ref = tmp_path / "again.pose.jsonl", tmp_path / "cli.pose.jsonl"
+    am.convert_file(odd, out)
+    cli("convert", pose_file, "-o", ref)
+    assert out.read_bytes() == ref.read_bytes()
+    with pytest.raises(am.InvalidArgumentError, match="unknown input type"):
+        am.convert_file(tmp_path / "notes.txt", tmp_path / "x.vrma")
+
+
 @pytest.mark.parametrize("ext", [".vrma", ".bvh"])
 def test_write_animation_equals_cli_convert(synth_file, cli, tmp_path, ext):
     """Python solve() + write_animation() against `avatarmap convert LANDMARKS -o OUT`."""

@@ -23,6 +23,8 @@ STRUCTS = {  # C name -> ctypes mirror
     "avm_live_stats": _lib.AvmLiveStats,
     "avm_frame_block": _lib.AvmFrameBlock,
     "avm_capture_summary": _lib.AvmCaptureSummary,
+    "avm_convert_options": _lib.AvmConvertOptions,
+    "avm_convert_summary": _lib.AvmConvertSummary,
 }
 
 
@@ -102,3 +104,46 @@ def test_poses_view_one_record_array():
                            expressions=poses.expressions.copy())
     assert np.array_equal(copy.records, rec)  # assembled from plain arrays: same bytes
     assert copy.records.tobytes() == rec.tobytes()
+
+
+def _example_mirrors():
+    """The ctypes mirrors the standalone examples (examples/python/*_ctypes.py: ctypes only, no
+    NumPy, so they keep their own) declare: {C struct: (example, mirror)}."""
+    import importlib.util
+    import sys
+    here = os.path.dirname(os.path.abspath(__file__))
+    folder = os.path.normpath(os.path.join(here, "..", "..", "examples", "python"))
+    if not os.path.isdir(folder):
+        pytest.skip("examples/python is not beside the tests")
+    sys.path.insert(0, folder)  # capture_ctypes imports solve_ctypes
+    try:
+        found = {}
+        for example in ("solve_ctypes", "capture_ctypes"):
+            spec = importlib.util.spec_from_file_location(
+                "example_" + example, os.path.join(folder, example + ".py"))
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)  # declarations only: main() is not run
+            for c_name, mirror in STRUCTS.items():
+                ours = getattr(module, mirror.__name__, None)
+                if ours is not None and c_name not in found:
+                    found[c_name] = (example, ours)
+        return found
+    finally:
+        sys.path.remove(folder)
+
+
+def test_example_mirrors_match_the_header_and_the_package(tmp_path):
+    """The examples' mirrors have the header's layout and the package's field names: a field
+    added to the header fails here until both are updated."""
+    present, layout = _c_layout(tmp_path)
+    examples = _example_mirrors()
+    assert "avm_solver_options" in examples and "avm_estimator_options" in examples
+    for c_name, (example, mirror) in examples.items():
+        if c_name not in present:
+            continue
+        size, offsets = layout[c_name]
+        assert ctypes.sizeof(mirror) == size, (example, c_name)
+        assert [f for f, _ in mirror._fields_] == [f for f, _ in STRUCTS[c_name]._fields_], (
+            example, c_name)
+        for field, _ in mirror._fields_:
+            assert getattr(mirror, field).offset == offsets[field], (example, c_name, field)

@@ -1,6 +1,6 @@
 // The per-frame path allocates nothing: a counting global operator new (for this test
-// executable) proves that frame_solver::solve, pose_filter::apply and the resampler make no
-// heap allocation once constructed.
+// executable) proves that frame_solver::solve, pose_filter::apply, the resampler and the pose
+// stream that chains them make no heap allocation once constructed.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -13,6 +13,7 @@
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/solve/frame_solver.hpp"
+#include "avatarmap/solve/pose_stream.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
 #include "avatarmap/time/pose_filter.hpp"
@@ -59,6 +60,55 @@ TEST(Allocation, SolveFilterAndResampleAllocateNothingPerFrame) {
     }
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
+// The pose stream (solve -> filter -> resample, the chain every caller uses) allocates nothing
+// per frame in any filter mode, with and without a grid, once constructed.
+TEST(Allocation, PoseStreamAllocatesNothingPerFrame) {
+  landmark_synth synth;
+  std::mt19937 rng(4);
+  std::vector<landmark_frame> frames(24);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    synth.generate(random_pose(rng), frames[i]);
+    frames[i].t = double(i) / 30.0;
+  }
+  frames[4].set(frame_part::face, false);
+  frames[9].parts = 0;
+  struct setup {
+    pose_filter_mode mode;
+    bool points;
+    double fps;
+  };
+  for (const setup& c :
+       {setup{pose_filter_mode::live, false, 0.0}, setup{pose_filter_mode::live, false, 60.0},
+        setup{pose_filter_mode::none, true, 0.0}, setup{pose_filter_mode::offline, false, 0.0},
+        setup{pose_filter_mode::offline, false, 45.0}}) {
+    pose_stream_options o;
+    o.filters.filter_mode = c.mode;
+    o.filters.landmark_filter.enabled = c.points;
+    o.output_fps = c.fps;
+    pose_stream stream(o);
+    proxy_pose out, sampled;
+    long emitted = 0;
+    auto emit = [&](const proxy_pose& p) {
+      out = p;
+      ++emitted;
+      return status{};
+    };
+    ASSERT_TRUE(stream.push(frames[0], emit).ok());  // warm-up
+    const long before = g_allocations.load();
+    for (int round = 0; round < 3; ++round) {
+      for (size_t i = 1; i < frames.size(); ++i) {
+        frames[i].t = round * 2.0 + double(i) / 30.0;
+        ASSERT_TRUE(stream.push(frames[i], emit).ok());
+        stream.sample(frames[i].t + 0.01, sampled);
+      }
+    }
+    ASSERT_TRUE(stream.finish(emit).ok());
+    EXPECT_EQ(g_allocations.load() - before, 0)
+        << "mode " << int(c.mode) << " points " << c.points << " fps " << c.fps;
+    EXPECT_GT(emitted, 0);
+  }
 }
 
 // Retargeting onto a rig (rest-aware path and table formulas) allocates nothing per frame

@@ -3,11 +3,10 @@
 #include "c_avatar.hpp"
 
 #include <cstdio>
-#include <cstdlib>
 #include <mutex>
 #include <string>
 
-#include "avatarmap/rig/avatar_loader.hpp"
+#include "avatarmap/rig/bound_avatar.hpp"
 #include "c_guard.hpp"
 
 namespace am = avatarmap;
@@ -27,65 +26,38 @@ std::string& mappings_folder_slot() {
   return folder;
 }
 
-// $AVATARMAP_MAPPINGS when set and not empty, else the folder given to
-// avm_set_mappings_folder() ("" when none).
-std::string current_mappings_folder() {
-  if (const char* env = std::getenv("AVATARMAP_MAPPINGS"); env != nullptr && *env != '\0')
-    return env;
+}  // namespace
+
+std::string given_mappings_folder() {
   std::lock_guard<std::mutex> lock(mappings_mutex());
   return mappings_folder_slot();
 }
 
-avm_status binding_status(am::rig_binding_failure f) {
-  switch (f) {
-    case am::rig_binding_failure::io:
-      return AVM_ERROR_IO;
-    case am::rig_binding_failure::unknown_name:
-      return AVM_ERROR_INVALID_ARGUMENT;
-    case am::rig_binding_failure::bad_table:
-    case am::rig_binding_failure::no_fit:
-      return AVM_ERROR_PARSE;
-    case am::rig_binding_failure::none:
-      break;
-  }
-  return AVM_ERROR_INTERNAL;
+avm_status bind_c_avatar(const char* avatar_path, const char* mapping, am::bound_avatar& out,
+                         std::string& msg) {
+  am::bind_avatar_options options;
+  options.rig = mapping != nullptr ? mapping : "auto";
+  // io/resources.hpp's order: the folder given to avm_set_mappings_folder(), else
+  // $AVATARMAP_MAPPINGS, else the installed tables, else the source tree's.
+  options.mappings_folder = given_mappings_folder();
+  const am::status st = am::bind_avatar(avatar_path, options, out);
+  if (st.ok()) return AVM_OK;
+  msg = st.message();
+  if (out.failed_step == am::bind_avatar_step::select && st.code() == am::status_code::io &&
+      out.mappings_folder.empty())
+    msg = std::string(avatar_path) + ": mapping '" + options.rig +
+          "' needs the mapping tables: no mappings folder was found (set AVATARMAP_MAPPINGS "
+          "or call avm_set_mappings_folder())";
+  return avm_code(st);  // io (cannot be read), parse (not a valid avatar; a table), ...
 }
 
-bool file_readable(const std::string& path) {
-  FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) return false;
-  std::fclose(f);
-  return true;
-}
-
-}  // namespace
-
-// Loads the avatar at `avatar_path` into `out_rig` and binds it as `mapping` says (NULL =
-// "auto"). On failure returns the status and sets `msg` (naming the file).
 avm_status load_bound_avatar(const char* avatar_path, const char* mapping, am::rig& out_rig,
                              am::rig_binding_choice& out_choice, std::string& msg) {
-  am::raw_rig raw;
-  am::status st = am::load_avatar(avatar_path, raw);
-  if (!st.ok()) {
-    msg = st.message();
-    return file_readable(avatar_path) ? AVM_ERROR_PARSE : AVM_ERROR_IO;
-  }
-  st = am::build_rig(raw, out_rig);
-  if (!st.ok()) {
-    msg = st.message();
-    return AVM_ERROR_PARSE;
-  }
-  const std::string option = mapping != nullptr ? mapping : "auto";
-  const std::string folder = current_mappings_folder();
-  st = am::select_binding(out_rig, option, folder, out_choice);
-  if (!st.ok()) {
-    msg = st.message();
-    if (out_choice.failure == am::rig_binding_failure::io && folder.empty())
-      msg = std::string(avatar_path) + ": mapping '" + option +
-            "' needs the mapping tables: no mappings folder is set (set AVATARMAP_MAPPINGS or "
-            "call avm_set_mappings_folder())";
-    return binding_status(out_choice.failure);
-  }
+  am::bound_avatar avatar;
+  const avm_status code = bind_c_avatar(avatar_path, mapping, avatar, msg);
+  if (code != AVM_OK) return code;
+  out_rig = std::move(avatar.rig);
+  out_choice = std::move(avatar.choice);  // no overrides: its binding is the avatar's
   return AVM_OK;
 }
 

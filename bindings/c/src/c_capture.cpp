@@ -64,7 +64,7 @@ AVATARMAP_C_API avm_status avm_estimator_create(const avm_estimator_options* opt
     if (code != AVM_OK) return to_create_error(code, msg.c_str());
     std::unique_ptr<avm_estimator> e(new avm_estimator());
     const am::status st = am::capture_pipeline::create(po, e->pipeline);
-    if (!st.ok()) return to_create_error(capture_create_code(st), st.message().c_str());
+    if (!st.ok()) return to_create_error(avm_code(st), st.message().c_str());
     e->pose.set_rest();
     e->last_error.reserve(256);  // the image checks' messages fit without allocating
     *out = e.release();
@@ -94,7 +94,7 @@ AVATARMAP_C_API avm_status avm_estimator_process(avm_estimator* estimator, const
     if (const char* bad = to_image_view(*image, view, buffer, sizeof buffer))
       return fail(estimator, AVM_ERROR_INVALID_ARGUMENT, bad);
     const am::status st = estimator->pipeline->process(view, t, estimator->frame, estimator->pose);
-    if (!st.ok()) return fail(estimator, code_for(st, AVM_ERROR_INTERNAL), st.message().c_str());
+    if (!st.ok()) return fail(estimator, avm_code(st), st.message().c_str());
     if (out_frame != nullptr) to_c_frame(estimator->frame, estimator->storage, *out_frame);
     if (out_pose != nullptr) to_c_pose(estimator->pose, *out_pose);
     return AVM_OK;

@@ -71,7 +71,7 @@ AVATARMAP_C_API avm_status avm_capture_file(const char* input, const char* out_l
     am::capture_file_summary s;
     const am::status st = job.run(s);
     if (out_summary != nullptr) fill_summary(s, *out_summary);
-    if (!st.ok()) return report(code_for(st, job_code(s.failure)), st.message().c_str());
+    if (!st.ok()) return report(avm_code(st), st.message().c_str());
     if (progress != nullptr)  // the last call says where it ended
       progress(user, s.frames, s.frames);
     return AVM_OK;

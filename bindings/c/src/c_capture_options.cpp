@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "avatarmap/io/resources.hpp"
 #include "c_guard.hpp"
 #include "c_solver_options.hpp"
 
@@ -25,19 +26,55 @@ bool has_backend(const char* name) {
 }
 }  // namespace
 
+namespace {
+
+// The int32_t fields of avm_estimator_options (all but struct_size and models_dir), each by
+// its name in k_estimator_option_table (the token is the name).
+struct c_field {
+  const char* name;
+  std::size_t offset;
+};
+#define AVM_FIELD(f) \
+  c_field { #f, offsetof(avm_estimator_options, f) }
+constexpr c_field k_fields[] = {
+    AVM_FIELD(model_complexity),      AVM_FIELD(hands),   AVM_FIELD(face),
+    AVM_FIELD(hand_model_complexity), AVM_FIELD(threads), AVM_FIELD(mirrored),
+    AVM_FIELD(static_images),
+};
+#undef AVM_FIELD
+// Every field from model_complexity to the end (past it only the struct's padding).
+constexpr std::size_t k_fields_end = offsetof(avm_estimator_options, static_images) + 4;
+static_assert(offsetof(avm_estimator_options, model_complexity) +
+                          sizeof(k_fields) / sizeof(k_fields[0]) * sizeof(std::int32_t) ==
+                      k_fields_end &&
+                  sizeof(avm_estimator_options) - k_fields_end < alignof(avm_estimator_options),
+              "k_fields must list every field of avm_estimator_options");
+
+std::int32_t field_value(const avm_estimator_options& o, const c_field& f) {
+  std::int32_t v;
+  std::memcpy(&v, reinterpret_cast<const char*>(&o) + f.offset, sizeof v);
+  return v;
+}
+
+const option_row<estimator_options>& row_of(const c_field& f) {
+  // Every name of k_fields is a row (tests/python/test_options.py checks the table's C rows
+  // against the struct); a missing one is a programming error caught on the first call.
+  const option_row<estimator_options>* r = find_option(k_estimator_option_table, f.name);
+  if (r == nullptr) std::abort();
+  return *r;
+}
+
+}  // namespace
+
 avm_estimator_options default_estimator_options() {
   avm_estimator_options o;
   std::memset(&o, 0, sizeof o);
   o.struct_size = sizeof o;
-  o.models_dir = nullptr;
-  const estimator_options e{};
-  o.model_complexity = e.model_complexity;
-  o.hands = 1;
-  o.face = 1;
-  o.hand_model_complexity = e.hand_model_complexity;
-  o.threads = 2;
-  o.mirrored = e.mirrored_input ? 1 : 0;
-  o.static_images = e.static_images ? 1 : 0;
+  o.models_dir = nullptr;  // find_resource(resource::models)
+  for (const c_field& f : k_fields) {
+    const std::int32_t v = static_cast<std::int32_t>(option_default(row_of(f)));
+    std::memcpy(reinterpret_cast<char*>(&o) + f.offset, &v, sizeof v);
+  }
   return o;
 }
 
@@ -59,44 +96,45 @@ avm_status read_capture_options(const avm_estimator_options* in,
   }
   core_options solver;
   if (!read_options(solver_in, solver, msg)) return AVM_ERROR_INVALID_ARGUMENT;
-  auto range = [&](const char* name, int v, int lo, int hi) {
-    if (v >= lo && v <= hi) return true;
-    msg = std::string("avm_estimator_options.") + name + " is " + std::to_string(v) +
-          ": it must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
-    return false;
-  };
-  if (!range("model_complexity", o.model_complexity, 0, 2) ||
-      !range("hand_model_complexity", o.hand_model_complexity, 0, 1) ||
-      !range("threads", o.threads, 1, 64))
-    return AVM_ERROR_INVALID_ARGUMENT;
+  // Each field through its row: the range and its message come from the table. A C boolean is
+  // 0 or non-zero (the header's rule), so booleans are not range-checked.
+  estimator_options e;
+  apply_option_defaults(k_estimator_option_table, e);
+  for (const c_field& f : k_fields) {
+    const option_row<estimator_options>& row = row_of(f);
+    const double v = field_value(o, f);
+    if (row.kind == option_kind::boolean) {
+      row.set(e, v != 0.0 ? 1.0 : 0.0);
+    } else if (!option_accepts(row, v)) {
+      msg = option_range_message(row, std::string("avm_estimator_options.") + f.name, v);
+      return AVM_ERROR_INVALID_ARGUMENT;
+    } else {
+      row.set(e, v);
+    }
+  }
   if (!has_backend("onnx")) {
     msg =
         "this avatarmap library was built without the ONNX Runtime backend "
         "(AVATARMAP_WITH_ONNX=OFF): it cannot estimate landmarks";
     return AVM_ERROR_UNSUPPORTED;
   }
-  std::string models = o.models_dir != nullptr ? o.models_dir : "";
-  if (models.empty()) {
-    const char* env = std::getenv("AVATARMAP_MODELS");
-    if (env == nullptr || *env == '\0') {
-      msg =
-          "avm_estimator_options.models_dir is not set and neither is AVATARMAP_MODELS: give the "
-          "folder of the converted models (scripts/prepare_capture.sh makes them)";
-      return AVM_ERROR_INVALID_ARGUMENT;
-    }
-    models = std::string(env) + "/onnx";
+  const resource_lookup found =
+      find_resource(resource::models, o.models_dir != nullptr ? o.models_dir : "");
+  if (found.folder.empty()) {
+    msg =
+        "avm_estimator_options.models_dir is not set and no models folder was found (looked "
+        "in:";
+    for (const std::string& t : found.tried) msg += " " + t + ";";
+    msg +=
+        " set AVATARMAP_MODELS): give the folder of the converted models "
+        "(scripts/prepare_capture.sh makes them)";
+    return AVM_ERROR_INVALID_ARGUMENT;
   }
+  const std::string& models = found.folder;
   out = capture_pipeline_options{};
   out.backend = "onnx";
-  estimator_options& e = out.estimator;
   e.source = models;
-  e.threads = o.threads;
-  e.model_complexity = o.model_complexity;
-  e.hand_model_complexity = o.hand_model_complexity;
-  e.hands = o.hands != 0;
-  e.face = o.face != 0;
-  e.mirrored_input = o.mirrored != 0;
-  e.static_images = o.static_images != 0;
+  out.estimator = e;
   out.solver = solver.solver;
   out.filter = solver.filter;
   out.filter.enabled =
@@ -132,7 +170,5 @@ const char* to_image_view(const avm_image& in, image_view& out, char* buffer, si
   copy_message(buffer, size, ("avm_image: " + st.message()).c_str());
   return buffer;
 }
-
-avm_status capture_create_code(const status& st) { return code_for(st, AVM_ERROR_IO); }
 
 }  // namespace avatarmap::c_api

@@ -23,8 +23,4 @@ avm_status read_capture_options(const avm_estimator_options* in,
 /// for the NULL and format cases, else written into `buffer`).
 const char* to_image_view(const avm_image& in, image_view& out, char* buffer, size_t size);
 
-/// The status for a failed capture_pipeline::create: AVM_ERROR_IO when the models are
-/// missing, else `otherwise`.
-avm_status capture_create_code(const status& st);
-
 }  // namespace avatarmap::c_api

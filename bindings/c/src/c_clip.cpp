@@ -10,10 +10,9 @@
 
 #include "avatarmap/avatarmap.h"
 #include "avatarmap/core/rotation.hpp"
-#include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/jobs/clip_output.hpp"
-#include "avatarmap/rig/rig.hpp"
-#include "avatarmap/rig/rig_binding.hpp"
+#include "avatarmap/jobs/convert_file.hpp"
+#include "avatarmap/rig/bound_avatar.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "c_avatar.hpp"
 #include "c_frames.hpp"
@@ -71,27 +70,22 @@ avm_status write_clip(const std::vector<am::proxy_pose>& frames, double source_f
   job.avatar_path = avatar_path != nullptr ? avatar_path : "";
   if (am::status st = job.validate(); !st.ok()) {
     msg = st.message();
-    return AVM_ERROR_INVALID_ARGUMENT;
+    return avm_code(st);
   }
-  // An avatar with its binding (large: kept on the heap).
-  struct bound_avatar {
-    am::rig rig;
-    am::rig_binding_choice choice;
-  };
-  std::unique_ptr<bound_avatar> avatar;
+  // An avatar with its binding (large: kept on the heap), as the library binds it.
+  std::unique_ptr<am::bound_avatar> avatar;
   if (avatar_path != nullptr && am::find_clip_format(path)->uses_avatar) {
-    avatar = std::make_unique<bound_avatar>();
-    const avm_status code =
-        load_bound_avatar(avatar_path, mapping, avatar->rig, avatar->choice, msg);
+    avatar = std::make_unique<am::bound_avatar>();
+    const avm_status code = bind_c_avatar(avatar_path, mapping, *avatar, msg);
     if (code != AVM_OK) return code;
     job.avatar_rig = &avatar->rig;
-    job.avatar_binding = avatar->choice.binding;
-    job.avatar_table = avatar->choice.table_or_null();
+    job.avatar_binding = avatar->binding;
+    job.avatar_table = avatar->table();
   }
   am::clip_output_summary summary;
   if (am::status st = job.run(summary); !st.ok()) {
     msg = st.message();
-    return code_for(st, job_code(summary.failure));
+    return avm_code(st);
   }
   return AVM_OK;
 }
@@ -214,26 +208,14 @@ AVATARMAP_C_API avm_status avm_clip_read(const char* path, avm_clip** out, char*
   if (path == nullptr || out == nullptr)
     return report(AVM_ERROR_INVALID_ARGUMENT, "avm_clip_read: path and out must not be NULL");
   return guard("avm_clip_read", report, [&]() -> avm_status {
-    am::pose_reader reader;
-    if (am::status st = reader.open(path); !st.ok())
-      return report(code_for(st, reader.line() > 0 ? AVM_ERROR_PARSE : AVM_ERROR_IO),
-                    st.message().c_str());
+    // The library's reader of motion files (the one `avatarmap convert` and avm_convert_file
+    // use): a pose file or a .vrma, the frames put in time order by its one rule.
+    am::motion_clip read;
+    if (am::status st = am::read_motion(path, nullptr, read); !st.ok())
+      return report(avm_code(st), st.message().c_str());
     std::unique_ptr<avm_clip> clip(new avm_clip());
-    clip->source_fps = reader.header().fps;
-    am::proxy_pose p;
-    for (;;) {
-      const am::read_result r = reader.next(p);
-      if (r == am::read_result::end) break;
-      if (r == am::read_result::error) return report(AVM_ERROR_PARSE, reader.error().c_str());
-      // The clip's rule (avm_clip_add): times increase.
-      if (!std::isfinite(p.t) || (!clip->frames.empty() && !(p.t > clip->frames.back().t))) {
-        const std::string msg = std::string(path) + ":" + std::to_string(reader.line()) + ": t (" +
-                                std::to_string(p.t) +
-                                ") must be finite and after the previous frame's";
-        return report(AVM_ERROR_PARSE, msg.c_str());
-      }
-      clip->frames.push_back(p);
-    }
+    clip->source_fps = read.source_fps;
+    clip->frames = std::move(read.frames);
     *out = clip.release();
     return AVM_OK;
   });

@@ -34,21 +34,21 @@ void set_error(const error_slot* h, const char* msg) noexcept {
   }
 }
 
-avm_status code_for(const status& st, avm_status otherwise) noexcept {
-  return st.is_out_of_memory() ? AVM_ERROR_OUT_OF_MEMORY : otherwise;
-}
-
-avm_status job_code(job_failure why) noexcept {
-  switch (why) {
-    case job_failure::invalid_argument:
+avm_status avm_code(status_code code) noexcept {
+  switch (code) {
+    case status_code::ok:
+      return AVM_OK;
+    case status_code::invalid_argument:
       return AVM_ERROR_INVALID_ARGUMENT;
-    case job_failure::input_io:
-    case job_failure::output_io:
+    case status_code::io:
       return AVM_ERROR_IO;
-    case job_failure::input_parse:
+    case status_code::parse:
       return AVM_ERROR_PARSE;
-    case job_failure::internal:
-    case job_failure::none:
+    case status_code::unsupported:
+      return AVM_ERROR_UNSUPPORTED;
+    case status_code::out_of_memory:
+      return AVM_ERROR_OUT_OF_MEMORY;
+    case status_code::internal:
       break;
   }
   return AVM_ERROR_INTERNAL;

@@ -1,8 +1,8 @@
 // What every C entry point shares (bindings/c/src/): the one exception boundary (guard), the
-// handles' error slots, the thread-local create error, and the mapping from library failures
-// to avm_status. Rules kept by every avm_* function: its body runs inside guard(), so no
-// exception leaves it; messages are composed in fixed buffers where memory may have run out;
-// the per-frame calls allocate nothing on success.
+// handles' error slots, the thread-local create error, and the one mapping from a library
+// status's code to avm_status. Rules kept by every avm_* function: its body runs inside guard(), so
+// no exception leaves it; messages are composed in fixed buffers where memory may have run out; the
+// per-frame calls allocate nothing on success.
 #pragma once
 
 #include <cstddef>
@@ -13,7 +13,6 @@
 
 #include "avatarmap/avatarmap.h"
 #include "avatarmap/core/status.hpp"
-#include "avatarmap/jobs/job_failure.hpp"
 
 namespace avatarmap::c_api {
 
@@ -42,11 +41,14 @@ inline avm_status fail(const error_slot* h, avm_status code, const char* msg) no
   return code;
 }
 
-/// AVM_ERROR_OUT_OF_MEMORY when memory ran out, else `otherwise` (the entry point's code for
-/// the step that failed: I/O, parse, invalid argument).
-avm_status code_for(const status& st, avm_status otherwise) noexcept;
-/// The status code for why a library job (avatarmap/jobs/*) failed.
-avm_status job_code(job_failure why) noexcept;
+/// The avm_status of a status_code, one to one: ok -> AVM_OK, invalid_argument ->
+/// AVM_ERROR_INVALID_ARGUMENT, io -> AVM_ERROR_IO, parse -> AVM_ERROR_PARSE, unsupported ->
+/// AVM_ERROR_UNSUPPORTED, out_of_memory -> AVM_ERROR_OUT_OF_MEMORY, internal ->
+/// AVM_ERROR_INTERNAL (AVM_ERROR_END_OF_FILE is no failure and has no code). Every entry point
+/// that reports a library status uses it (or avm_code below).
+avm_status avm_code(status_code code) noexcept;
+/// avm_code(st.code()): AVM_OK for an ok status.
+inline avm_status avm_code(const status& st) noexcept { return avm_code(st.code()); }
 
 // Reporters for guard(): where an entry point's error message goes.
 inline avm_status to_create_error(avm_status code, const char* msg) noexcept {

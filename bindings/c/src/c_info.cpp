@@ -1,13 +1,17 @@
 // The C API's library-wide functions: version, status strings, bone and expression names,
-// the create error (bindings/c/include/avatarmap/avatarmap.h).
+// the create error, the shipped folders (bindings/c/include/avatarmap/avatarmap.h).
 #include <cstring>
+#include <string>
 #include <string_view>
 
 #include "avatarmap/avatarmap.h"
+#include "avatarmap/core/limits.hpp"
+#include "avatarmap/io/resources.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/bone.hpp"
 #include "avatarmap/skeleton/expression.hpp"
 #include "avatarmap/version.hpp"
+#include "c_avatar.hpp"
 #include "c_guard.hpp"
 
 namespace am = avatarmap;
@@ -17,12 +21,20 @@ static_assert(AVM_VERSION_MAJOR == AVATARMAP_VERSION_MAJOR &&
                   AVM_VERSION_MINOR == AVATARMAP_VERSION_MINOR &&
                   AVM_VERSION_PATCH == AVATARMAP_VERSION_PATCH,
               "avatarmap.h and avatarmap/version.hpp disagree on the version");
+static_assert(AVM_MAX_FPS == am::k_max_fps, "AVM_MAX_FPS must be core/limits.hpp's k_max_fps");
+static_assert(AVM_MAX_MODEL_THREADS == am::k_max_model_threads,
+              "AVM_MAX_MODEL_THREADS must be core/limits.hpp's k_max_model_threads");
 static_assert(AVM_BONE_COUNT == am::k_bone_count, "bone count");
 static_assert(AVM_EXPRESSION_COUNT == am::k_expression_count, "expression count");
 static_assert(AVM_POSE_LANDMARK_COUNT == am::k_pose_landmark_count, "pose landmark count");
 static_assert(AVM_HAND_LANDMARK_COUNT == am::k_hand_landmark_count, "hand landmark count");
 static_assert(AVM_FACE_LANDMARK_COUNT == am::k_face_mesh_count, "face landmark count");
 static_assert(AVM_FACE_IRIS_LANDMARK_COUNT == am::k_face_mesh_iris_count, "face+iris count");
+static_assert(AVM_RESOURCE_MAPPINGS == static_cast<int>(am::resource::mappings) &&
+                  AVM_RESOURCE_MODELS == static_cast<int>(am::resource::models) &&
+                  AVM_RESOURCE_VIEWER_PAGE == static_cast<int>(am::resource::viewer_page) &&
+                  AVM_RESOURCE_VIEWER_MODULES == static_cast<int>(am::resource::viewer_modules),
+              "avm_resource must follow avatarmap::resource");
 static_assert(AVM_BONE_RIGHT_LITTLE_DISTAL == am::idx(am::bone::right_little_distal) &&
                   AVM_BONE_LEFT_HAND == am::idx(am::bone::left_hand) &&
                   AVM_BONE_RIGHT_TOES == am::idx(am::bone::right_toes) &&
@@ -119,6 +131,50 @@ AVATARMAP_C_API int avm_expression_from_name(const char* name) {
     if (name == nullptr) return -1;
     auto e = am::expression_from_name(std::string_view(name));
     return e ? am::idx(*e) : -1;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_find_resource(int kind, const char* explicit_folder,
+                                             char* out_folder, size_t folder_size, char* out_rule,
+                                             size_t rule_size, char* err, size_t err_size) {
+  copy_message(err, err_size, "");
+  copy_message(out_folder, folder_size, "");
+  copy_message(out_rule, rule_size, "");
+  auto report = [&](avm_status code, const char* msg) {
+    copy_message(err, err_size, msg);
+    return code;
+  };
+  return guard("avm_find_resource", report, [&]() -> avm_status {
+    if (kind < AVM_RESOURCE_MAPPINGS || kind > AVM_RESOURCE_VIEWER_MODULES)
+      return report(AVM_ERROR_INVALID_ARGUMENT, ("avm_find_resource: kind " + std::to_string(kind) +
+                                                 " is not an avm_resource (0 .. 3)")
+                                                    .c_str());
+    const auto which = static_cast<am::resource>(kind);
+    std::string given = explicit_folder != nullptr ? explicit_folder : "";
+    if (explicit_folder == nullptr && which == am::resource::mappings)
+      given = given_mappings_folder();
+    const am::resource_lookup found = am::find_resource(which, given);
+    if (found.folder.empty()) {
+      std::string msg = std::string("avm_find_resource: no ") + am::resource_name(which) +
+                        " folder found; looked in:";
+      for (const std::string& t : found.tried) msg += " " + t + ";";
+      return report(AVM_ERROR_IO, msg.c_str());
+    }
+    // A NULL buffer of size 0 is not wanted; any other must hold the whole text.
+    auto fits = [&](const std::string& text, const char* buffer, size_t size, const char* what) {
+      if ((buffer == nullptr && size == 0) || text.size() < size) return true;
+      report(AVM_ERROR_INVALID_ARGUMENT,
+             ("avm_find_resource: " + std::string(what) + " needs " +
+              std::to_string(text.size() + 1) + " bytes, got " + std::to_string(size))
+                 .c_str());
+      return false;
+    };
+    if (!fits(found.folder, out_folder, folder_size, "out_folder") ||
+        !fits(found.source, out_rule, rule_size, "out_rule"))
+      return AVM_ERROR_INVALID_ARGUMENT;
+    copy_message(out_folder, folder_size, found.folder.c_str());
+    copy_message(out_rule, rule_size, found.source.c_str());
+    return AVM_OK;
   });
 }
 

@@ -34,11 +34,8 @@ AVATARMAP_C_API avm_status avm_landmark_reader_open(const char* path, avm_landma
   return guard("avm_landmark_reader_open", to_create_error, [&]() -> avm_status {
     std::unique_ptr<avm_landmark_reader> r(new avm_landmark_reader());
     const am::status st = r->reader.open(path);
-    if (!st.ok()) {
-      // Opened but the header line is bad: a parse error; else the file could not be read.
-      const avm_status code = r->reader.line() > 0 ? AVM_ERROR_PARSE : code_for(st, AVM_ERROR_IO);
-      return to_create_error(code, st.message().c_str());
-    }
+    // io: the file cannot be opened; parse: the header line is bad.
+    if (!st.ok()) return to_create_error(avm_code(st), st.message().c_str());
     r->last_error.reserve(256);
     *out = r.release();
     return AVM_OK;
@@ -82,9 +79,10 @@ AVATARMAP_C_API avm_status avm_landmark_reader_read(avm_landmark_reader* r,
       }
       if (res == am::read_result::error) {
         *out_read = n;
-        fail(r, AVM_ERROR_PARSE, r->ahead->error().c_str());
+        const avm_status code = avm_code(r->ahead->error_code());  // parse, or io
+        fail(r, code, r->ahead->error().c_str());
         r->ahead->release();
-        return AVM_ERROR_PARSE;
+        return code;
       }
       frame_to_block_row(r->ahead->frame(), *block, n);
       r->ahead->release();

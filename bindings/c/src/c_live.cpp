@@ -110,10 +110,10 @@ AVATARMAP_C_API avm_status avm_live_create(const avm_estimator_options* options,
     const avm_status code =
         read_capture_options(options, solver_options, lo.pipeline, extrapolation, msg);
     if (code != AVM_OK) return to_create_error(code, msg.c_str());
-    lo.resampler.max_extrapolation_seconds = extrapolation;
+    lo.pipeline.resampler.max_extrapolation_seconds = extrapolation;
     std::unique_ptr<avm_live> l(new avm_live());
     const am::status st = am::live_session::create(lo, l->session);
-    if (!st.ok()) return to_create_error(capture_create_code(st), st.message().c_str());
+    if (!st.ok()) return to_create_error(avm_code(st), st.message().c_str());
     {
       live_registry& r = registry();
       std::lock_guard<std::mutex> lock(r.m);
@@ -156,7 +156,7 @@ AVATARMAP_C_API avm_status avm_live_push(avm_live* live, const avm_image* image,
     if (const char* bad = to_image_view(*image, view, live->buffer, sizeof live->buffer))
       return report(AVM_ERROR_INVALID_ARGUMENT, bad);
     const am::status st = live->session->push(view, t);
-    if (!st.ok()) return report(code_for(st, AVM_ERROR_INVALID_ARGUMENT), st.message().c_str());
+    if (!st.ok()) return report(avm_code(st), st.message().c_str());
     return AVM_OK;
   });
 }

@@ -74,7 +74,7 @@ AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const 
                                         r->choice.table_or_null());
     if (!st.ok()) {
       set_create_error(st.message().c_str());
-      return AVM_ERROR_PARSE;
+      return avm_code(st);  // parse: the binding does not fit the rig
     }
     r->retargeter.prepare(r->pose);
     set_create_error("");

@@ -1,6 +1,6 @@
 // The C API's solver handle and file solve (avm_solver_*, avm_solve_file): options read and
-// checked, landmarks -> proxy pose -> live filter -> resampler per frame, and the library's
-// solve-file job for files.
+// checked, the library's pose stream per frame (landmarks -> proxy pose -> live filter ->
+// resampler), and the library's solve-file job for files.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -12,11 +12,8 @@
 #include "avatarmap/jobs/solve_file.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
-#include "avatarmap/solve/frame_solver.hpp"
+#include "avatarmap/solve/pose_stream.hpp"
 #include "avatarmap/solve/solver_options.hpp"
-#include "avatarmap/time/offline_smoother.hpp"
-#include "avatarmap/time/pose_filter.hpp"
-#include "avatarmap/time/pose_resampler.hpp"
 #include "c_clip.hpp"
 #include "c_frame_block.hpp"
 #include "c_frames.hpp"
@@ -28,37 +25,27 @@ using namespace avatarmap::c_api;
 
 // The handle. Everything a frame needs is preallocated here.
 struct avm_solver : avatarmap::c_api::error_slot {
-  am::frame_solver solver;
-  am::pose_filter filter;
-  am::pose_resampler resampler;
-  am::pose_filter_channels channels;
+  am::pose_stream stream;    // solve -> live filter (its channels) -> resampler
   am::landmark_frame frame;  // scratch: the C frame converted
-  am::proxy_pose raw;        // scratch: solved, before filtering
   am::proxy_pose latest;     // solved and filtered
   am::proxy_pose sampled;    // scratch for sample()
 
-  avm_solver(const am::solver_options& s, const am::pose_filter_options& f,
-             const am::pose_resampler_options& r)
-      : solver(s), filter(f), resampler(r) {}
+  explicit avm_solver(const am::pose_stream_options& o) : stream(o) {}
 };
 
 namespace {
 
-// The solve-file job as avm_solve_file and avm_solve_frames run it: with file_threads 2 (the
-// default) a file is parsed ahead on a second thread of the job's own, as `avatarmap solve`
-// does (frames from memory are pulled on the calling thread whatever `threads` says).
-am::solve_file_job file_job(const core_options& o) {
-  am::solve_file_job job;
-  job.options = o.solver;
-  // Non-zero options.image_width/height win over the file's header (0 = the header's).
-  job.image_width = o.solver.image_width;
-  job.image_height = o.solver.image_height;
-  job.filter_mode = o.file_filter;
-  job.offline.strength = o.file_smoothing;
-  job.filter = o.filter;
-  job.filter_channels = o.channels;
-  job.threads = o.file_threads;
-  return job;
+// The stream of a solver handle: the live filter on the channels asked for, one pose per
+// frame, sample() at any time.
+am::pose_stream_options stream_options(const core_options& o) {
+  am::pose_stream_options so;
+  so.solver = o.solver;
+  so.filters.filter_mode = am::pose_filter_mode::live;  // filter.enabled = false: none
+  so.filters.filter = o.filter;
+  so.filters.filter_channels = o.channels;
+  so.resampler = o.resampler;
+  so.name = "avm_solver";
+  return so;
 }
 
 // What avm_solve_file, avm_solve_file_to_clip and avm_solve_frames share: the options read
@@ -76,7 +63,7 @@ avm_status run_file_job(const avm_solver_options* options, Report& report, Setup
   am::solve_file_job job = file_job(o);
   setup(job);
   const am::status st = job.run(summary);
-  if (!st) return report(code_for(st, job_code(summary.failure)), st.message().c_str());
+  if (!st) return report(avm_code(st), st.message().c_str());
   return AVM_OK;
 }
 
@@ -116,8 +103,13 @@ AVATARMAP_C_API avm_status avm_solver_create(const avm_solver_options* options,
       set_create_error(msg.c_str());
       return AVM_ERROR_INVALID_ARGUMENT;
     }
-    auto* s = new avm_solver(o.solver, o.filter, o.resampler);
-    s->channels = o.channels;
+    const am::pose_stream_options so = stream_options(o);
+    if (const am::status st = so.validate(); !st.ok()) {
+      const std::string m = "avm_solver_options: " + st.message();
+      set_create_error(m.c_str());
+      return avm_code(st);  // invalid_argument
+    }
+    auto* s = new avm_solver(so);
     s->latest.set_rest();
     s->last_error.reserve(128);  // push's messages fit without allocating
     *out_solver = s;
@@ -136,9 +128,7 @@ AVATARMAP_C_API avm_status avm_solver_reset(avm_solver* solver) {
   if (solver == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
   solver->last_error.clear();
   return guard("avm_solver_reset", to_handle(solver), [&]() -> avm_status {
-    solver->solver.reset();
-    solver->filter.reset();
-    solver->resampler.reset();
+    solver->stream.reset();
     solver->latest.set_rest();
     solver->latest.t = 0.0;
     return AVM_OK;
@@ -153,11 +143,12 @@ AVATARMAP_C_API avm_status avm_solver_push(avm_solver* solver, const avm_frame* 
   if (const char* bad = check_frame(*frame)) return fail(solver, AVM_ERROR_INVALID_ARGUMENT, bad);
   return guard("avm_solver_push", to_handle(solver), [&]() -> avm_status {
     convert_frame(*frame, solver->frame);
-    solver->solver.solve(solver->frame, solver->raw);
-    am::filter_pose_channels(solver->filter, solver->channels, solver->raw, solver->latest);
+    // One pose per frame (the live filter, no grid): emit is called once.
+    solver->stream.push(solver->frame, [solver](const am::proxy_pose& p) {
+      solver->latest = p;
+      return am::status{};
+    });
     solver->latest.t = frame->t;
-    if (!solver->resampler.push(solver->latest))
-      return fail(solver, AVM_ERROR_INTERNAL, "avm_solver_push: the resampler refused the pose");
     return AVM_OK;
   });
 }
@@ -181,7 +172,7 @@ AVATARMAP_C_API avm_status avm_solver_sample(avm_solver* solver, double t, avm_p
   if (!std::isfinite(t))
     return fail(solver, AVM_ERROR_INVALID_ARGUMENT, "avm_solver_sample: t must be finite");
   return guard("avm_solver_sample", to_handle(solver), [&]() -> avm_status {
-    if (!solver->resampler.sample(t, solver->sampled)) {
+    if (!solver->stream.sample(t, solver->sampled)) {
       solver->sampled.set_rest();  // nothing pushed yet
       solver->sampled.t = t;
     }
@@ -285,7 +276,7 @@ AVATARMAP_C_API avm_status avm_solve_frames(const avm_frame_block* frames,
     };
     auto sink = [&](const am::proxy_pose& p) -> am::status {
       if (written >= count)  // the job gives one pose per frame; never more
-        return am::status::error("avm_solve_frames: more poses than frames");
+        return am::status::internal("avm_solve_frames: more poses than frames");
       to_c_pose(p, out_poses[written++]);
       return {};
     };

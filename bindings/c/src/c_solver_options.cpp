@@ -6,8 +6,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <string>
+#include <type_traits>
 
-#include "avatarmap/time/offline_smoother.hpp"
+#include "avatarmap/core/option_table.hpp"
 
 namespace am = avatarmap;
 
@@ -17,46 +19,123 @@ static_assert(sizeof(avm_solver_options) % 4 == 0 && alignof(avm_solver_options)
 
 namespace avatarmap::c_api {
 
+namespace {
+
+// The fields of avm_solver_options after struct_size, each by its name in the option tables
+// (the token is the name: the two cannot drift apart) and whether it is a float (else an
+// int32_t). The static_assert below checks that the list covers the whole struct.
+struct c_field {
+  const char* name;
+  std::size_t offset;
+  bool is_float;
+};
+#define AVM_FIELD(f)                                                                              \
+  c_field {                                                                                       \
+#f, offsetof(avm_solver_options, f), std::is_same_v < decltype(avm_solver_options::f), float> \
+  }
+constexpr c_field k_fields[] = {
+    AVM_FIELD(mirror),
+    AVM_FIELD(image_width),
+    AVM_FIELD(image_height),
+    AVM_FIELD(solve_body),
+    AVM_FIELD(solve_hands),
+    AVM_FIELD(solve_face),
+    AVM_FIELD(solve_hips_translation),
+    AVM_FIELD(confidence_lost_below),
+    AVM_FIELD(confidence_found_above),
+    AVM_FIELD(confidence_hold_seconds),
+    AVM_FIELD(confidence_ease_seconds),
+    AVM_FIELD(confidence_regain_seconds),
+    AVM_FIELD(hips_lean_share),
+    AVM_FIELD(forearm_twist_share),
+    AVM_FIELD(horizontal_fov_degrees),
+    AVM_FIELD(rest_hips_height),
+    AVM_FIELD(filter_rotations),
+    AVM_FIELD(rotation_min_cutoff),
+    AVM_FIELD(rotation_beta),
+    AVM_FIELD(rotation_d_cutoff),
+    AVM_FIELD(filter_position),
+    AVM_FIELD(position_min_cutoff),
+    AVM_FIELD(position_beta),
+    AVM_FIELD(position_d_cutoff),
+    AVM_FIELD(filter_expressions),
+    AVM_FIELD(expression_min_cutoff),
+    AVM_FIELD(expression_beta),
+    AVM_FIELD(expression_d_cutoff),
+    AVM_FIELD(max_extrapolation_seconds),
+    AVM_FIELD(file_filter),
+    AVM_FIELD(file_smoothing),
+    AVM_FIELD(file_threads),
+    AVM_FIELD(fit_hand_shape),
+};
+#undef AVM_FIELD
+static_assert(sizeof(k_fields) / sizeof(k_fields[0]) * 4 + 4 == sizeof(avm_solver_options),
+              "k_fields must list every field of avm_solver_options");
+
+double field_value(const avm_solver_options& o, const c_field& f) {
+  const char* p = reinterpret_cast<const char*>(&o) + f.offset;
+  if (f.is_float) {
+    float v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  }
+  std::int32_t v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+void set_field_value(avm_solver_options& o, const c_field& f, double value) {
+  char* p = reinterpret_cast<char*>(&o) + f.offset;
+  if (f.is_float) {
+    const float v = static_cast<float>(value);
+    std::memcpy(p, &v, sizeof v);
+  } else {
+    const std::int32_t v = static_cast<std::int32_t>(value);
+    std::memcpy(p, &v, sizeof v);
+  }
+}
+
+// The library's options the C struct is read into: each C field is a row of one of these
+// tables (the solver's, the solve-file job's, the resampler's).
+struct library_options {
+  am::solver_options solver;
+  am::solve_file_job file;
+  am::pose_resampler_options resampler;
+};
+
+// Calls `visit(row)` with the row named `name`, from whichever table has it; false if none.
+template <class Visit>
+bool with_row(const char* name, Visit&& visit) {
+  if (const auto* r = am::find_option(am::k_solver_option_table, name)) return visit(*r), true;
+  if (const auto* r = am::find_option(am::k_solve_file_option_table, name)) return visit(*r), true;
+  if (const auto* r = am::find_option(am::k_pose_resampler_option_table, name))
+    return visit(*r), true;
+  return false;
+}
+
+template <class O>
+O& part(library_options& l);
+template <>
+am::solver_options& part(library_options& l) {
+  return l.solver;
+}
+template <>
+am::solve_file_job& part(library_options& l) {
+  return l.file;
+}
+template <>
+am::pose_resampler_options& part(library_options& l) {
+  return l.resampler;
+}
+
+}  // namespace
+
 avm_solver_options default_options() {
   avm_solver_options o;
   std::memset(&o, 0, sizeof o);
   o.struct_size = sizeof o;
-  const am::solver_options s{};
-  o.mirror = s.mirror ? 1 : 0;
-  o.image_width = s.image_width;
-  o.image_height = s.image_height;
-  o.solve_body = s.parts.body ? 1 : 0;
-  o.solve_hands = s.parts.hands ? 1 : 0;
-  o.solve_face = s.parts.face ? 1 : 0;
-  o.solve_hips_translation = s.parts.hips_translation ? 1 : 0;
-  o.confidence_lost_below = s.confidence.lost_below;
-  o.confidence_found_above = s.confidence.found_above;
-  o.confidence_hold_seconds = s.confidence.hold_seconds;
-  o.confidence_ease_seconds = s.confidence.ease_seconds;
-  o.confidence_regain_seconds = s.confidence.regain_seconds;
-  o.hips_lean_share = s.hips_lean_share;
-  o.forearm_twist_share = s.forearm_twist_share;
-  o.horizontal_fov_degrees = s.horizontal_fov_degrees;
-  o.rest_hips_height = s.rest_hips_height;
-  const am::pose_filter_options f{};
-  o.filter_rotations = f.enabled ? 1 : 0;
-  o.rotation_min_cutoff = f.rotation.min_cutoff;
-  o.rotation_beta = f.rotation.beta;
-  o.rotation_d_cutoff = f.rotation.d_cutoff;
-  o.filter_position = f.enabled ? 1 : 0;
-  o.position_min_cutoff = f.position.min_cutoff;
-  o.position_beta = f.position.beta;
-  o.position_d_cutoff = f.position.d_cutoff;
-  o.filter_expressions = f.enabled ? 1 : 0;
-  o.expression_min_cutoff = f.expression.min_cutoff;
-  o.expression_beta = f.expression.beta;
-  o.expression_d_cutoff = f.expression.d_cutoff;
-  const am::pose_resampler_options r{};
-  o.max_extrapolation_seconds = static_cast<float>(r.max_extrapolation_seconds);
-  o.file_filter = AVM_FILE_FILTER_OFFLINE;
-  o.file_smoothing = am::offline_smoother_options{}.strength;
-  o.file_threads = 2;
-  o.fit_hand_shape = s.fit_hand_shape ? 1 : 0;
+  for (const c_field& f : k_fields)
+    with_row(f.name, [&](const auto& row) { set_field_value(o, f, am::option_default(row)); });
   return o;
 }
 
@@ -82,92 +161,53 @@ bool read_options(const avm_solver_options* in, core_options& out, std::string& 
     std::memcpy(&o, in, n);
     o.struct_size = sizeof o;
   }
-  auto& s = out.solver;
-  s.mirror = o.mirror != 0;
-  s.image_width = o.image_width;
-  s.image_height = o.image_height;
-  s.parts.body = o.solve_body != 0;
-  s.parts.hands = o.solve_hands != 0;
-  s.parts.face = o.solve_face != 0;
-  s.parts.hips_translation = o.solve_hips_translation != 0;
-  s.confidence.lost_below = o.confidence_lost_below;
-  s.confidence.found_above = o.confidence_found_above;
-  s.confidence.hold_seconds = o.confidence_hold_seconds;
-  s.confidence.ease_seconds = o.confidence_ease_seconds;
-  s.confidence.regain_seconds = o.confidence_regain_seconds;
-  s.hips_lean_share = o.hips_lean_share;
-  s.forearm_twist_share = o.forearm_twist_share;
-  s.horizontal_fov_degrees = o.horizontal_fov_degrees;
-  s.rest_hips_height = o.rest_hips_height;
-  s.fit_hand_shape = o.fit_hand_shape != 0;
-  am::status st = s.validate();
-  if (!st) {
+  // Each field through its row: the range check and its message come from the table. A C
+  // boolean is 0 or non-zero (the header's rule), so booleans are not range-checked.
+  library_options lib;
+  for (const c_field& f : k_fields) {
+    const double v = field_value(o, f);
+    bool ok = true;
+    with_row(f.name, [&](const auto& row) {
+      auto& target = part<typename std::decay_t<decltype(row)>::options_type>(lib);
+      if (row.kind == am::option_kind::boolean) {
+        row.set(target, v != 0.0 ? 1.0 : 0.0);
+      } else if (!am::option_accepts(row, v)) {
+        msg = am::option_range_message(row, std::string("avm_solver_options.") + f.name, v);
+        ok = false;
+      } else {
+        row.set(target, v);
+      }
+    });
+    if (!ok) return false;
+  }
+  // What a single field's range cannot say.
+  if (am::status st = lib.solver.validate(); !st) {
     msg = "avm_solver_options: " + st.message();
     return false;
   }
-
-  struct param_check {
-    const char* name;
-    float min_cutoff, beta, d_cutoff;
-  };
-  const param_check checks[] = {
-      {"rotation", o.rotation_min_cutoff, o.rotation_beta, o.rotation_d_cutoff},
-      {"position", o.position_min_cutoff, o.position_beta, o.position_d_cutoff},
-      {"expression", o.expression_min_cutoff, o.expression_beta, o.expression_d_cutoff}};
-  for (const param_check& c : checks) {
-    if (!(std::isfinite(c.min_cutoff) && c.min_cutoff > 0.f)) {
-      msg = std::string("avm_solver_options.") + c.name + "_min_cutoff must be finite and > 0";
-      return false;
-    }
-    if (!(std::isfinite(c.beta) && c.beta >= 0.f)) {
-      msg = std::string("avm_solver_options.") + c.name + "_beta must be finite and >= 0";
-      return false;
-    }
-    if (!(std::isfinite(c.d_cutoff) && c.d_cutoff > 0.f)) {
-      msg = std::string("avm_solver_options.") + c.name + "_d_cutoff must be finite and > 0";
-      return false;
-    }
-  }
-  if (!(std::isfinite(o.max_extrapolation_seconds) && o.max_extrapolation_seconds >= 0.f)) {
-    msg = "avm_solver_options.max_extrapolation_seconds must be finite and >= 0";
-    return false;
-  }
-  out.filter.rotation = {o.rotation_min_cutoff, o.rotation_beta, o.rotation_d_cutoff};
-  out.filter.position = {o.position_min_cutoff, o.position_beta, o.position_d_cutoff};
-  out.filter.expression = {o.expression_min_cutoff, o.expression_beta, o.expression_d_cutoff};
-  out.channels.rotations = o.filter_rotations != 0;
-  out.channels.position = o.filter_position != 0;
-  out.channels.expressions = o.filter_expressions != 0;
+  out.solver = lib.solver;
+  out.filter = lib.file.filter;
+  out.channels = lib.file.filter_channels;
   out.filter.enabled = out.channels.rotations || out.channels.position || out.channels.expressions;
-  out.resampler.max_extrapolation_seconds = o.max_extrapolation_seconds;
-  switch (o.file_filter) {
-    case AVM_FILE_FILTER_OFFLINE:
-      out.file_filter = am::pose_filter_mode::offline;
-      break;
-    case AVM_FILE_FILTER_LIVE:
-      out.file_filter = am::pose_filter_mode::live;
-      break;
-    case AVM_FILE_FILTER_NONE:
-      out.file_filter = am::pose_filter_mode::none;
-      break;
-    default:
-      msg =
-          "avm_solver_options.file_filter is " + std::to_string(o.file_filter) +
-          ": use AVM_FILE_FILTER_OFFLINE (0), AVM_FILE_FILTER_LIVE (1) or AVM_FILE_FILTER_NONE (2)";
-      return false;
-  }
-  if (!(std::isfinite(o.file_smoothing) && o.file_smoothing >= 0.f && o.file_smoothing <= 10.f)) {
-    msg = "avm_solver_options.file_smoothing must be finite and in [0, 10] (1 = default)";
-    return false;
-  }
-  out.file_smoothing = o.file_smoothing;
-  if (o.file_threads != 1 && o.file_threads != 2) {
-    msg = "avm_solver_options.file_threads is " + std::to_string(o.file_threads) +
-          ": use 1 (the calling thread only) or 2 (parse ahead on a second thread; default)";
-    return false;
-  }
-  out.file_threads = o.file_threads;
+  out.resampler = lib.resampler;
+  out.file_filter = lib.file.filter_mode;
+  out.file_smoothing = lib.file.offline.strength;
+  out.file_threads = lib.file.threads;
   return true;
+}
+
+solve_file_job file_job(const core_options& o) {
+  solve_file_job job;
+  job.options = o.solver;
+  // Non-zero options.image_width/height win over the file's header (0 = the header's).
+  job.image_width = o.solver.image_width;
+  job.image_height = o.solver.image_height;
+  job.filter_mode = o.file_filter;
+  job.offline.strength = o.file_smoothing;
+  job.filter = o.filter;
+  job.filter_channels = o.channels;
+  job.threads = o.file_threads;
+  return job;
 }
 
 }  // namespace avatarmap::c_api

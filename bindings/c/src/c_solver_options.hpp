@@ -31,4 +31,10 @@ avm_solver_options default_options();
 /// field and its range into `msg` and returns false.
 bool read_options(const avm_solver_options* in, core_options& out, std::string& msg);
 
+/// The library's solve-file job with these options, as avm_solve_file, avm_solve_frames,
+/// avm_solve_file_to_clip and avm_convert_file run it: with file_threads 2 (the default) a file
+/// is parsed ahead on a second thread of the job's own, as `avatarmap solve` does (frames from
+/// memory are pulled on the calling thread whatever `threads` says). Input and output unset.
+avatarmap::solve_file_job file_job(const core_options& o);
+
 }  // namespace avatarmap::c_api

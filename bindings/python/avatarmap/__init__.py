@@ -23,20 +23,21 @@ from __future__ import annotations
 from typing import Tuple
 
 from . import _lib
-from ._data import (Landmarks, Poses, SOLVER_OPTION_NAMES, convert_file, read_landmarks,
-                    read_poses, solve, solve_file, write_animation)
-from ._errors import (AvatarmapError, FileIOError, InvalidArgumentError, ParseError,
-                      UnsupportedError)
+from ._data import (Landmarks, Poses, SOLVER_OPTION_NAMES, convert_file, motion_input_kind,
+                    read_landmarks, read_poses, solve, solve_file, write_animation)
+from ._errors import (AvatarmapError, FileIOError, InternalError, InvalidArgumentError,
+                      OutOfMemoryError, ParseError, UnsupportedError)
 from ._handles import (CaptureSummary, Estimator, Live, LiveStats, Retargeter, Solver,
                        capture_file)
 from ._lib import POSE_DTYPE
 
 __all__ = [
     "AvatarmapError", "InvalidArgumentError", "FileIOError", "ParseError", "UnsupportedError",
+    "OutOfMemoryError", "InternalError",
     "BONE_NAMES", "BONE_PARENTS", "EXPRESSION_NAMES", "POSE_DTYPE", "SOLVER_OPTION_NAMES",
     "bone_index", "version",
     "Landmarks", "Poses", "read_landmarks", "read_poses", "solve", "solve_file",
-    "write_animation", "convert_file",
+    "write_animation", "convert_file", "motion_input_kind",
     "Solver", "Retargeter", "Estimator", "Live", "LiveStats", "CaptureSummary", "capture_file",
 ]
 

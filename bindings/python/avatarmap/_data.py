@@ -6,6 +6,7 @@ import ctypes
 import os
 import stat
 import threading
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple, Union
 
@@ -526,9 +527,11 @@ def read_landmarks(path: PathLike) -> Landmarks:
 
 
 def read_poses(path: PathLike) -> Poses:
-    """Reads a whole ``*.pose.jsonl`` file (frames as written) into arrays.
+    """Reads a whole ``*.pose.jsonl`` file (or a ``.vrma``) into arrays, with the library's
+    reader of motion files (avm_clip_read, the one convert_file() uses): the frames in time
+    order (sorted stably when the file has them out of order, as convert_file() sorts them).
 
-    Raises FileIOError, ParseError."""
+    Raises FileIOError, ParseError, InvalidArgumentError (a landmark file: solve_file() it)."""
     clip = _Clip.__new__(_Clip)
     _Handle.__init__(clip)
     err = ctypes.create_string_buffer(_ERR_SIZE)
@@ -633,29 +636,57 @@ class _Target:
                                     err, _ERR_SIZE), err.value)
 
 
+def motion_input_kind(path: PathLike) -> Optional[str]:
+    """The kind of motion file convert_file() reads at ``path``, by the library's one rule
+    (avm_motion_input_kind; the CLI's ``convert`` uses it too): "landmarks", "poses" or
+    "vrma", or None when it reads none. The name's extension decides first (any case:
+    ``.landmarks.jsonl``, ``.pose.jsonl``, ``.vrma``); else "-" is landmarks; else the first
+    bytes of a regular file (a GLB is a .vrma; a JSON header names its format); else a
+    ``*.jsonl`` is landmarks."""
+    return _motion_input(path)[0]
+
+
+def _motion_input(path: PathLike) -> Tuple[Optional[str], str]:
+    """(kind or None, the path without the extension that decided) by avm_motion_input_kind."""
+    src = _path(path, "motion_input_kind")
+    stem = ctypes.c_size_t(0)
+    kind = _lib.MOTION_INPUTS.get(int(fn("avm_motion_input_kind")(src, ctypes.byref(stem))))
+    return kind, os.fsdecode(src[:stem.value])
+
+
 def convert_file(in_path: PathLike, out_path: PathLike, *, fps: float = 0.0,
                  avatar: Optional[PathLike] = None, mapping: Optional[str] = None,
                  **options: Any) -> int:
-    """``avatarmap convert IN -o OUT`` inside the library (no NumPy round trip); returns the
-    number of frames converted (before any resampling to ``fps``). IN is a
-    ``*.pose.jsonl`` (read as written: avm_clip_read) or a ``*.landmarks.jsonl``, solved first
-    as solve_file(IN) solves it, with ``options`` as solve()'s (avm_solve_file_to_clip; the
-    bytes of ``avatarmap convert`` of the landmarks). Written atomically."""
+    """``avatarmap convert IN -o OUT`` inside the library: the same library job
+    (avm_convert_file), so the same input and arguments give the CLI's bytes; returns the
+    number of frames read (before any resampling to ``fps``).
+
+    IN is any motion file the library reads (motion_input_kind()): a ``*.landmarks.jsonl``,
+    solved first as solve_file(IN) solves it, with ``options`` as solve()'s (solver options
+    for another input raise InvalidArgumentError); a ``*.pose.jsonl``; a ``.vrma``. Frames out
+    of time order are sorted, for every input and output, with a warning (``warnings.warn``)
+    that counts them, as the CLI warns. OUT's extension chooses the format as
+    write_animation()'s does; ``fps`` 0 keeps the frames' own times (the CLI's default is 30,
+    but for ``.pose.jsonl``), ``avatar`` and ``mapping`` as write_animation(). Written
+    atomically."""
     src = _path(in_path, "convert_file")
-    target = _Target(out_path, fps, avatar, mapping)
-    landmarks = os.fsdecode(src).lower().endswith(".landmarks.jsonl")  # by name: never opened
-    if not landmarks and options:
-        raise InvalidArgumentError("convert_file: solver options (%s) apply to a "
-                                   "*.landmarks.jsonl input only" % ", ".join(sorted(options)), 1)
-    o = solver_options(options) if landmarks else None
-    clip = _Clip.__new__(_Clip)
-    _Handle.__init__(clip)
+    dst = _path(out_path, "convert_file")
+    buf = ctypes.create_string_buffer(4096)  # room for a newer library's longer struct
+    o = _lib.AvmConvertOptions.from_buffer(buf)
+    _check(fn("avm_convert_options_init_sized")(o, ctypes.sizeof(o)),
+           "avm_convert_options_init_sized failed")
+    o.fps = c_value(ctypes.c_double, fps, "fps")
+    o.avatar = _text_arg(avatar, "avatar")
+    o.mapping = _text_arg(mapping, "mapping")
+    solver = solver_options(options) if options else None
+    if solver is not None:
+        o.solver = ctypes.pointer(solver)
+    warnings_seen: List[str] = []
+    o.warning = _lib.WARNING_FN(lambda _user, message: warnings_seen.append(text(message)))
+    summary = _lib.AvmConvertSummary(struct_size=ctypes.sizeof(_lib.AvmConvertSummary))
     err = ctypes.create_string_buffer(_ERR_SIZE)
-    if landmarks:
-        _check(fn("avm_solve_file_to_clip")(src, o, ctypes.byref(clip._h), err, _ERR_SIZE),
-               err.value)
-    else:
-        _check(fn("avm_clip_read")(src, ctypes.byref(clip._h), err, _ERR_SIZE), err.value)
-    with clip:
-        target.write(clip)
-        return int(fn("avm_clip_frame_count")(clip._h))
+    status = fn("avm_convert_file")(src, dst, o, ctypes.byref(summary), err, _ERR_SIZE)
+    for message in warnings_seen:
+        warnings.warn("convert_file: " + message, stacklevel=2)
+    _check(status, err.value)
+    return int(summary.frames_read)

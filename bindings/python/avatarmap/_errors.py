@@ -1,4 +1,5 @@
-"""Exceptions: one per avm_status, carrying the C API's message."""
+"""Exceptions: one per failing avm_status (the C API maps the library's error kinds to those one
+to one), carrying the C API's message."""
 
 from __future__ import annotations
 
@@ -46,8 +47,21 @@ class UnsupportedError(AvatarmapError):
     status = 5
 
 
+class OutOfMemoryError(AvatarmapError, MemoryError):
+    """AVM_ERROR_OUT_OF_MEMORY: memory ran out (an input too large for the process; also a
+    MemoryError)."""
+    status = 6
+
+
+class InternalError(AvatarmapError):
+    """AVM_ERROR_INTERNAL: a stage failed on valid input (a bug in avatarmap or a library
+    beneath it): please report it with the message."""
+    status = 7
+
+
 _BY_STATUS: Dict[int, Type[AvatarmapError]] = {
-    1: InvalidArgumentError, 2: FileIOError, 3: ParseError, 5: UnsupportedError}
+    1: InvalidArgumentError, 2: FileIOError, 3: ParseError, 5: UnsupportedError,
+    6: OutOfMemoryError, 7: InternalError}
 
 
 def error_for(status: int, message: str) -> AvatarmapError:

@@ -23,6 +23,11 @@ HAND_POINTS = 21
 FACE_POINTS = 478  # with iris refinement; a 468-point face has rows 468..477 NaN
 FACE_POINTS_NO_IRIS = 468
 
+# Limits (AVM_MAX_FPS, AVM_MAX_MODEL_THREADS; include/avatarmap/core/limits.hpp): checked
+# against the library's tables by tests/python/test_options.py.
+MAX_FPS = 1000.0
+MAX_MODEL_THREADS = 64
+
 # avm_status
 OK = 0
 ERROR_INVALID_ARGUMENT = 1
@@ -78,7 +83,10 @@ POSE_DTYPE = np.dtype([("t", "<f8"), ("hips_position", "<f4", (3,)),
 
 class AvmSolverOptions(ctypes.Structure):
     # Field order as in the header; new fields are only ever appended there. _kinds_ and
-    # _ranges_ say how set_field() checks a value (see c_value()).
+    # _ranges_ say how set_field() checks a value (see c_value()): _kinds_ marks the option
+    # tables' boolean rows, _ranges_ the ranges of their integer and choice rows (the library
+    # checks the numbers' ranges itself). tests/python/test_options.py checks all three
+    # against `avatarmap options --json` and the C defaults.
     _fields_ = [
         ("struct_size", _U32),
         ("mirror", _I32), ("image_width", _F32), ("image_height", _F32),
@@ -102,7 +110,8 @@ class AvmSolverOptions(ctypes.Structure):
     _kinds_ = {name: BOOL for name in (
         "mirror", "solve_body", "solve_hands", "solve_face", "solve_hips_translation",
         "filter_rotations", "filter_position", "filter_expressions", "fit_hand_shape")}
-    _ranges_ = {"file_filter": (0, 2)}  # avm_file_filter
+    _ranges_ = {"file_filter": (0, 2),  # avm_file_filter
+                "file_threads": (1, 2)}
 
 
 class AvmFrameBlock(ctypes.Structure):
@@ -122,13 +131,35 @@ class AvmEstimatorOptions(ctypes.Structure):
                 ("hand_model_complexity", _I32), ("threads", _I32), ("mirrored", _I32),
                 ("static_images", _I32)]
     _kinds_ = {name: BOOL for name in ("hands", "face", "mirrored", "static_images")}
-    _ranges_ = {"model_complexity": (0, 2), "hand_model_complexity": (0, 1)}
+    _ranges_ = {"model_complexity": (0, 2), "hand_model_complexity": (0, 1),
+                "threads": (1, MAX_MODEL_THREADS)}
 
 
 class AvmLiveStats(ctypes.Structure):
     _fields_ = [("pushed", _I64), ("processed", _I64), ("dropped", _I64), ("failed", _I64),
                 ("latency_p50_ms", _F64), ("latency_p95_ms", _F64), ("latency_max_ms", _F64),
                 ("newest_t", _F64)]
+
+
+WARNING_FN = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p)
+
+
+class AvmConvertOptions(ctypes.Structure):
+    _fields_ = [("struct_size", _U32), ("fps", _F64), ("avatar", ctypes.c_char_p),
+                ("mapping", ctypes.c_char_p), ("keep_feet_on_ground", _I32),
+                ("root_motion", _I32), ("solver", ctypes.POINTER(AvmSolverOptions)),
+                ("warning", WARNING_FN), ("user", _P)]
+    _kinds_ = {name: BOOL for name in ("keep_feet_on_ground", "root_motion")}
+
+
+class AvmConvertSummary(ctypes.Structure):
+    _fields_ = [("struct_size", _U32), ("input_kind", _I32), ("frames_read", _I64),
+                ("frames_out_of_order", _I64), ("frames_written", _I64), ("fps", _F64),
+                ("seconds", _F64)]
+
+
+# avm_motion_input
+MOTION_INPUTS = {1: "landmarks", 2: "poses", 3: "vrma"}
 
 
 class AvmCaptureSummary(ctypes.Structure):
@@ -279,6 +310,7 @@ _SIGNATURES: Dict[str, Tuple[object, List[object]]] = {
     "avm_solve_file": (_S, [_STR, _STR, ctypes.POINTER(AvmSolverOptions), _P, _SIZE]),
     "avm_solve_file_to_clip": (_S, [_STR, ctypes.POINTER(AvmSolverOptions), _PP, _P, _SIZE]),
     "avm_set_mappings_folder": (_S, [_STR]),
+    "avm_find_resource": (_S, [ctypes.c_int, _STR, _P, _SIZE, _P, _SIZE, _P, _SIZE]),
     "avm_retargeter_create": (_S, [_STR, _STR, _PP]),
     "avm_retargeter_destroy": (None, [_P]),
     "avm_retargeter_joint_count": (ctypes.c_int, [_P]),
@@ -325,18 +357,24 @@ _SIGNATURES: Dict[str, Tuple[object, List[object]]] = {
     "avm_retargeter_apply_poses": (_S, [_P, _P, _I64, _P, _P]),
     "avm_capture_file": (_S, [_STR, _STR, ctypes.POINTER(AvmEstimatorOptions),
                               ctypes.POINTER(AvmCaptureSummary), PROGRESS_FN, _P, _P, _SIZE]),
+    # issue 21
+    "avm_motion_input_kind": (ctypes.c_int, [_STR, ctypes.POINTER(_SIZE)]),
+    "avm_convert_options_init_sized": (_S, [ctypes.POINTER(AvmConvertOptions), _SIZE]),
+    "avm_convert_file": (_S, [_STR, _STR, ctypes.POINTER(AvmConvertOptions),
+                              ctypes.POINTER(AvmConvertSummary), _P, _SIZE]),
 }
 
 _LIBRARY_NAME = "libavatarmap_c.so"
 
 
 def _config() -> Dict[str, Optional[str]]:
-    """Paths recorded when the package was installed (the generated _config.py), or {}."""
+    """The library's path recorded when the package was installed (the generated _config.py),
+    or {}. The mapping tables and the models are found by the library (find_resource())."""
     try:
         from . import _config as cfg  # type: ignore[attr-defined]
     except ImportError:
         return {}
-    return {k: getattr(cfg, k, None) for k in ("LIBRARY", "MODELS_DIR", "MAPPINGS_DIR")}
+    return {k: getattr(cfg, k, None) for k in ("LIBRARY",)}
 
 
 def _source_root() -> Optional[str]:
@@ -424,36 +462,30 @@ def status_name(status: int) -> str:
     return text(fn("avm_status_string")(status))
 
 
+# avm_resource
+RESOURCE_MAPPINGS = 0
+RESOURCE_MODELS = 1
+RESOURCE_VIEWER_PAGE = 2
+RESOURCE_VIEWER_MODULES = 3
+
+
+def find_resource(kind: int, folder: Optional[str] = None) -> Tuple[Optional[str], str]:
+    """(folder, rule) as the library finds the shipped folder `kind` (avm_find_resource: the
+    explicit `folder`, else the environment, else the installed location beside the library,
+    else its source tree; docs/architecture.md "Resources"), or (None, the message listing
+    every place looked at) when none was found."""
+    out_folder = ctypes.create_string_buffer(4096)
+    out_rule = ctypes.create_string_buffer(64)
+    err = ctypes.create_string_buffer(4096)
+    explicit = os.fsencode(folder) if folder else None
+    status = fn("avm_find_resource")(kind, explicit, out_folder, len(out_folder), out_rule,
+                                     len(out_rule), err, len(err))
+    if status != OK:
+        return None, text(err.value)
+    return os.fsdecode(out_folder.value), text(out_rule.value)
+
+
 def models_dir_default() -> Optional[str]:
-    """The models folder to use when none is given: $AVATARMAP_MODELS/onnx, else the one
-    recorded at build/install time, else the source tree's cache."""
-    env = os.environ.get("AVATARMAP_MODELS")
-    if env:
-        return os.path.join(env, "onnx")
-    recorded = _config().get("MODELS_DIR")
-    if recorded:
-        return recorded
-    root = _source_root()
-    if root:
-        return os.path.join(root, ".cache", "avatarmap", "models", "onnx")
-    return None
-
-
-def mappings_dir_default() -> Optional[str]:
-    recorded = _config().get("MAPPINGS_DIR")
-    if recorded and os.path.isdir(recorded):
-        return recorded
-    root = _source_root()
-    if root and os.path.isdir(os.path.join(root, "mappings")):
-        return os.path.join(root, "mappings")
-    return None
-
-
-def _set_mappings_folder() -> None:
-    # $AVATARMAP_MAPPINGS, when set, wins inside the library; this is the fallback.
-    folder = mappings_dir_default()
-    if folder:
-        fn("avm_set_mappings_folder")(os.fsencode(folder))
-
-
-_set_mappings_folder()
+    """The models folder to use when none is given (find_resource(RESOURCE_MODELS)), or None
+    (the C library then says where it looked)."""
+    return find_resource(RESOURCE_MODELS)[0]

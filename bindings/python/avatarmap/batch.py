@@ -5,7 +5,8 @@
 
 Each input file is one task: a video or image is captured (landmarks), landmarks are solved
 (proxy poses, offline smoothing) and the poses are written in the asked format; a
-``*.landmarks.jsonl`` starts at the solve and a ``*.pose.jsonl`` at the last step. Without
+``*.landmarks.jsonl`` starts at the solve and a ``*.pose.jsonl`` or ``.vrma`` at the last step
+(each by the library's rule and job, as ``avatarmap convert`` reads and writes it). Without
 ``--scheduler`` a ``LocalCluster`` runs one worker process per core, one task (and, for
 capture, one inference thread) at a time each; with ``--scheduler`` the same tasks go to the
 workers of an existing cluster, which must see the inputs and OUTDIR at the same paths and
@@ -46,12 +47,13 @@ import time
 import uuid
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
+from . import _lib
+from ._data import _motion_input
+
 VIDEO_SUFFIXES = (".mp4", ".mkv", ".avi", ".mov", ".webm", ".m4v", ".mpg", ".mpeg", ".ts",
                   ".flv", ".wmv", ".y4m")
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
-LANDMARKS_SUFFIX = ".landmarks.jsonl"
-POSE_SUFFIX = ".pose.jsonl"
-OUTPUT_SUFFIXES = {"vrma": ".vrma", "glb": ".glb", "bvh": ".bvh", "pose": POSE_SUFFIX}
+OUTPUT_SUFFIXES = {"vrma": ".vrma", "glb": ".glb", "bvh": ".bvh", "pose": ".pose.jsonl"}
 WORK_FOLDER = ".avatarmap-batch"
 LOOPBACK = "127.0.0.1"
 PROG = "avatarmap.batch"
@@ -198,7 +200,7 @@ def _warn_exposure(args: argparse.Namespace) -> None:
 class Task:
     """One input file and what it becomes."""
     input: str   # absolute path
-    kind: str    # "media" (video or image), "landmarks" or "poses"
+    kind: str    # "media" (video or image), or input_kind's "landmarks", "poses" or "vrma"
     output: str  # absolute path of the finished output
 
 
@@ -215,17 +217,18 @@ class Result:
 
 
 def input_kind(path: str) -> Optional[Tuple[str, str]]:
-    """(kind, stem) of an input path by its name, or None when it is no input we read."""
+    """(kind, stem) of an input, or None when it is no input we read: "media" (a video or an
+    image, by its suffix: captured first), else the motion file the library reads it as
+    (avatarmap.motion_input_kind, the rule of ``avatarmap convert``: "landmarks", "poses" or
+    "vrma"). The stem is the file's name without the suffix that decided."""
     name = os.path.basename(path)
-    low = name.lower()
-    if low.endswith(LANDMARKS_SUFFIX):
-        return "landmarks", name[:-len(LANDMARKS_SUFFIX)]
-    if low.endswith(POSE_SUFFIX):
-        return "poses", name[:-len(POSE_SUFFIX)]
     stem, ext = os.path.splitext(name)
     if ext.lower() in VIDEO_SUFFIXES or ext.lower() in IMAGE_SUFFIXES:
         return "media", stem
-    return None
+    kind, without = _motion_input(path)
+    if kind is None:
+        return None
+    return kind, os.path.basename(without)
 
 
 _URL = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
@@ -278,8 +281,8 @@ def plan(inputs: Sequence[str], outdir: str, to: str,
                     names.append(n)
             if not names:
                 bad.append(Result(given, status="failed",
-                                  reason="a folder with no video, image, *.landmarks.jsonl or "
-                                         "*.pose.jsonl in it"))
+                                  reason="a folder with no video, image, *.landmarks.jsonl, "
+                                         "*.pose.jsonl or *.vrma in it"))
             paths = [os.path.join(given, n) for n in names]
         else:
             paths = [given]
@@ -292,8 +295,8 @@ def plan(inputs: Sequence[str], outdir: str, to: str,
                 continue
             if kind is None:
                 bad.append(Result(path, status="failed",
-                                  reason="not a video, image, *.landmarks.jsonl or *.pose.jsonl "
-                                         "(by its name)"))
+                                  reason="not a video, image, *.landmarks.jsonl, *.pose.jsonl or "
+                                         "*.vrma"))
                 continue
             out = os.path.join(outdir, kind[1] + suffix)
             if os.path.abspath(out) == path:  # a *.pose.jsonl in OUTDIR itself, --to pose
@@ -309,16 +312,6 @@ def plan(inputs: Sequence[str], outdir: str, to: str,
             by_output[out] = task
             tasks.append(task)
     return tasks, bad
-
-
-def _count_poses(path: str) -> int:
-    """Frames in a *.pose.jsonl (its lines after the header)."""
-    n = 0
-    with open(path, "rb") as f:
-        for line in f:
-            if line.startswith(b'{"t"'):
-                n += 1
-    return n
 
 
 def convert_one(task: Task, options: dict) -> Result:
@@ -338,7 +331,7 @@ def convert_one(task: Task, options: dict) -> Result:
         os.makedirs(work)
         src, kind, frames = task.input, task.kind, 0
         if kind == "media":
-            landmarks = os.path.join(work, "capture" + LANDMARKS_SUFFIX)
+            landmarks = os.path.join(work, "capture.landmarks.jsonl")
             summary = avatarmap.capture_file(src, landmarks, models=options.get("models"),
                                              hands=options.get("hands", True),
                                              face=options.get("face", True),
@@ -346,20 +339,14 @@ def convert_one(task: Task, options: dict) -> Result:
             frames = int(summary.frames)
             src, kind = landmarks, "landmarks"
         finished = os.path.join(work, "out" + OUTPUT_SUFFIXES[options["to"]])
-        # One thread a task (file_threads=1): the workers are one per core; the CLI parses a
-        # file ahead on a second thread.
-        if kind == "landmarks" and options["to"] == "pose":
-            avatarmap.solve_file(src, finished, file_threads=1)
-            frames = frames or _count_poses(finished)
-        elif kind == "landmarks":  # solved in memory, as `avatarmap convert IN.landmarks.jsonl`
-            n = avatarmap.convert_file(src, finished, fps=options.get("fps", 0.0),
-                                       avatar=options.get("avatar"),
-                                       mapping=options.get("mapping"), file_threads=1)
-            frames = frames or n
-        else:
-            frames = avatarmap.convert_file(src, finished, fps=options.get("fps", 0.0),
-                                            avatar=options.get("avatar"),
-                                            mapping=options.get("mapping"))
+        # The library's convert (`avatarmap convert`): landmarks solved in memory, the frames
+        # in time order, the format by the output's name. One thread a task (file_threads=1):
+        # the workers are one per core; the CLI parses a file ahead on a second thread.
+        solve = {"file_threads": 1} if kind == "landmarks" else {}
+        n = avatarmap.convert_file(src, finished, fps=options.get("fps", 0.0),
+                                   avatar=options.get("avatar"), mapping=options.get("mapping"),
+                                   **solve)
+        frames = frames or n
         os.replace(finished, task.output)
         result.frames = frames
     except (avatarmap.AvatarmapError, OSError, ValueError) as e:
@@ -480,8 +467,8 @@ def _parse(argv: Optional[Sequence[str]]) -> argparse.Namespace:
         ap.error("--threads is 1 .. 64")
     if a.fps is None:
         a.fps = 0.0 if a.to == "pose" else 30.0
-    if not (a.fps >= 0 and a.fps <= 1000):
-        ap.error("--fps is 0 .. 1000 (0: the frames' own times)")
+    if not (a.fps >= 0 and a.fps <= _lib.MAX_FPS):
+        ap.error("--fps is 0 .. %g (0: the frames' own times)" % _lib.MAX_FPS)
     if a.avatar and not os.path.isfile(a.avatar):
         ap.error("--avatar %s: no such file" % a.avatar)
     if a.scheduler and (a.dashboard is not None or a.host != LOOPBACK):

@@ -15,7 +15,6 @@
 
 #include "avatarmap/capture/estimator.hpp"
 #include "avatarmap/core/status.hpp"
-#include "avatarmap/jobs/job_failure.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/media/video_source.hpp"
 
@@ -49,7 +48,6 @@ struct capture_file_summary {
   std::string estimator_description;  // estimator::describe() ("models: ...", lanes)
   /// Why a device or stream stopped (video_source::end_reason()); "" for files.
   std::string end_reason;
-  job_failure failure = job_failure::none;  // why the run failed (none on success)
 };
 
 /// The job. Fill the inputs, call run(). Thread-safety: a job may be run from any thread; the
@@ -64,7 +62,8 @@ struct capture_file_job {
   /// The estimator's options (source = the models folder; hands, face, threads, lanes, ...).
   estimator_options options{};
   /// Creates the estimator; empty = create_estimator("onnx", ...). The CLI's adds a hint on
-  /// how to get the models. A failure ends the run (failure input_io: the models are input).
+  /// how to get the models. A failure ends the run with its code (io: the models cannot be
+  /// read; unsupported: the backend is not built).
   std::function<status(const estimator_options&, std::unique_ptr<estimator>&)> make_estimator;
   video_source_options video{};
   /// Devices and streams are read until they end or stall; refused (invalid_argument) when
@@ -77,13 +76,13 @@ struct capture_file_job {
   double seconds = 0.0;
 
   /// Optional: called after the input and the estimator are open, before the output is
-  /// opened (the CLI opens its overlay here); an error ends the run (failure output_io).
+  /// opened (the CLI opens its overlay here); an error ends the run, its code kept.
   std::function<status(const video_info&)> on_open;
   /// Optional: each frame written, with its decoded image (RGB8; the CLI's overlay draws on
-  /// it); an error ends the run (failure output_io).
+  /// it); an error ends the run, its code kept.
   std::function<status(const image_view&, const landmark_frame&)> on_frame;
   /// Optional: after the output is committed (the CLI closes its overlay here); an error ends
-  /// the run (failure output_io; the landmarks are written).
+  /// the run, its code kept (the landmarks are written).
   std::function<status()> on_finish;
   /// Optional: about twice a second.
   std::function<void(const capture_file_progress&)> progress;
@@ -96,9 +95,11 @@ struct capture_file_job {
   /// the field.
   status validate() const;
   /// validate(), then the whole run into `out` (replaced). Fails with a message naming the
-  /// input, output or the frame's time, and out.failure set: invalid_argument, input_io (the
-  /// input cannot be opened or read, the estimator cannot be made), output_io, internal (the
-  /// estimator failed on a frame). Never throws but for std::bad_alloc.
+  /// input, output or the frame's time, and the code of the step that failed:
+  /// invalid_argument (the fields, a live input not allowed), io (the input, the models or
+  /// the output cannot be opened, read or written), unsupported (no FFmpeg for a video, no
+  /// ONNX backend), internal (the estimator failed on a frame), out_of_memory; a hook's error
+  /// keeps its own code. Never throws but for std::bad_alloc.
   status run(capture_file_summary& out) const;
 };
 

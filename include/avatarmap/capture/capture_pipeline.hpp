@@ -1,13 +1,15 @@
-// One image in, its landmarks and the proxy pose out: the estimator (capture/estimator.hpp),
-// the solver (solve/frame_solver.hpp) and the live filter (time/pose_filter.hpp) behind one
-// call. It is the per-frame step of every live workflow (the C API's estimator and live
-// handles; live_session.hpp). Frames must come in capture order (the solver and the filter
-// keep state between them).
+// One image in, its landmarks and the proxy pose out: the estimator (capture/estimator.hpp)
+// and the pose stream (solve/pose_stream.hpp: the solver, the live filter and the resampler)
+// behind one call. It is the per-frame step of every live workflow (the C API's estimator
+// handle; live_session.hpp, the one live loop). Frames must come in capture order (the solver
+// and the filter keep state between them).
 //
 // Memory: everything is made at create(); process() allocates nothing beyond what the
 // estimator's backend does (ONNX Runtime). The solver takes the image size from the first
 // image (unless given in the options) and is remade, with fresh state, when it changes.
-// Thread-safety: one pipeline per thread at a time.
+// Thread-safety: one pipeline per thread at a time, except that stream().sample() touches
+// only the resampler, which estimate() never does: a caller may run estimate() on one thread
+// while another samples, if solve() and sample() are under one lock (live_session does so).
 #pragma once
 
 #include <memory>
@@ -17,9 +19,10 @@
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
-#include "avatarmap/solve/frame_solver.hpp"
+#include "avatarmap/solve/pose_stream.hpp"
 #include "avatarmap/solve/solver_options.hpp"
 #include "avatarmap/time/pose_filter.hpp"
+#include "avatarmap/time/pose_resampler.hpp"
 
 namespace avatarmap {
 
@@ -40,8 +43,11 @@ struct capture_pipeline_options {
   solver_options solver;
   /// The live filter (One Euro + short extrapolation; enabled = false: the solver's poses).
   pose_filter_options filter;
+  /// How far stream().sample() extrapolates past the newest pose (the live session's sample()).
+  pose_resampler_options resampler;
 
-  /// Checks the solver's options and the backend name; the message names the field.
+  /// Checks the solver's options, the filter's parameters, max_extrapolation_seconds finite
+  /// and >= 0, and the backend name; the message names the field.
   status validate() const;
 };
 
@@ -55,14 +61,24 @@ class capture_pipeline {
   capture_pipeline(const capture_pipeline&) = delete;
   capture_pipeline& operator=(const capture_pipeline&) = delete;
 
-  /// Estimates the landmarks of `image` (capture time `t`, seconds) into `frame` and solves and
-  /// filters them into `pose` (pose.t = t). A frame with no person is not an error (the solver
-  /// holds and eases what it lost). Errors: a bad image (check_image), the estimator's.
+  /// estimate(), then solve(): the landmarks of `image` (capture time `t`, seconds) into
+  /// `frame`, their solved and filtered pose into `pose` (pose.t = t). A frame with no person
+  /// is not an error (the solver holds and eases what it lost). Errors: estimate()'s.
   status process(const image_view& image, double t, landmark_frame& frame, proxy_pose& pose);
+  /// The estimator's step: checks `image` (check_image; the replay backend needs no pixels)
+  /// and `t` (finite), remakes the solver when the image size changed (unless the options give
+  /// one), estimates the landmarks into `frame` (frame.t = t). Touches neither the resampler
+  /// nor a pose. Errors: a bad image or time, the estimator's.
+  status estimate(const image_view& image, double t, landmark_frame& frame);
+  /// The pose stream's step: solves `frame`, filters it into `pose` and hands it to the
+  /// resampler. Allocates nothing.
+  void solve(const landmark_frame& frame, proxy_pose& pose);
+  /// The pose stream (stream().sample(t): the pose at any capture time).
+  const pose_stream& stream() const { return *stream_; }
 
   /// Where the time of the last process() went in the estimator (nullptr: no stages).
   const estimator_timings* last_timings() const;
-  /// Forgets the solver's and the filter's state (a new take).
+  /// Forgets the stream's state: solver, filter, resampler (a new take).
   void reset();
   const capture_pipeline_options& options() const { return options_; }
 
@@ -70,8 +86,7 @@ class capture_pipeline {
   capture_pipeline() = default;
   capture_pipeline_options options_;
   std::unique_ptr<estimator> estimator_;
-  frame_solver solver_;
-  pose_filter filter_;
+  std::unique_ptr<pose_stream> stream_;
   estimate_args args_;
   int solver_width_ = 0, solver_height_ = 0;  // image size the solver was made for
 };

@@ -9,6 +9,8 @@
 #include <string>
 #include <string_view>
 
+#include "avatarmap/core/limits.hpp"
+#include "avatarmap/core/option_table.hpp"
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/media/image.hpp"
@@ -63,6 +65,73 @@ struct estimator_options {
   int lanes = 2;
   /// onnx: the models' precision, for every model (docs/capture.md "int8 models").
   model_precision precision = model_precision::float32;
+};
+
+/// The estimator's options as every front end takes them (the CLI's capture, live and animate
+/// flags, avm_estimator_options, Python's Estimator, Live and capture_file), one row per
+/// option; the rows the C struct has come in its order, with its names. Defaults: the
+/// struct's, except the models' threads (2) and the hands and face (on), which the front ends
+/// start from (`avatarmap capture` alone turns the hands and face off by default).
+inline constexpr option_row<estimator_options> k_estimator_option_table[] = {
+    option_row<estimator_options>("models_dir", AVATARMAP_OPTION_TEXT(estimator_options, source))
+        .cli("--models", "DIR")
+        .help("converted models; empty: $AVATARMAP_MODELS/onnx, else the installed ones, else "
+              "the cache scripts/prepare_capture.sh fills (`avatarmap backends` says which)"),
+    option_row<estimator_options>("model_complexity",
+                                  AVATARMAP_OPTION_FIELD(estimator_options, model_complexity))
+        .choices("lite|full|heavy")
+        .cli("--model")
+        .help("pose landmark model"),
+    option_row<estimator_options>("hands", AVATARMAP_OPTION_FIELD(estimator_options, hands))
+        .boolean()
+        .defaults_to(1)
+        .cli("--hands", nullptr, "--no-hands")
+        .help("estimate both hands (21 points each, image + world)"),
+    option_row<estimator_options>("face", AVATARMAP_OPTION_FIELD(estimator_options, face))
+        .boolean()
+        .defaults_to(1)
+        .cli("--face", nullptr, "--no-face")
+        .help("estimate the face mesh (468 points)"),
+    option_row<estimator_options>("hand_model_complexity",
+                                  AVATARMAP_OPTION_FIELD(estimator_options, hand_model_complexity))
+        .choices("lite|full")
+        .cli("--hand-model")
+        .help("hand landmark model"),
+    option_row<estimator_options>("threads", AVATARMAP_OPTION_FIELD(estimator_options, threads))
+        .integer(1, k_max_model_threads)
+        .defaults_to(2)
+        .cli("--threads", "N")
+        .help("threads for the models (1 is better when another process keeps a core busy)"),
+    option_row<estimator_options>("mirrored",
+                                  AVATARMAP_OPTION_FIELD(estimator_options, mirrored_input))
+        .boolean()
+        .cli("--mirrored")
+        .help("the input is mirrored (a selfie preview); sides stay the person's"),
+    option_row<estimator_options>("static_images",
+                                  AVATARMAP_OPTION_FIELD(estimator_options, static_images))
+        .boolean()
+        .cli("--static")
+        .help("detect on every frame (images unrelated to each other)"),
+    option_row<estimator_options>("precision", AVATARMAP_OPTION_FIELD(estimator_options, precision))
+        .choices("float|int8")
+        .cli("--precision")
+        .not_in_c()
+        .help("model precision. int8 (the int8 models scripts/prepare_capture.sh builds) is "
+              "faster but leaves Google's tolerances on some references, on CPUs without "
+              "VNNI on most (docs/capture.md \"int8 models\")"),
+    option_row<estimator_options>("lanes", AVATARMAP_OPTION_FIELD(estimator_options, lanes))
+        .integer(1, 2)
+        .cli("--lanes", "1|2")
+        .not_in_c()
+        .help("with hands or face and 2+ threads: 2 runs the hands and face beside the body "
+              "(of the next frame, for files), each model on one thread; 1 runs every model "
+              "on all threads in turn"),
+    option_row<estimator_options>("spin", AVATARMAP_OPTION_FIELD(estimator_options, spin))
+        .boolean()
+        .cli("--spin")
+        .not_in_c()
+        .help("let ONNX Runtime's threads spin between operators: faster on an idle machine, "
+              "much slower when another process is busy"),
 };
 
 /// Where the time of the last estimate() went, milliseconds (0 for a stage that did not run).

@@ -32,7 +32,8 @@ class landmark_reader {
   landmark_reader& operator=(const landmark_reader&) = delete;
 
   /// Opens `path` ("-" = standard input) and reads the header line if there is one. Fails
-  /// when the file cannot be opened or the header is bad (wrong format, version > 1).
+  /// when the file cannot be opened (status_code::io) or the header is bad (wrong format,
+  /// version > 1: status_code::parse).
   status open(const std::string& path);
   /// Reads from a memory buffer (not copied: it must outlive the reader). For tests/fuzzing.
   status open_memory(const char* data, std::size_t size, const std::string& name = "<memory>");
@@ -44,6 +45,8 @@ class landmark_reader {
   /// following line, so a caller may skip bad lines. Blank lines are skipped.
   read_result next(landmark_frame& out);
   const std::string& error() const;
+  /// The kind of the last error: parse (a malformed or over-long line), io (reading failed).
+  status_code error_code() const;
   /// 1-based number of the line last read.
   long line() const;
 

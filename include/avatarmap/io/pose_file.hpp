@@ -26,6 +26,9 @@ class pose_reader {
   pose_reader(const pose_reader&) = delete;
   pose_reader& operator=(const pose_reader&) = delete;
 
+  /// Opens `path` ("-" = standard input) and reads the header line if there is one. Fails
+  /// when the file cannot be opened (status_code::io) or the header is bad
+  /// (status_code::parse).
   status open(const std::string& path);
   status open_memory(const char* data, std::size_t size, const std::string& name = "<memory>");
   const pose_file_header& header() const;
@@ -34,6 +37,8 @@ class pose_reader {
   /// error.
   read_result next(proxy_pose& out);
   const std::string& error() const;
+  /// The kind of the last error: parse (a malformed or over-long line), io (reading failed).
+  status_code error_code() const;
   long line() const;
 
  private:

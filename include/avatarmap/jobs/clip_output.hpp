@@ -11,8 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include "avatarmap/core/limits.hpp"
 #include "avatarmap/core/status.hpp"
-#include "avatarmap/jobs/job_failure.hpp"
 #include "avatarmap/rig/mapping.hpp"
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/rig/rig.hpp"
@@ -42,8 +42,8 @@ inline constexpr std::array<clip_format_info, 4> k_clip_formats = {{
 
 /// Frame rate of avatar outputs (.glb, rig .bvh) when the job's fps is 0: they need a fixed rate.
 inline constexpr double k_default_rig_fps = 30.0;
-/// Highest output frame rate accepted.
-inline constexpr double k_max_output_fps = 1000.0;
+/// Highest output frame rate accepted: the one frame-rate limit (core/limits.hpp).
+inline constexpr double k_max_output_fps = k_max_fps;
 
 /// The format whose extension ends `path`, compared without regard to ASCII case ("X.VRMA" is
 /// a .vrma); null when none does.
@@ -62,7 +62,6 @@ struct clip_output_summary {
   std::size_t frames_written = 0;
   double fps = 0.0;                  // the rate written (0: the frames' own times)
   float standing_hips_height = 0.f;  // rig outputs with root motion (metres)
-  job_failure failure = job_failure::none;
 };
 
 /// The job. The caller keeps `frames`, `avatar_rig` and `avatar_table` alive during run().
@@ -100,9 +99,10 @@ struct clip_output_job {
   /// the path (times: `what`).
   status validate() const;
   /// validate(), then the write; `out` is replaced. Fails with a message naming the file and
-  /// out.failure set: invalid_argument (validate, the clip's hips heights), input_parse (a
-  /// binding the retargeter refuses), output_io (the file cannot be written). Memory running
-  /// out is a status::out_of_memory. Never throws but for std::bad_alloc.
+  /// the code of the step that failed: invalid_argument (validate, the clip's hips heights, a
+  /// clip a writer refuses), parse (a binding the retargeter refuses; the avatar re-read by
+  /// .glb is malformed), io (the file cannot be written, the avatar cannot be re-read),
+  /// out_of_memory. Never throws but for std::bad_alloc.
   status run(clip_output_summary& out) const;
 };
 

@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "avatarmap/core/status.hpp"
-#include "avatarmap/jobs/job_failure.hpp"
 #include "avatarmap/rig/mapping.hpp"
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/rig/rig.hpp"
@@ -50,12 +49,10 @@ struct retarget_clip_job {
   /// the rig). The message names the field.
   status validate() const;
   /// validate(), the standing height (root_motion only), retargeter::build, then one rig pose
-  /// per frame into `out_poses` (replaced). On failure `out_poses` is empty and
-  /// `out_failure` (when given) says why: invalid_argument for the fields and the clip's
-  /// heights, input_parse for a binding the retargeter refuses. Never throws but for
-  /// std::bad_alloc.
-  status run(std::vector<rig_pose>& out_poses, job_failure* out_failure = nullptr,
-             float* out_standing_height = nullptr) const;
+  /// per frame into `out_poses` (replaced). On failure `out_poses` is empty and the status's
+  /// code says why: invalid_argument for the fields and the clip's heights, parse for a
+  /// binding the retargeter refuses. Never throws but for std::bad_alloc.
+  status run(std::vector<rig_pose>& out_poses, float* out_standing_height = nullptr) const;
 };
 
 }  // namespace avatarmap

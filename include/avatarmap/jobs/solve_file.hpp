@@ -1,59 +1,30 @@
 // The landmarks-file -> proxy-poses workflow, written once for the CLI (`solve`, `demo`,
 // `convert` of a landmark file) and the C API (avm_solve_file): read a *.landmarks.jsonl,
-// solve every frame (frame_solver), filter (landmark_filter before; offline_smoother or
-// pose_filter after), optionally resample at a fixed rate (after the filter), and write a
-// *.pose.jsonl or hand each pose to a sink.
+// solve every frame, filter and optionally resample at a fixed rate (solve/pose_stream.hpp:
+// landmark_filter before solving, offline_smoother or pose_filter after, by the filter rules
+// of time/filter_rules.hpp), and write a *.pose.jsonl or hand each pose to a sink.
 //
 // Memory: one frame in flight (or a ring of 64 parsed frames with threads = 2) and, with the
 // offline filter, its window of poses (offline_smoother_options::capacity_frames, ~300 kB by
-// default); the poses are streamed, never held all. Per-frame state lives in the solver, the
-// filters and the resampler the job creates for one run.
+// default); the poses are streamed, never held all. Per-frame state lives in the pose stream
+// the job creates for one run.
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <string>
 
+#include "avatarmap/core/limits.hpp"
+#include "avatarmap/core/option_table.hpp"
 #include "avatarmap/core/status.hpp"
-#include "avatarmap/jobs/job_failure.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "avatarmap/solve/solver_options.hpp"
+#include "avatarmap/time/filter_rules.hpp"  // pose_filter_mode, pose_filter_channels
 #include "avatarmap/time/offline_smoother.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 
 namespace avatarmap {
-
-/// Which channels of a solved pose take pose_filter's output; a channel that is off keeps the
-/// solver's value (pose_filter itself filters all channels or none).
-struct pose_filter_channels {
-  bool rotations = true;
-  bool position = true;
-  bool expressions = true;
-};
-
-/// Filters `raw` into `out` with `filter`, then puts back the channels of `raw` whose
-/// filtering `channels` turns off. Allocates nothing.
-inline void filter_pose_channels(pose_filter& filter, const pose_filter_channels& channels,
-                                 const proxy_pose& raw, proxy_pose& out) {
-  filter.apply(raw, out);
-  if (!channels.rotations) out.rotations = raw.rotations;
-  if (!channels.position) out.hips_position = raw.hips_position;
-  if (!channels.expressions) out.expressions = raw.expressions;
-}
-
-/// How solved poses are smoothed over time (docs/smoothing.md).
-enum class pose_filter_mode : unsigned char {
-  /// Zero-phase smoothing and gap filling with a bounded lookahead (offline_smoother): the
-  /// default for files. The solver's confidence gate is opened (thresholds 0) so that every
-  /// measured bone reaches the smoother, which decides what is observed with the future in
-  /// view (offline_smoother_options::observed_above) and fills or eases the rest.
-  offline,
-  /// The causal One Euro filter (pose_filter, `filter`): what a live stream gets; the solver's
-  /// gate as configured in `options`.
-  live,
-  /// No temporal filter after solving (the solver's gate as configured).
-  none,
-};
 
 /// What a solve_file_job reports to its progress callback.
 struct solve_file_progress {
@@ -67,6 +38,9 @@ struct solve_file_summary {
   long frames = 0;         // frames solved
   long poses_written = 0;  // poses written (or handed to the sink)
   long bad_lines = 0;      // malformed lines skipped (skip_bad_lines)
+  /// The input was opened and its header read: a parse error after it is a malformed line
+  /// (which skip_bad_lines would skip), not a malformed header.
+  bool input_opened = false;
   /// With output_fps > 0: frames left out because their time was earlier than the frame before.
   long out_of_order = 0;
   long part_frames[k_frame_part_count] = {};  // frames that had each part
@@ -86,20 +60,20 @@ struct solve_file_summary {
   float horizontal_fov_degrees = 0.f;
   bool fov_estimated = false;
   long fov_evidence_frames = 0;
-  /// Why the run failed (none on success).
-  job_failure failure = job_failure::none;
 };
 
 /// The job. Fill the inputs, call run(). Thread-safety: a job may be run from any thread; the
-/// callbacks are called on the thread that called run().
-struct solve_file_job {
+/// callbacks are called on the thread that called run(). Its filter fields (filter_mode,
+/// offline, filter, filter_channels, landmark_filter) are the pose stream's, inherited from
+/// pose_stream_filters (time/filter_rules.hpp), which owns their rules.
+struct solve_file_job : pose_stream_filters {
   /// *.landmarks.jsonl to read ("-" = standard input). With `source` set: only the name that
   /// messages give the frames (e.g. "frames"; empty = "frames").
   std::string input;
   /// When set, frames come from here instead of a file (frames held in memory, e.g. the C
   /// API's avm_solve_frames): each call fills `out` with the next frame and returns ok, or
   /// sets `end` = true when there are no more; an error it returns ends the run with that
-  /// error (failure invalid_argument: the caller's frames are its arguments). Pulled on the
+  /// error, its code kept (invalid_argument: the caller's frames are its arguments). Pulled on the
   /// thread that calls run() (`threads` does not apply); no header: the image size is
   /// image_width/height or options.image_width/height, the output's fps 0.
   std::function<status(landmark_frame& out, bool& end)> source;
@@ -107,27 +81,13 @@ struct solve_file_job {
   /// left as it was. Ignored when `sink` is set.
   std::string output;
   /// When set, every output pose goes here instead of a file; an error it returns ends the
-  /// run with that error (failure output_io).
+  /// run with that error, its code kept.
   std::function<status(const proxy_pose&)> sink;
   solver_options options{};
   /// Image size in pixels; 0 = the file's header's, else options.image_width/height (when
   /// those are 0 too, square pixels are assumed and the summary says so).
   float image_width = 0.f;
   float image_height = 0.f;
-  /// Which filter runs after solving; `offline` and `live` use the options below.
-  pose_filter_mode filter_mode = pose_filter_mode::offline;
-  /// Options of the offline filter (filter_mode offline).
-  offline_smoother_options offline{};
-  /// Options of the live filter (filter_mode live; filter.enabled = false is the same as none).
-  pose_filter_options filter{};
-  /// Channels that take the live filter's output (filter_mode live only).
-  pose_filter_channels filter_channels{};
-  /// Point filtering before solving: off unless asked for.
-  landmark_filter_options landmark_filter = [] {
-    landmark_filter_options o;
-    o.enabled = false;
-    return o;
-  }();
   /// 0 = one pose per input frame, in the file's order. > 0: poses at t_first + j / fps; a frame
   /// earlier than the one before it is skipped with a warning (counted in out_of_order), and a
   /// frame more than k_max_clip_seconds after the first, or more than k_max_resampled_frames
@@ -149,13 +109,108 @@ struct solve_file_job {
   std::function<void(const std::string&)> warning;
 
   /// Checks the fields that do not need the file: input or source set, output or sink set, options
-  /// valid, image size finite and >= 0 (both or neither), output_fps finite in [0, 1000],
-  /// threads 1 or 2, filter_mode known, filter parameters positive, offline options valid
-  /// (offline_smoother_options::validate). The message names the field.
+  /// valid, image size finite and >= 0 (both or neither), output_fps finite in [0, k_max_fps],
+  /// threads 1 or 2, and the filter fields by the filter rules (pose_stream_filters::validate:
+  /// filter_mode known, filter parameters positive, offline options valid). The message names
+  /// the field.
   status validate() const;
   /// validate(), then the whole run into `out` (replaced). Fails with a message naming the
-  /// file (and line or frame) and out.failure set. Never throws but for std::bad_alloc.
+  /// file (and line or frame) and the code of the step that failed: invalid_argument (the
+  /// fields, a source's frame, times too far apart for output_fps), io (the input cannot be
+  /// opened or read, the output cannot be written), parse (a malformed header or line),
+  /// out_of_memory; a sink's error keeps its own code. Never throws but for std::bad_alloc.
   status run(solve_file_summary& out) const;
+};
+
+/// The solve-file job's options as the front ends take them (the CLI's solve and convert
+/// flags, avm_solver_options' filter and file fields, Python's solve and Solver), one row per
+/// option; the rows the C struct has come in its order, with its names (the live filter's
+/// parameters serve the C solver handle too). core/option_table.hpp.
+inline constexpr option_row<solve_file_job> k_solve_file_option_table[] = {
+    option_row<solve_file_job>("filter_rotations",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter_channels.rotations))
+        .boolean()
+        .help("the live filter smooths the bone rotations"),
+    option_row<solve_file_job>("rotation_min_cutoff",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter.rotation.min_cutoff))
+        .number(0, std::numeric_limits<double>::infinity(), true)
+        .cli("--min-cutoff", "HZ")
+        .help("live: One Euro cutoff at rest for rotations"),
+    option_row<solve_file_job>("rotation_beta",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter.rotation.beta))
+        .number(0, std::numeric_limits<double>::infinity())
+        .cli("--beta", "B")
+        .help("live: One Euro speed coefficient for rotations"),
+    option_row<solve_file_job>("rotation_d_cutoff",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter.rotation.d_cutoff))
+        .number(0, std::numeric_limits<double>::infinity(), true)
+        .help("live: cutoff of the rotations' speed estimate (Hz)"),
+    option_row<solve_file_job>("filter_position",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter_channels.position))
+        .boolean()
+        .help("the live filter smooths the hips position"),
+    option_row<solve_file_job>("position_min_cutoff",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter.position.min_cutoff))
+        .number(0, std::numeric_limits<double>::infinity(), true)
+        .help("live: One Euro cutoff at rest for the hips position (Hz)"),
+    option_row<solve_file_job>("position_beta",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter.position.beta))
+        .number(0, std::numeric_limits<double>::infinity())
+        .help("live: One Euro speed coefficient for the hips position (s/m)"),
+    option_row<solve_file_job>("position_d_cutoff",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter.position.d_cutoff))
+        .number(0, std::numeric_limits<double>::infinity(), true)
+        .help("live: cutoff of the position's speed estimate (Hz)"),
+    option_row<solve_file_job>("filter_expressions",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter_channels.expressions))
+        .boolean()
+        .help("the live filter smooths the expressions"),
+    option_row<solve_file_job>("expression_min_cutoff",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter.expression.min_cutoff))
+        .number(0, std::numeric_limits<double>::infinity(), true)
+        .help("live: One Euro cutoff at rest for the expressions (Hz)"),
+    option_row<solve_file_job>("expression_beta",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter.expression.beta))
+        .number(0, std::numeric_limits<double>::infinity())
+        .help("live: One Euro speed coefficient for the expressions"),
+    option_row<solve_file_job>("expression_d_cutoff",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, filter.expression.d_cutoff))
+        .number(0, std::numeric_limits<double>::infinity(), true)
+        .help("live: cutoff of the expressions' speed estimate (Hz)"),
+    option_row<solve_file_job>("file_filter", AVATARMAP_OPTION_FIELD(solve_file_job, filter_mode))
+        .choices("offline|live|none")
+        .help("the filter after solving a file: offline (zero-lag smoothing that sees 1.5 s "
+              "ahead and fills gaps), live (the causal One Euro filter) or none"),
+    option_row<solve_file_job>("file_smoothing",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, offline.strength))
+        .number(0, k_max_smoothing)
+        .cli("--smoothing", "S")
+        .help("scale on the offline filter's time constants (0 = fill gaps only, 2 = twice as "
+              "smooth)"),
+    option_row<solve_file_job>("file_threads", AVATARMAP_OPTION_FIELD(solve_file_job, threads))
+        .integer(1, 2)
+        .cli("--threads", "1|2")
+        .help("2 parses the input on a second thread; 1 does all on one"),
+    option_row<solve_file_job>("output_fps", AVATARMAP_OPTION_FIELD(solve_file_job, output_fps))
+        .number(0, k_max_fps, true)
+        .or_zero()
+        .cli("--fps", "N")
+        .not_in_c()
+        .help("resample the output at N frames per second (slerp between capture frames); 0: "
+              "one pose per input frame. Frames earlier than the one before are skipped (a "
+              "warning); at most 24 h of capture and 4194304 poses"),
+    option_row<solve_file_job>("skip_bad_lines",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, skip_bad_lines))
+        .boolean()
+        .cli("--skip-bad-lines")
+        .not_in_c()
+        .help("report malformed lines and go on (default: stop at the first)"),
+    option_row<solve_file_job>("write_confidence",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, write_confidence))
+        .boolean()
+        .cli("--confidence")
+        .not_in_c()
+        .help("also write per-bone confidence"),
 };
 
 }  // namespace avatarmap

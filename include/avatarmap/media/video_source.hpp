@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "avatarmap/core/limits.hpp"
+#include "avatarmap/core/option_table.hpp"
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/io/landmark_file.hpp"  // read_result
 #include "avatarmap/media/image.hpp"
@@ -59,6 +61,42 @@ struct video_source_options {
   /// Seconds next() waits for a frame before it reports the input stalled (returns end,
   /// end_reason() "no frame from INPUT for S s: ..."), 0.1..3600.
   double stall_timeout_seconds = 5.0;
+};
+
+/// The options a user gives for devices and URLs (the CLI's input flags of capture, live and
+/// animate), one row each; video_source::open() checks them.
+inline constexpr option_row<video_source_options> k_video_source_option_table[] = {
+    option_row<video_source_options>("video_size",
+                                     AVATARMAP_OPTION_TEXT(video_source_options, video_size))
+        .cli("--video-size", "WxH")
+        .not_in_c()
+        .help("devices: frame size to ask for (e.g. 1280x720)"),
+    option_row<video_source_options>("framerate",
+                                     AVATARMAP_OPTION_FIELD(video_source_options, framerate))
+        .number(0, k_max_fps, true)
+        .or_zero()
+        .cli("--framerate", "N")
+        .not_in_c()
+        .help("devices: frame rate to ask for; 0: the device's"),
+    option_row<video_source_options>("input_format",
+                                     AVATARMAP_OPTION_TEXT(video_source_options, input_format))
+        .cli("--input-format", "NAME")
+        .not_in_c()
+        .help("devices: pixel format or codec to ask for (v4l2: mjpeg, yuyv422)"),
+    option_row<video_source_options>(
+        "open_timeout_seconds", AVATARMAP_OPTION_FIELD(video_source_options, open_timeout_seconds))
+        .number(0.1, 3600)
+        .cli("--open-seconds", "S")
+        .not_in_c()
+        .help("devices and URLs: give up when no picture came within S s of opening"),
+    option_row<video_source_options>(
+        "stall_timeout_seconds",
+        AVATARMAP_OPTION_FIELD(video_source_options, stall_timeout_seconds))
+        .number(0.1, 3600)
+        .cli("--stall-seconds", "S")
+        .not_in_c()
+        .help("devices and URLs: stop when no frame came for S s: \"no frame from INPUT for S "
+              "s: the stream stalled or ended\""),
 };
 
 /// What kind of input open() found: camera is any input device (FORMAT:DEVICE, a test

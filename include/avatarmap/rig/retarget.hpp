@@ -56,7 +56,8 @@ struct rig_pose {
 class retargeter {
  public:
   /// Binds `r` (kept by reference: it must outlive the retargeter) with `binding`. Needs at
-  /// least the hips bound; the error names what is missing. Precomputes every constant.
+  /// least the hips bound; the error (status_code::parse: the binding does not fit the rig)
+  /// names what is missing. Precomputes every constant.
   /// `table`, when given, supplies per-bone formulas (docs/mappings.md): bones with formulas
   /// take SysMocap's conversion (rest Euler angles + f(x, y, z) in the bone's order) instead
   /// of the rest-aware one; the formulas are copied.

@@ -64,7 +64,8 @@ struct rig {
 };
 
 /// Validates a raw rig (parents in range, no cycles, finite transforms, non-zero scale) and
-/// builds the runtime rig, reordering joints parent-first. Errors name the node.
+/// builds the runtime rig, reordering joints parent-first. Errors (status_code::parse: the
+/// avatar's skeleton is malformed) name the node.
 status build_rig(const raw_rig& raw, rig& out);
 
 }  // namespace avatarmap

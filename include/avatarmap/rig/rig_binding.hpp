@@ -3,7 +3,6 @@
 // a table name (a table of that folder) or the path of a .json table.
 #pragma once
 
-#include <cstdint>
 #include <string>
 
 #include "avatarmap/core/status.hpp"
@@ -13,15 +12,6 @@
 
 namespace avatarmap {
 
-/// Why select_binding failed (to map onto error codes; the message says the rest).
-enum class rig_binding_failure : std::uint8_t {
-  none,
-  io,            // the .json table or the tables' folder cannot be read
-  bad_table,     // a table file is malformed (the message names the file and the key)
-  unknown_name,  // `option` names no table of the folder
-  no_fit,        // the table (or every table) lacks required bones of this rig
-};
-
 /// The outcome of select_binding. Copyable: the table used is held by value.
 struct rig_binding_choice {
   bool uses_table = false;  // false: the rig's declared humanoid (VRM) is used as is
@@ -29,7 +19,6 @@ struct rig_binding_choice {
   bone_binding binding{};   // rig joint per proxy bone, -1 when unbound
   int bound = 0;            // proxy bones bound
   std::string description;  // how the binding was made, for the user
-  rig_binding_failure failure = rig_binding_failure::none;
 
   /// The table to give retargeter::build (its formulas), or null.
   const mapping_table* table_or_null() const { return uses_table ? &table : nullptr; }
@@ -41,8 +30,11 @@ struct rig_binding_choice {
 ///  - a name ending in ".json": the table at that path (its formulas apply);
 ///  - anything else: the table of `mappings_folder` whose "name" is `option`.
 /// `mappings_folder` is only read when a table of it is needed. `out` is replaced. Errors say
-/// what was tried (the rig's file, the table, missing required bones, the known table names)
-/// and set out.failure. Never throws but for std::bad_alloc.
+/// what was tried (the rig's file, the table, missing required bones, the known table names);
+/// their codes: io (the .json table or the tables' folder cannot be read, or no folder was
+/// given), parse (a table is malformed; the table, or with "auto" every table, lacks required
+/// bones of this rig), invalid_argument (`option` names no table of the folder). Never throws
+/// but for std::bad_alloc.
 status select_binding(const rig& r, const std::string& option, const std::string& mappings_folder,
                       rig_binding_choice& out);
 

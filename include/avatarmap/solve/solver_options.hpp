@@ -1,10 +1,14 @@
 // Options of the landmark -> proxy pose solver (frame_solver). Every field has a default
-// that works for a non-mirrored camera; validate() names any field out of range.
+// that works for a non-mirrored camera; k_solver_option_table declares each field's range and
+// help once (core/option_table.hpp): validate(), the CLI's flags and the C API's checks come
+// from it.
 #pragma once
 
 #include <cmath>
+#include <limits>
 #include <string>
 
+#include "avatarmap/core/option_table.hpp"
 #include "avatarmap/core/status.hpp"
 
 namespace avatarmap {
@@ -60,30 +64,95 @@ struct solver_options {
   /// landmarks. false = the hand landmarks as they are.
   bool fit_hand_shape = true;
 
-  status validate() const {
-    auto bad01 = [](float v) { return !(v >= 0.f && v <= 1.f); };
-    if (!(image_width >= 0.f) || !(image_height >= 0.f) || !std::isfinite(image_width) ||
-        !std::isfinite(image_height))
-      return status::error("image_width/image_height must be finite and >= 0 (0 = unknown)");
-    if ((image_width > 0.f) != (image_height > 0.f))
-      return status::error("give both image_width and image_height, or neither");
-    if (bad01(confidence.lost_below) || bad01(confidence.found_above) ||
-        confidence.found_above < confidence.lost_below)
-      return status::error(
-          "confidence thresholds must satisfy 0 <= lost_below <= found_above <= 1");
-    if (!(confidence.hold_seconds >= 0.f) || !(confidence.ease_seconds >= 0.f) ||
-        !(confidence.regain_seconds >= 0.f) || !std::isfinite(confidence.hold_seconds) ||
-        !std::isfinite(confidence.ease_seconds) || !std::isfinite(confidence.regain_seconds))
-      return status::error("confidence hold/ease/regain seconds must be finite and >= 0");
-    if (bad01(hips_lean_share)) return status::error("hips_lean_share must be in [0, 1]");
-    if (bad01(forearm_twist_share)) return status::error("forearm_twist_share must be in [0, 1]");
-    if (!(horizontal_fov_degrees == 0.f ||
-          (horizontal_fov_degrees > 1.f && horizontal_fov_degrees < 179.f)))
-      return status::error("horizontal_fov_degrees must be 0 (estimate) or in (1, 179)");
-    if (!(rest_hips_height > 0.f && rest_hips_height < 10.f))
-      return status::error("rest_hips_height must be in (0, 10) metres");
-    return {};
-  }
+  /// Checks every field against k_solver_option_table (the message names the field and its
+  /// range), then image_width and image_height both given or neither, and lost_below <=
+  /// found_above.
+  status validate() const;
 };
+
+/// The solver's options, one row per field, in the order (and with the names) of
+/// avm_solver_options' solver fields.
+inline constexpr option_row<solver_options> k_solver_option_table[] = {
+    option_row<solver_options>("mirror", AVATARMAP_OPTION_FIELD(solver_options, mirror))
+        .boolean()
+        .cli("--mirror")
+        .help("mirror the performer: swap left and right and flip X (mirrored webcam "
+              "recordings)"),
+    option_row<solver_options>("image_width", AVATARMAP_OPTION_FIELD(solver_options, image_width))
+        .number(0, std::numeric_limits<double>::infinity())
+        .help("image width in pixels; 0 = unknown (square pixels assumed)"),
+    option_row<solver_options>("image_height", AVATARMAP_OPTION_FIELD(solver_options, image_height))
+        .number(0, std::numeric_limits<double>::infinity())
+        .help("image height in pixels; 0 = unknown"),
+    option_row<solver_options>("solve_body", AVATARMAP_OPTION_FIELD(solver_options, parts.body))
+        .boolean()
+        .help("solve the body (hips, spine, arms, legs)"),
+    option_row<solver_options>("solve_hands", AVATARMAP_OPTION_FIELD(solver_options, parts.hands))
+        .boolean()
+        .help("solve the wrists and fingers"),
+    option_row<solver_options>("solve_face", AVATARMAP_OPTION_FIELD(solver_options, parts.face))
+        .boolean()
+        .help("solve the neck, head, eyes and expressions"),
+    option_row<solver_options>("solve_hips_translation",
+                               AVATARMAP_OPTION_FIELD(solver_options, parts.hips_translation))
+        .boolean()
+        .help("move the hips (root motion)"),
+    option_row<solver_options>("confidence_lost_below",
+                               AVATARMAP_OPTION_FIELD(solver_options, confidence.lost_below))
+        .number(0, 1)
+        .help("a bone is lost when its confidence falls below this"),
+    option_row<solver_options>("confidence_found_above",
+                               AVATARMAP_OPTION_FIELD(solver_options, confidence.found_above))
+        .number(0, 1)
+        .help("a lost bone is found again above this (>= confidence_lost_below)"),
+    option_row<solver_options>("confidence_hold_seconds",
+                               AVATARMAP_OPTION_FIELD(solver_options, confidence.hold_seconds))
+        .number(0, std::numeric_limits<double>::infinity())
+        .help("seconds a lost bone holds its last good rotation"),
+    option_row<solver_options>("confidence_ease_seconds",
+                               AVATARMAP_OPTION_FIELD(solver_options, confidence.ease_seconds))
+        .number(0, std::numeric_limits<double>::infinity())
+        .help("seconds a lost bone then eases to rest"),
+    option_row<solver_options>("confidence_regain_seconds",
+                               AVATARMAP_OPTION_FIELD(solver_options, confidence.regain_seconds))
+        .number(0, std::numeric_limits<double>::infinity())
+        .help("seconds a found bone blends back to the measurement"),
+    option_row<solver_options>("hips_lean_share",
+                               AVATARMAP_OPTION_FIELD(solver_options, hips_lean_share))
+        .number(0, 1)
+        .help("share of the torso's lean given to the hips"),
+    option_row<solver_options>("forearm_twist_share",
+                               AVATARMAP_OPTION_FIELD(solver_options, forearm_twist_share))
+        .number(0, 1)
+        .help("share of the wrist's twist moved to the lower arm"),
+    option_row<solver_options>("horizontal_fov_degrees",
+                               AVATARMAP_OPTION_FIELD(solver_options, horizontal_fov_degrees))
+        .number(1, 179, true, true)
+        .or_zero()
+        .cli("--fov", "DEG")
+        .help("camera's horizontal field of view (head under perspective, root motion); 0: "
+              "estimated from the pose's image and world points when they form one pinhole "
+              "view, else 60"),
+    option_row<solver_options>("rest_hips_height",
+                               AVATARMAP_OPTION_FIELD(solver_options, rest_hips_height))
+        .number(0, 10, true, true)
+        .help("hips height while the legs have never been seen (metres)"),
+    option_row<solver_options>("fit_hand_shape",
+                               AVATARMAP_OPTION_FIELD(solver_options, fit_hand_shape))
+        .boolean()
+        .cli(nullptr, nullptr, "--no-hand-fit")
+        .help("--no-hand-fit: use the hand landmarks as they are (default: each hand's points "
+              "fitted to its shape learnt over the take, a rigid palm and fingers of constant "
+              "length; docs/solver.md)"),
+};
+
+inline status solver_options::validate() const {
+  if (status st = check_options(k_solver_option_table, *this, ""); !st.ok()) return st;
+  if ((image_width > 0.f) != (image_height > 0.f))
+    return status::error("give both image_width and image_height, or neither");
+  if (confidence.found_above < confidence.lost_below)
+    return status::error("confidence thresholds must satisfy 0 <= lost_below <= found_above <= 1");
+  return {};
+}
 
 }  // namespace avatarmap

@@ -47,6 +47,7 @@
 // Thread-safety: one instance per stream.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -105,10 +106,22 @@ struct offline_smoother_options {
   /// lookahead (1.5 s) up to ~160 fps.
   int capacity_frames = 256;
 
-  /// Checks every field: strength and sigmas finite and >= 0 (sigmas > 0), observed_above in
-  /// [0, 1], times finite and >= 0 (max_gap, hold, ease at most 60 s), min_sigma_frames in
-  /// [0, 10], capacity_frames in
-  /// [8, 65536]. The message names the field and its range.
+  /// The widest kernel a strength may give: strength x the largest of the four sigmas above is
+  /// at most this (seconds; a window several seconds wide is a strength nobody means, and a
+  /// large buffer).
+  static constexpr float k_widest_sigma_seconds = 2.f;
+  /// The largest strength validate() accepts with these sigmas: k_widest_sigma_seconds / the
+  /// largest sigma (6.67 with the defaults; filter_rules.hpp's k_max_smoothing).
+  constexpr float max_strength() const {
+    const float widest = std::max({body_sigma_seconds, finger_sigma_seconds, position_sigma_seconds,
+                                   expression_sigma_seconds});
+    return widest > 0.f ? k_widest_sigma_seconds / widest : 0.f;
+  }
+
+  /// Checks every field: strength and sigmas finite and >= 0 (sigmas > 0), strength at most
+  /// max_strength(), observed_above in [0, 1], times finite and >= 0 (max_gap, hold, ease at
+  /// most 60 s), min_sigma_frames in [0, 10], capacity_frames in [8, 65536]. The message
+  /// names the field and its range.
   status validate() const;
 };
 

@@ -13,6 +13,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <limits>
 
+#include "avatarmap/core/option_table.hpp"
 #include "avatarmap/core/rotation.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 
@@ -25,6 +26,16 @@ struct pose_resampler_options {
   /// it the pose holds. 0.1 s covers two to three missing frames at 20-30 fps (the estimator
   /// drops frames it cannot keep up with) without letting a limb fly away when capture stalls.
   double max_extrapolation_seconds = 0.1;
+};
+
+/// The resampler's options (avm_solver_options' field of the same name; core/option_table.hpp).
+inline constexpr option_row<pose_resampler_options> k_pose_resampler_option_table[] = {
+    option_row<pose_resampler_options>(
+        "max_extrapolation_seconds",
+        AVATARMAP_OPTION_FIELD(pose_resampler_options, max_extrapolation_seconds))
+        .number(0, std::numeric_limits<double>::infinity())
+        .help("how far past the newest frame a sample extrapolates (seconds); beyond it the "
+              "pose holds"),
 };
 
 /// Thread-safety: one instance per stream; push() and sample() must not run concurrently.

@@ -120,37 +120,34 @@ status capture_file_job::validate() const {
 status capture_file_job::run(capture_file_summary& s) const {
   s = capture_file_summary{};
   const auto run_t0 = clock_type::now();
-  auto fail = [&](job_failure why, const status& st) {
-    s.failure = why;
+  auto fail = [&](const status& st) {
     s.seconds = seconds_since(run_t0);
     return st;
   };
-  if (status st = validate(); !st.ok()) return fail(job_failure::invalid_argument, st);
+  if (status st = validate(); !st.ok()) return fail(st);
 
   video_source source;
-  if (status st = source.open(input, video); !st.ok()) return fail(job_failure::input_io, st);
+  if (status st = source.open(input, video); !st.ok()) return fail(st);
   const video_info info = source.info();
   s.input = info;
   const bool live_input =
       info.kind == video_source_kind::camera || info.kind == video_source_kind::stream;
   if (live_input && !allow_live_input)
-    return fail(
-        job_failure::invalid_argument,
-        status::error(shown_input(input) + ": a device or stream; give a video file, an image, a "
-                                           "folder of images or a pattern"));
+    return fail(status::invalid_argument(shown_input(input) +
+                                         ": a device or stream; give a video file, an image, a "
+                                         "folder of images or a pattern"));
   if (live_input && loops > 1)
-    return fail(job_failure::invalid_argument,
-                status::error("loops is for files, not devices or streams"));
+    return fail(status::invalid_argument("loops is for files, not devices or streams"));
 
   std::unique_ptr<estimator> est;
   const auto startup_t0 = clock_type::now();
   status st =
       make_estimator ? make_estimator(options, est) : create_estimator("onnx", options, est);
   s.startup_ms = seconds_since(startup_t0) * 1000.0;
-  if (!st.ok()) return fail(job_failure::input_io, st);
+  if (!st.ok()) return fail(st);  // io (models missing), unsupported (backend not built)
   if (on_open) {
     st = on_open(info);
-    if (!st.ok()) return fail(job_failure::output_io, st);
+    if (!st.ok()) return fail(st);
   }
   landmark_writer writer;
   landmark_file_header h;
@@ -159,7 +156,7 @@ status capture_file_job::run(capture_file_summary& s) const {
   h.image_height = info.height;
   h.fps = info.fps;
   st = writer.open(output, h);
-  if (!st.ok()) return fail(job_failure::output_io, st);
+  if (!st.ok()) return fail(st);
 
   // Frames are decoded on a second thread, a few ahead of the estimator (prefetch_ring):
   // decoding then overlaps inference. With loops the decoder reopens the input and keeps the
@@ -246,9 +243,9 @@ status capture_file_job::run(capture_file_summary& s) const {
     decoded& d = ring.next();
     if (d.kind != read_result::frame && in_flight) {  // end or a broken frame: drain first
       st = est->estimate_pipelined(nullptr, frame, ready);
-      if (!st.ok()) return fail(job_failure::internal, st);
+      if (!st.ok()) return fail(st);
       if (ready) st = emit(*in_flight);
-      if (!st.ok()) return fail(job_failure::output_io, st);
+      if (!st.ok()) return fail(st);
       ring.release();
       in_flight = nullptr;
     }
@@ -265,10 +262,10 @@ status capture_file_job::run(capture_file_summary& s) const {
     if (!st.ok()) {
       char at[48];
       std::snprintf(at, sizeof at, "frame at %.3f s: ", ea.t);
-      return fail(job_failure::internal, status::error(at + st.message()));
+      return fail(st.prefixed(at));
     }
     if (ready) st = emit(in_flight ? *in_flight : d);
-    if (!st.ok()) return fail(job_failure::output_io, st);
+    if (!st.ok()) return fail(st);
     if (!delayed) {
       ring.release();
     } else {
@@ -278,10 +275,10 @@ status capture_file_job::run(capture_file_summary& s) const {
   }
   s.end_reason = source.end_reason();
   st = writer.commit();
-  if (!st.ok()) return fail(job_failure::output_io, st);
+  if (!st.ok()) return fail(st);
   if (on_finish) {
     st = on_finish();
-    if (!st.ok()) return fail(job_failure::output_io, st);
+    if (!st.ok()) return fail(st);
   }
   s.capture_seconds = seconds_since(t0);
   s.estimator_description = est->describe();

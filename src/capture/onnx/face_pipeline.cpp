@@ -141,8 +141,8 @@ status face_pipeline::create(const face_pipeline_options& options,
   const std::string mesh_path = dir + "/" + model_file_name("face_landmark", options.precision);
   for (const std::string& p : {det_path, mesh_path})
     if (!std::ifstream(p).good())
-      return status::error("face_pipeline: cannot open " + p +
-                           missing_model_hint(options.precision));
+      return status::io_error("face_pipeline: cannot open " + p +
+                              missing_model_hint(options.precision));
 
   std::unique_ptr<impl> m(new impl());
   m->options = options;
@@ -166,9 +166,9 @@ status face_pipeline::create(const face_pipeline_options& options,
           });
         });
   } catch (const Ort::Exception& ex) {
-    return status::error("face_pipeline: ONNX Runtime: " + std::string(ex.what()));
+    return status::parse_error("face_pipeline: ONNX Runtime: " + std::string(ex.what()));
   }
-  if (!e.empty()) return status::error("face_pipeline: " + e);
+  if (!e.empty()) return status::parse_error("face_pipeline: " + e);
   generate_ssd_anchors(face_detection_anchor_options(), m->anchors);
   m->decode = face_detection_decode_options(options.min_detection_score);
   m->decoded.reserve(m->anchors.size());

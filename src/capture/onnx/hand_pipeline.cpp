@@ -383,8 +383,8 @@ status hand_pipeline::create(const hand_pipeline_options& options,
                       options.precision);
   for (const std::string& p : {palm_path, lm_path})
     if (!std::ifstream(p).good())
-      return status::error("hand_pipeline: cannot open " + p +
-                           missing_model_hint(options.precision));
+      return status::io_error("hand_pipeline: cannot open " + p +
+                              missing_model_hint(options.precision));
 
   std::unique_ptr<impl> m(new impl());
   m->options = options;
@@ -408,9 +408,9 @@ status hand_pipeline::create(const hand_pipeline_options& options,
           });
         });
   } catch (const Ort::Exception& ex) {
-    return status::error("hand_pipeline: ONNX Runtime: " + std::string(ex.what()));
+    return status::parse_error("hand_pipeline: ONNX Runtime: " + std::string(ex.what()));
   }
-  if (!e.empty()) return status::error("hand_pipeline: " + e);
+  if (!e.empty()) return status::parse_error("hand_pipeline: " + e);
   generate_ssd_anchors(palm_detection_anchor_options(), m->anchors);
   m->decode = palm_detection_decode_options();
   m->decode.min_score_thresh = options.min_detection_score;

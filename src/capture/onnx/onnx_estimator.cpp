@@ -93,7 +93,7 @@ class onnx_estimator final : public estimator {
     if (pending_) add_side_tasks(args_[prev], slot_[prev], slot_timings_[prev]);
     run_tasks();
     for (int i = 0; i < task_count_; ++i)
-      if (!task_error_[i].empty()) return status::error(task_error_[i]);
+      if (!task_error_[i].empty()) return status::internal(task_error_[i]);
     if (pending_) {
       merge_side_parts(slot_[prev]);
       out = slot_[prev];
@@ -162,7 +162,7 @@ class onnx_estimator final : public estimator {
   status finish(estimator_timings& tm) {
     add_total(tm);
     for (int i = 0; i < 3; ++i)
-      if (!task_error_[i].empty()) return status::error(task_error_[i]);
+      if (!task_error_[i].empty()) return status::internal(task_error_[i]);
     return {};
   }
 

@@ -224,8 +224,8 @@ status pose_pipeline::create(const pose_pipeline_options& options,
                       options.precision);
   for (const std::string& p : {det_path, lm_path})
     if (!std::ifstream(p).good())
-      return status::error("pose_pipeline: cannot open " + p +
-                           missing_model_hint(options.precision));
+      return status::io_error("pose_pipeline: cannot open " + p +
+                              missing_model_hint(options.precision));
 
   std::unique_ptr<impl> m(new impl());
   m->options = options;
@@ -249,9 +249,9 @@ status pose_pipeline::create(const pose_pipeline_options& options,
           });
         });
     m->has_heatmap = !found.empty() && found[0];
-    if (!e.empty()) return status::error("pose_pipeline: " + e);
+    if (!e.empty()) return status::parse_error("pose_pipeline: " + e);
   } catch (const Ort::Exception& ex) {
-    return status::error("pose_pipeline: ONNX Runtime: " + std::string(ex.what()));
+    return status::parse_error("pose_pipeline: ONNX Runtime: " + std::string(ex.what()));
   }
   if (options.smoothing == pose_smoothing::velocity) {
     m->smooth_image = landmark_smoother(mediapipe_velocity_params{5, 10.f});

@@ -210,7 +210,7 @@ status builtin_avatar_glb(const builtin_avatar_options& options, std::string& ou
 status write_builtin_avatar(const std::string& path, const builtin_avatar_options& options) {
   std::string bytes;
   if (status s = builtin_avatar_glb(options, bytes); !s)
-    return s.is_out_of_memory() ? s : status::error(path + ": " + s.message());
+    return s.is_out_of_memory() ? s : s.prefixed(path + ": ");
   try {
     return io_detail::write_file_atomically(path, bytes);
   } catch (const std::bad_alloc&) {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "avatarmap/core/limits.hpp"
 #include "avatarmap/core/rotation.hpp"
 #include "common/atomic_file.hpp"
 #include "rig/export/glb_builder.hpp"
@@ -33,17 +34,18 @@ status gather_buffers(const gltf_detail::gltf_document& doc, json& j, glb_builde
   std::vector<std::size_t> offset;
   if (j.contains("buffers")) {
     const json& buffers = j["buffers"];
-    if (!buffers.is_array()) return status::error(p + ": buffers is not an array");
+    if (!buffers.is_array()) return status::parse_error(p + ": buffers is not an array");
     for (std::size_t i = 0; i < buffers.size(); ++i) {
       const json& b = buffers[i];
       const std::string where = "buffers[" + std::to_string(i) + "]";
       if (!b.is_object() || !b.contains("byteLength") || !b["byteLength"].is_number_integer() ||
           b["byteLength"].get<std::int64_t>() < 0)
-        return status::error(p + ": " + where + " has no valid byteLength");
+        return status::parse_error(p + ": " + where + " has no valid byteLength");
       const auto length = static_cast<std::uint64_t>(b["byteLength"].get<std::int64_t>());
       std::string bytes;
       if (b.contains("uri")) {
-        if (!b["uri"].is_string()) return status::error(p + ": " + where + ".uri is not a string");
+        if (!b["uri"].is_string())
+          return status::parse_error(p + ": " + where + ".uri is not a string");
         if (status s = gltf_detail::read_gltf_uri(doc, b["uri"].get<std::string>(), where + ".uri",
                                                   total_read, bytes);
             !s)
@@ -51,12 +53,13 @@ status gather_buffers(const gltf_detail::gltf_document& doc, json& j, glb_builde
       } else if (doc.binary && i == 0) {
         bytes.assign(doc.bin());
       } else {
-        return status::error(p + ": " + where +
-                             " has no uri and is not the GLB's binary chunk; its data is nowhere");
+        return status::parse_error(
+            p + ": " + where +
+            " has no uri and is not the GLB's binary chunk; its data is nowhere");
       }
       if (bytes.size() < length)
-        return status::error(p + ": " + where + " declares " + std::to_string(length) +
-                             " bytes but its data has " + std::to_string(bytes.size()));
+        return status::parse_error(p + ": " + where + " declares " + std::to_string(length) +
+                                   " bytes but its data has " + std::to_string(bytes.size()));
       bytes.resize(static_cast<std::size_t>(length));
       offset.push_back(bin.append(bytes));
     }
@@ -64,16 +67,16 @@ status gather_buffers(const gltf_detail::gltf_document& doc, json& j, glb_builde
   // Points a {buffer, byteOffset} object into the BIN chunk.
   auto rebase = [&](json& view, const std::string& where) -> status {
     if (!view.contains("buffer") || !view["buffer"].is_number_integer())
-      return status::error(p + ": " + where + " has no valid buffer index");
+      return status::parse_error(p + ": " + where + " has no valid buffer index");
     const std::int64_t b = view["buffer"].get<std::int64_t>();
     if (b < 0 || b >= static_cast<std::int64_t>(offset.size()))
-      return status::error(p + ": " + where + " names buffer " + std::to_string(b) +
-                           ", out of range (the file has " + std::to_string(offset.size()) +
-                           " buffers)");
+      return status::parse_error(p + ": " + where + " names buffer " + std::to_string(b) +
+                                 ", out of range (the file has " + std::to_string(offset.size()) +
+                                 " buffers)");
     std::uint64_t start = 0;
     if (view.contains("byteOffset")) {
       if (!view["byteOffset"].is_number_integer() || view["byteOffset"].get<std::int64_t>() < 0)
-        return status::error(p + ": " + where + ".byteOffset is not a non-negative integer");
+        return status::parse_error(p + ": " + where + ".byteOffset is not a non-negative integer");
       start = static_cast<std::uint64_t>(view["byteOffset"].get<std::int64_t>());
     }
     view["buffer"] = 0;
@@ -82,11 +85,11 @@ status gather_buffers(const gltf_detail::gltf_document& doc, json& j, glb_builde
   };
   if (j.contains("bufferViews")) {
     json& views = j["bufferViews"];
-    if (!views.is_array()) return status::error(p + ": bufferViews is not an array");
+    if (!views.is_array()) return status::parse_error(p + ": bufferViews is not an array");
     for (std::size_t i = 0; i < views.size(); ++i) {
       const std::string where = "bufferViews[" + std::to_string(i) + "]";
       json& v = views[i];
-      if (!v.is_object()) return status::error(p + ": " + where + " is not an object");
+      if (!v.is_object()) return status::parse_error(p + ": " + where + " is not an object");
       if (status s = rebase(v, where); !s) return s;
       if (v.contains("extensions") && v["extensions"].is_object())
         for (auto it = v["extensions"].begin(); it != v["extensions"].end(); ++it)
@@ -106,13 +109,13 @@ status gather_images(const gltf_detail::gltf_document& doc, json& j, glb_builder
                      std::uint64_t& total_read) {
   if (!j.contains("images")) return {};
   json& images = j["images"];
-  if (!images.is_array()) return status::error(doc.path + ": images is not an array");
+  if (!images.is_array()) return status::parse_error(doc.path + ": images is not an array");
   for (std::size_t i = 0; i < images.size(); ++i) {
     json& image = images[i];
     if (!image.is_object() || !image.contains("uri")) continue;
     const std::string where = "images[" + std::to_string(i) + "].uri";
     if (!image["uri"].is_string())
-      return status::error(doc.path + ": " + where + " is not a string");
+      return status::parse_error(doc.path + ": " + where + " is not a string");
     std::string bytes;
     bool missing = false;
     if (status s = gltf_detail::read_gltf_uri(doc, image["uri"].get<std::string>(), where,
@@ -125,9 +128,10 @@ status gather_images(const gltf_detail::gltf_document& doc, json& j, glb_builder
     if (mime.empty() && image.contains("mimeType") && image["mimeType"].is_string())
       mime = image["mimeType"].get<std::string>();
     if (mime.empty())
-      return status::error(doc.path + ": " + where +
-                           ": cannot tell the image's format (not PNG, JPEG, WebP, KTX2, AVIF "
-                           "or DDS, and no mimeType given)");
+      return status::parse_error(
+          doc.path + ": " + where +
+          ": cannot tell the image's format (not PNG, JPEG, WebP, KTX2, AVIF "
+          "or DDS, and no mimeType given)");
     image.erase("uri");
     image["bufferView"] = bin.add_view(bytes);
     image["mimeType"] = mime;
@@ -204,16 +208,16 @@ status add_animation(const rig& r, const std::vector<rig_pose>& frames,
 status write_impl(const std::string& avatar_path, const rig& r, const std::vector<rig_pose>& frames,
                   const animated_glb_options& options, const std::string& out_path) {
   if (frames.empty()) return status::error(out_path + ": no frames to write");
-  if (!(options.fps > 0.0 && options.fps <= 1000.0))
-    return status::error(out_path + ": fps must be in (0, 1000]");
+  if (!(options.fps > 0.0 && options.fps <= k_max_fps))
+    return status::error(out_path + ": fps must be in (0, " + limit_text(k_max_fps) + "]");
   gltf_detail::gltf_document doc;
   if (status s = gltf_detail::open_gltf_document(avatar_path, doc); !s) return s;
   json j = std::move(doc.json);
   const std::size_t nodes = j.contains("nodes") && j["nodes"].is_array() ? j["nodes"].size() : 0;
   for (int k = 0; k < r.joint_count(); ++k)
     if (r.source_index[k] < 0 || static_cast<std::size_t>(r.source_index[k]) >= nodes)
-      return status::error(avatar_path + ": the rig does not belong to this file (joint '" +
-                           r.names[k] + "')");
+      return status::invalid_argument(
+          avatar_path + ": the rig does not belong to this file (joint '" + r.names[k] + "')");
 
   glb_builder bin(j);
   std::uint64_t total_read = 0;
@@ -224,7 +228,7 @@ status write_impl(const std::string& avatar_path, const rig& r, const std::vecto
   j["asset"]["generator"] = "avatarmap";
   std::string glb;
   if (status s = export_detail::make_glb(j, bin.bytes(), out_path, glb); !s)
-    return status::error(s.message() + "; use a shorter clip");
+    return s.with_message(s.message() + "; use a shorter clip");
   return io_detail::write_file_atomically(out_path, glb);
 }
 
@@ -238,9 +242,9 @@ status write_animated_glb(const std::string& avatar_path, const rig& r,
   } catch (const std::bad_alloc&) {
     return status::out_of_memory(out_path + ": not enough memory to write the animated avatar");
   } catch (const std::exception&) {
-    return status::error(out_path +
-                         ": cannot write the animated avatar (unexpected internal "
-                         "error)");
+    return status::internal(out_path +
+                            ": cannot write the animated avatar (unexpected internal "
+                            "error)");
   }
 }
 

@@ -95,7 +95,7 @@ class parser {
     return true;
   }
   bool fail_bool(const std::string& what) {
-    error_ = status::error(path_ + ":" + std::to_string(line_) + ": " + what);
+    error_ = status::parse_error(path_ + ":" + std::to_string(line_) + ": " + what);
     return false;
   }
   status fail(const std::string& what) {
@@ -232,26 +232,26 @@ status read_bvh(const std::string& path, bvh_clip& out) {
     std::error_code ec;
     const std::uintmax_t size = std::filesystem::file_size(path, ec);
     if (!ec && size > k_max_file_bytes)
-      return status::error(path + ": " + std::to_string(size) +
-                           " bytes, more than a BVH file may have here (1 GiB)");
+      return status::parse_error(path + ": " + std::to_string(size) +
+                                 " bytes, more than a BVH file may have here (1 GiB)");
     std::ifstream in(path, std::ios::binary);
-    if (!in) return status::error(path + ": cannot open the file");
+    if (!in) return status::io_error(path + ": cannot open the file");
     // Read in blocks up to the limit: a FIFO or a device has no size to check up front.
     std::string text;
     char block[1 << 16];
     while (in.read(block, sizeof block) || in.gcount() > 0) {
       text.append(block, static_cast<std::size_t>(in.gcount()));
       if (text.size() > k_max_file_bytes)
-        return status::error(path + ": more than the 1 GiB a BVH file may have here");
+        return status::parse_error(path + ": more than the 1 GiB a BVH file may have here");
     }
-    if (in.bad()) return status::error(path + ": read error");
-    if (text.empty()) return status::error(path + ": empty file (not a BVH)");
+    if (in.bad()) return status::io_error(path + ": read error");
+    if (text.empty()) return status::parse_error(path + ": empty file (not a BVH)");
     parser p(path, text);
     return p.parse(out);
   } catch (const std::bad_alloc&) {
     return status::out_of_memory(path + ": not enough memory to read the file");
   } catch (const std::exception&) {
-    return status::error(path + ": could not be read (an unexpected failure; please report it)");
+    return status::internal(path + ": could not be read (an unexpected failure; please report it)");
   }
 }
 

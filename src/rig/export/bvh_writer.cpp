@@ -107,11 +107,11 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
     }
     text.push_back('\n');
     if (text.size() > 1 << 16) {
-      if (!out.write(text)) return status::error(out.error());
+      if (!out.write(text)) return status::io_error(out.error());
       text.clear();
     }
   }
-  if (!out.write(text)) return status::error(out.error());
+  if (!out.write(text)) return status::io_error(out.error());
   return out.commit();
 }
 
@@ -122,7 +122,7 @@ status write_bvh(const std::string& path, const std::vector<proxy_pose>& frames,
   try {
     return write_impl(path, frames, options);
   } catch (const std::exception& e) {
-    return status::error(path + ": " + e.what());
+    return status::internal(path + ": " + e.what());
   }
 }
 

@@ -224,11 +224,11 @@ status write_impl(const std::string& path, const rig& r, const std::vector<rig_p
     }
     text.push_back('\n');
     if (text.size() > 1 << 16) {
-      if (!out.write(text)) return status::error(out.error());
+      if (!out.write(text)) return status::io_error(out.error());
       text.clear();
     }
   }
-  if (!out.write(text)) return status::error(out.error());
+  if (!out.write(text)) return status::io_error(out.error());
   return out.commit();
 }
 
@@ -239,7 +239,7 @@ status write_rig_bvh(const std::string& path, const rig& r, const std::vector<ri
   try {
     return write_impl(path, r, frames, options);
   } catch (const std::exception& e) {
-    return status::error(path + ": " + e.what());
+    return status::internal(path + ": " + e.what());
   }
 }
 

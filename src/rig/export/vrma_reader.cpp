@@ -225,11 +225,12 @@ int node_of(const json& entry, int node_count) {
 }
 
 status read_impl(const std::string& path, vrma_clip& out, const vrma_read_options& options) {
-  auto fail = [&path](const std::string& what) { return status::error(path + ": " + what); };
+  // The file's content: a parse error (the options are checked first, as arguments).
+  auto fail = [&path](const std::string& what) { return status::parse_error(path + ": " + what); };
   if (!std::isfinite(options.fps) || options.fps < 0.0)
-    return fail("fps must be 0 (key times) or positive");
+    return status::invalid_argument(path + ": fps must be 0 (key times) or positive");
   if (!std::isfinite(options.hips_height) || options.hips_height < 0.f)
-    return fail("hips_height must be 0 (keep) or positive");
+    return status::invalid_argument(path + ": hips_height must be 0 (keep) or positive");
 
   gltf_detail::gltf_document doc;
   if (status s = gltf_detail::open_gltf_document(path, doc); !s) return s;
@@ -514,9 +515,9 @@ status read_vrma(const std::string& path, vrma_clip& out, const vrma_read_option
   try {
     return read_impl(path, out, options);
   } catch (const std::exception& e) {
-    return status::error(path + ": " + e.what());
+    return status::internal(path + ": " + e.what());
   } catch (...) {
-    return status::error(path + ": unexpected error while reading");
+    return status::internal(path + ": unexpected error while reading");
   }
 }
 

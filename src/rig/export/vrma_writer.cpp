@@ -140,7 +140,7 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
 
   io_detail::text_output out;
   if (status s = out.open(path); !s) return s;
-  if (!out.write(glb)) return status::error(out.error());
+  if (!out.write(glb)) return status::io_error(out.error());
   return out.commit();
 }
 
@@ -151,9 +151,9 @@ status write_vrma(const std::string& path, const std::vector<proxy_pose>& frames
   try {
     return write_impl(path, frames, options);
   } catch (const std::exception& e) {
-    return status::error(path + ": " + e.what());
+    return status::internal(path + ": " + e.what());
   } catch (...) {
-    return status::error(path + ": unexpected error while writing");
+    return status::internal(path + ": unexpected error while writing");
   }
 }
 

@@ -11,20 +11,13 @@
 #include "avatarmap/jobs/retarget_clip.hpp"
 #include "avatarmap/time/resample_clip.hpp"
 #include "avatarmap/time/seconds_text.hpp"
+#include "rig/jobs/file_extension.hpp"
 
 namespace avatarmap {
 
 namespace {
 
-char lower_ascii(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
-
-bool ends_with_nocase(std::string_view s, std::string_view suffix) {
-  if (s.size() < suffix.size()) return false;
-  const std::string_view tail = s.substr(s.size() - suffix.size());
-  for (std::size_t i = 0; i < suffix.size(); ++i)
-    if (lower_ascii(tail[i]) != suffix[i]) return false;
-  return true;
-}
+using jobs_detail::ends_with_nocase;
 
 // "PATH: message" unless the message already names PATH.
 std::string naming(const std::string& path, const std::string& msg) {
@@ -66,8 +59,8 @@ status clip_output_job::validate() const {
   const clip_format_info* format = nullptr;
   if (status st = clip_format_for(path, format); !st.ok()) return st;
   if (!(std::isfinite(fps) && fps >= 0.0 && fps <= k_max_output_fps))
-    return status::error(path + ": fps must be 0 (the frames' own times) or in (0, 1000], got " +
-                         seconds_text(fps, 6));
+    return status::error(path + ": fps must be 0 (the frames' own times) or in (0, " +
+                         limit_text(k_max_fps) + "], got " + seconds_text(fps, 6));
   if (frames == nullptr) return status::error(path + ": clip_output_job.frames is not set");
   if (frames->empty())
     return status::error(path + ": the clip has no frames; add frames before writing it");
@@ -97,27 +90,22 @@ status clip_output_job::validate() const {
 
 status clip_output_job::run(clip_output_summary& s) const {
   s = clip_output_summary{};
-  auto fail = [&s](job_failure why, status st) {
-    s.failure = why;
-    return st;
-  };
-  if (status st = validate(); !st.ok()) return fail(job_failure::invalid_argument, st);
+  if (status st = validate(); !st.ok()) return st;
   const clip_format_info& format = *find_clip_format(path);
   s.format = &format;
   const std::string& name = what.empty() ? path : what;
   const bool on_avatar = writes_on_avatar(format, avatar_path);
   if (on_avatar && avatar_rig == nullptr)
-    return fail(job_failure::invalid_argument,
-                status::error(path + ": clip_output_job.avatar_rig is not set (build the rig of " +
-                              avatar_path + " first)"));
+    return status::invalid_argument(path +
+                                    ": clip_output_job.avatar_rig is not set (build the rig of " +
+                                    avatar_path + " first)");
 
   // One resampling for every format (resample_clip: in-order times, equal times allowed, the
   // later frame winning); the writers then get frames at fixed steps from t = 0.
   const double rate = fps > 0.0 ? fps : on_avatar ? k_default_rig_fps : 0.0;
   std::vector<proxy_pose> resampled;
   if (rate > 0.0) {
-    if (status st = resample_clip(*frames, rate, true, resampled, name); !st.ok())
-      return fail(job_failure::invalid_argument, st);
+    if (status st = resample_clip(*frames, rate, true, resampled, name); !st.ok()) return st;
   }
   const std::vector<proxy_pose>& written = rate > 0.0 ? resampled : *frames;
   s.fps = rate;
@@ -133,11 +121,9 @@ status clip_output_job::run(clip_output_summary& s) const {
     rj.keep_feet_on_ground = keep_feet_on_ground;
     rj.root_motion = root_motion;
     rj.what = name;
-    job_failure why = job_failure::none;
-    if (status st = rj.run(rig_poses, &why, &s.standing_hips_height); !st.ok())
-      return fail(why, why == job_failure::input_parse
-                           ? status::error(naming(avatar_path, st.message()))
-                           : st);
+    if (status st = rj.run(rig_poses, &s.standing_hips_height); !st.ok())
+      return st.code() == status_code::parse ? st.with_message(naming(avatar_path, st.message()))
+                                             : st;
   }
 
   status st;
@@ -175,10 +161,7 @@ status clip_output_job::run(clip_output_summary& s) const {
       break;
     }
   }
-  if (!st.ok()) {
-    if (st.is_out_of_memory()) return fail(job_failure::output_io, st);
-    return fail(job_failure::output_io, status::error(naming(path, st.message())));
-  }
+  if (!st.ok()) return st.is_out_of_memory() ? st : st.with_message(naming(path, st.message()));
   if (out_frames != nullptr) *out_frames = written;
   if (out_rig_poses != nullptr) *out_rig_poses = std::move(rig_poses);
   return {};

@@ -51,32 +51,23 @@ status retarget_clip_job::validate() const {
   return {};
 }
 
-status retarget_clip_job::run(std::vector<rig_pose>& out_poses, job_failure* out_failure,
-                              float* out_standing_height) const {
+status retarget_clip_job::run(std::vector<rig_pose>& out_poses, float* out_standing_height) const {
   out_poses.clear();
-  if (out_failure != nullptr) *out_failure = job_failure::none;
   if (out_standing_height != nullptr) *out_standing_height = 0.f;
-  auto fail = [&](job_failure why, status st) {
-    out_poses.clear();
-    if (out_failure != nullptr) *out_failure = why;
-    return st;
-  };
-  if (status st = validate(); !st.ok()) return fail(job_failure::invalid_argument, st);
+  if (status st = validate(); !st.ok()) return st;
   retarget_options ro;
   ro.keep_feet_on_ground = keep_feet_on_ground;
   ro.root_motion = root_motion;
   if (root_motion) {
     float h = 0.f;
-    if (status st = standing_hips_height(*frames, what, h); !st.ok())
-      return fail(job_failure::invalid_argument, st);
+    if (status st = standing_hips_height(*frames, what, h); !st.ok()) return st;
     ro.performer_hips_height = h;
     if (out_standing_height != nullptr) *out_standing_height = h;
   }
   // On the heap: the retargeter's constants are sized by the rig, and a C API caller's stack
   // may be small.
   auto rt = std::make_unique<retargeter>();
-  if (status st = rt->build(*target, binding, ro, table); !st.ok())
-    return fail(job_failure::input_parse, st);
+  if (status st = rt->build(*target, binding, ro, table); !st.ok()) return st;  // parse
   out_poses.resize(frames->size());
   for (std::size_t i = 0; i < frames->size(); ++i) {
     rt->prepare(out_poses[i]);

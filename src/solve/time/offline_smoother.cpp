@@ -120,13 +120,10 @@ status offline_smoother_options::validate() const {
     return range("position_sigma_seconds", "finite and > 0");
   if (!(finite_at_least(expression_sigma_seconds, 0.f) && expression_sigma_seconds > 0.f))
     return range("expression_sigma_seconds", "finite and > 0");
-  // A window several seconds wide is a strength nobody means (and a large buffer).
-  const float widest = strength * std::max({body_sigma_seconds, finger_sigma_seconds,
-                                            position_sigma_seconds, expression_sigma_seconds});
-  if (!(widest <= 2.f))
+  if (!(strength <= max_strength()))
     return range("strength", "such that strength x the largest sigma is at most 2 s");
   if (!(finite_at_least(low_confidence_sigma_seconds, 0.f) &&
-        strength * low_confidence_sigma_seconds <= 2.f))
+        strength * low_confidence_sigma_seconds <= k_widest_sigma_seconds))
     return range("low_confidence_sigma_seconds", "finite, >= 0 and at most 2 s x strength");
   if (!(min_sigma_frames >= 0.f && min_sigma_frames <= 10.f))
     return range("min_sigma_frames", "in [0, 10]");

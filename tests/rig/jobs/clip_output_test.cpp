@@ -240,7 +240,7 @@ TEST_F(clip_output, refusals_name_the_file_and_write_nothing) {
     clip_output_summary s;
     const status st = j.run(s);
     ASSERT_FALSE(st.ok()) << c.name;
-    EXPECT_EQ(s.failure, job_failure::invalid_argument) << c.name;
+    EXPECT_EQ(st.code(), status_code::invalid_argument) << c.name;
     EXPECT_NE(st.message().find(j.path), std::string::npos) << st.message();
     EXPECT_NE(st.message().find(c.words), std::string::npos) << st.message();
   }
@@ -255,7 +255,7 @@ TEST_F(clip_output, refusals_name_the_file_and_write_nothing) {
   clip_output_summary s;
   const status st = k.run(s);
   ASSERT_FALSE(st.ok());
-  EXPECT_EQ(s.failure, job_failure::output_io);
+  EXPECT_EQ(st.code(), status_code::io);
   EXPECT_NE(st.message().find("no-such-dir/x.bvh"), std::string::npos) << st.message();
   EXPECT_EQ(test::read_text(dir.file("keep.vrma")), "precious");
   for (const std::string& e : dir.entries()) EXPECT_EQ(e, "keep.vrma");

@@ -134,11 +134,10 @@ TEST(retarget_clip_job, gives_what_a_retargeter_at_the_standing_height_gives) {
     job.binding = r.declared_humanoid;
     job.keep_feet_on_ground = ground;
     std::vector<rig_pose> got;
-    job_failure why = job_failure::invalid_argument;
     float height = 0.f;
-    const status st = job.run(got, &why, &height);
+    const status st = job.run(got, &height);
     ASSERT_TRUE(st.ok()) << st.message();
-    EXPECT_EQ(why, job_failure::none);
+    EXPECT_EQ(st.code(), status_code::ok);
 
     // Independent reference: heights sorted by hand, the value at index n * 9 / 10.
     std::vector<float> h;
@@ -174,15 +173,14 @@ TEST(retarget_clip_job, refuses_a_clip_without_height_unless_root_motion_is_off)
   job.binding = r.declared_humanoid;
   job.what = "flat.vrma";
   std::vector<rig_pose> got(3);
-  job_failure why = job_failure::none;
-  status st = job.run(got, &why);
+  status st = job.run(got);
   ASSERT_FALSE(st.ok());
-  EXPECT_EQ(why, job_failure::invalid_argument);
+  EXPECT_EQ(st.code(), status_code::invalid_argument);
   EXPECT_NE(st.message().find("flat.vrma"), std::string::npos) << st.message();
   EXPECT_TRUE(got.empty());
   // Without root motion the height is not used: the hips keep their rest translation.
   job.root_motion = false;
-  st = job.run(got, &why);
+  st = job.run(got);
   ASSERT_TRUE(st.ok()) << st.message();
   ASSERT_EQ(got.size(), frames.size());
   EXPECT_EQ(got[5].hips_translation,
@@ -218,10 +216,9 @@ TEST(retarget_clip_job, validate_names_each_broken_field) {
   j = good();
   j.binding[idx(bone::hips)] = -1;
   std::vector<rig_pose> out;
-  job_failure why = job_failure::none;
-  const status st = j.run(out, &why);
+  const status st = j.run(out);
   ASSERT_FALSE(st.ok());
-  EXPECT_EQ(why, job_failure::input_parse);
+  EXPECT_EQ(st.code(), status_code::parse);
   EXPECT_NE(st.message().find("hips"), std::string::npos) << st.message();
 }
 

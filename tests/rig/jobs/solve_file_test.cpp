@@ -159,7 +159,7 @@ TEST_F(solve_file, sink_gets_exactly_the_frame_by_frame_poses_with_either_thread
     ASSERT_TRUE(st.ok()) << st.message();
     EXPECT_EQ(s.frames, 60);
     EXPECT_EQ(s.poses_written, 60);
-    EXPECT_EQ(s.failure, job_failure::none);
+    EXPECT_EQ(st.code(), status_code::ok);
     EXPECT_FALSE(s.image_size_assumed);  // the header's 1280x720
     EXPECT_EQ(s.image_width, 1280.f);
     EXPECT_DOUBLE_EQ(s.t_first, 1.0);
@@ -216,7 +216,7 @@ TEST(solve_file_inputs, a_source_error_ends_the_run_as_an_argument_error) {
   const status st = job.run(s);
   ASSERT_FALSE(st.ok());
   EXPECT_EQ(st.message(), "frame 2 is bad");
-  EXPECT_EQ(s.failure, job_failure::invalid_argument);
+  EXPECT_EQ(st.code(), status_code::invalid_argument);
   EXPECT_EQ(poses, 2);
   solve_file_job none;
   none.sink = job.sink;
@@ -333,7 +333,7 @@ TEST(solve_file_times, a_span_beyond_a_day_fails_as_an_argument_and_leaves_the_o
   solve_file_summary s;
   const status st = job.run(s);
   ASSERT_FALSE(st.ok());
-  EXPECT_EQ(s.failure, job_failure::invalid_argument);
+  EXPECT_EQ(st.code(), status_code::invalid_argument);
   EXPECT_NE(st.message().find("gap.landmarks.jsonl: frame 1"), std::string::npos) << st.message();
   EXPECT_NE(st.message().find("output_fps resamples at most 86400 s"), std::string::npos)
       << st.message();
@@ -354,7 +354,7 @@ TEST(solve_file_lines, a_bad_line_fails_naming_it_or_is_skipped_and_counted) {
     solve_file_summary s;
     status st = job.run(s);
     ASSERT_FALSE(st.ok());
-    EXPECT_EQ(s.failure, job_failure::input_parse);
+    EXPECT_EQ(st.code(), status_code::parse);
     EXPECT_NE(st.message().find("bad.landmarks.jsonl:2"), std::string::npos) << st.message();
     EXPECT_TRUE(test::read_text(out).empty());  // never created
 
@@ -397,7 +397,7 @@ TEST(solve_file_long, many_frames_in_batches_give_the_frame_by_frame_poses_and_e
     solve_file_summary s;
     status st = job.run(s);  // stops at the first bad line
     ASSERT_FALSE(st.ok());
-    EXPECT_EQ(s.failure, job_failure::input_parse);
+    EXPECT_EQ(st.code(), status_code::parse);
     EXPECT_NE(st.message().find("in.landmarks.jsonl:102"), std::string::npos) << st.message();
     EXPECT_FALSE(std::filesystem::exists(out));
 
@@ -433,7 +433,7 @@ TEST(solve_file_inputs, a_missing_input_is_an_input_error) {
   solve_file_summary s;
   const status st = job.run(s);
   ASSERT_FALSE(st.ok());
-  EXPECT_EQ(s.failure, job_failure::input_io);
+  EXPECT_EQ(st.code(), status_code::io);
   EXPECT_NE(st.message().find("none.landmarks.jsonl"), std::string::npos) << st.message();
 }
 
@@ -445,13 +445,13 @@ TEST(solve_file_inputs, a_sink_error_ends_the_run_as_an_output_error) {
   job.input = in;
   int calls = 0;
   job.sink = [&calls](const proxy_pose&) {
-    return ++calls == 3 ? status::error("sink full") : status{};
+    return ++calls == 3 ? status::io_error("sink full") : status{};
   };
   solve_file_summary s;
   const status st = job.run(s);
   ASSERT_FALSE(st.ok());
   EXPECT_EQ(st.message(), "sink full");
-  EXPECT_EQ(s.failure, job_failure::output_io);
+  EXPECT_EQ(st.code(), status_code::io);  // the sink's own code
   EXPECT_EQ(calls, 3);
 }
 
@@ -492,8 +492,9 @@ TEST(solve_file_validate, names_each_broken_field) {
     ASSERT_FALSE(st.ok()) << c.words;
     EXPECT_NE(st.message().find(c.words), std::string::npos) << st.message();
     solve_file_summary s;
-    EXPECT_FALSE(j.run(s).ok());
-    EXPECT_EQ(s.failure, job_failure::invalid_argument) << c.words;
+    const status run = j.run(s);
+    EXPECT_FALSE(run.ok());
+    EXPECT_EQ(run.code(), status_code::invalid_argument) << c.words;
   }
   // A sink replaces the output.
   solve_file_job j = good();

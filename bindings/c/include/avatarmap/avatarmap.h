@@ -64,6 +64,9 @@ AVATARMAP_C_API const char* avm_version_string(void);
 
 /* ---- status -------------------------------------------------------------------------- */
 
+/* Each failure of the library has a kind, and each kind its own status, one to one (the
+ * kinds and when they occur: docs/c-api.md, "Errors"). */
+
 typedef enum avm_status {
   AVM_OK = 0,
   AVM_ERROR_INVALID_ARGUMENT, /* NULL pointer, bad count, option out of range, ... */
@@ -78,6 +81,13 @@ typedef enum avm_status {
 /* Short English description of a status ("ok", "invalid argument", ...); "unknown status"
  * for values outside the enum. Static string; thread-safe. */
 AVATARMAP_C_API const char* avm_status_string(avm_status status);
+
+/* ---- limits (include/avatarmap/core/limits.hpp; the library checks they are equal) ------ */
+
+/* The highest frame rate any call accepts, frames per second (avm_clip_write's fps, ...). */
+#define AVM_MAX_FPS 1000.0
+/* The most threads avm_estimator_options.threads may ask for. */
+#define AVM_MAX_MODEL_THREADS 64
 
 /* ---- skeleton vocabulary ------------------------------------------------------------- */
 
@@ -289,8 +299,8 @@ typedef struct avm_solver_options {
    *    (avm_solver_push) always uses the One Euro filter above. Added in 0.1.0 after the
    *    fields above: a caller whose struct_size ends before them gets the defaults. -- */
   int32_t file_filter;  /* avm_file_filter; AVM_FILE_FILTER_OFFLINE */
-  float file_smoothing; /* offline: scale on the smoothing time constants, finite, [0, 10]
-                           (0 = fill gaps only); 1 */
+  float file_smoothing; /* offline: scale on the smoothing time constants, finite, [0, 6.66]
+                           (the widest kernel at most 2 s; 0 = fill gaps only); 1 */
   /* -- added in 0.1.0 after file_smoothing (a caller whose struct_size ends before it gets
    *    the default) -- */
   int32_t file_threads; /* threads of avm_solve_file / avm_solve_file_to_clip: 2 parses the
@@ -428,17 +438,49 @@ AVATARMAP_C_API avm_status avm_solve_file(const char* in_landmarks, const char* 
  *                   "unity_humanoid", "ue5_mannequin", "vrm1", ...);
  *   "PATH.json"     the table in that file (any name ending in ".json"); its per-bone
  *                   formulas, if any, apply.
- * The mappings folder is $AVATARMAP_MAPPINGS when that is set and not empty, else the folder
- * given to avm_set_mappings_folder(); it is read (all of its *.json but schema.json) by each
- * call that needs a table of it. The installed tables are in share/avatarmap/mappings. */
+ * The mappings folder is found as avm_find_resource(AVM_RESOURCE_MAPPINGS) says: the folder
+ * given to avm_set_mappings_folder(), else $AVATARMAP_MAPPINGS when that is set and not empty,
+ * else the installed tables (share/avatarmap/mappings beside this library), else the source
+ * tree's mappings/; it is read (all of its *.json but schema.json) by each call that needs a
+ * table of it. */
 
-/* Sets the process-wide mappings folder used when $AVATARMAP_MAPPINGS is unset or empty.
+/* Sets the process-wide mappings folder, which takes precedence over $AVATARMAP_MAPPINGS and
+ * the installed and source-tree tables.
  * The string is copied; NULL or "" forgets the folder. Calls that start afterwards use the
  * new folder; calls already running keep the one they read.
  * Failures: AVM_ERROR_OUT_OF_MEMORY (the previous folder is kept). The folder is not checked
  * here: a missing folder is reported by the call that needs it.
  * Thread-safe (may be called at any time from any thread). */
 AVATARMAP_C_API avm_status avm_set_mappings_folder(const char* folder);
+
+/* ---- shipped folders ------------------------------------------------------------------ */
+
+/* The folders the library looks for (docs/architecture.md, "Resources"). */
+typedef enum avm_resource {
+  AVM_RESOURCE_MAPPINGS = 0,      /* the mapping tables */
+  AVM_RESOURCE_MODELS = 1,        /* the converted ONNX models (the models cache's onnx/) */
+  AVM_RESOURCE_VIEWER_PAGE = 2,   /* the browser viewer's page */
+  AVM_RESOURCE_VIEWER_MODULES = 3 /* three.js and three-vrm for the viewer */
+} avm_resource;
+
+/* Finds one of the shipped folders in the one order the command-line tool and the Python
+ * package use too: `explicit_folder` when not NULL or "" (for AVM_RESOURCE_MAPPINGS, NULL
+ * means the folder given to avm_set_mappings_folder()); else the environment
+ * ($AVATARMAP_MAPPINGS, $AVATARMAP_MODELS + "/onnx", $AVATARMAP_VIEWER_PAGE,
+ * $AVATARMAP_VIEWER_MODULES) when set and not empty; else the installed folder beside this
+ * library (LIBDIR/../share/avatarmap/...) when it exists; else the source tree the library was
+ * built from when that folder exists. The first two are taken unchecked.
+ * `kind` is an avm_resource. Writes the folder to out_folder (folder_size bytes) and the rule
+ * that found it to out_rule (rule_size bytes: "argument", "environment AVATARMAP_MODELS" (the
+ * variable's name), "installed", "source tree"); either may be NULL when its size is 0; both
+ * are "" unless AVM_OK. `err` as avm_solve_file's.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (an unknown kind, or a buffer too small for the folder
+ *   or the rule: nothing is truncated and err says the size needed), AVM_ERROR_IO (no rule
+ *   found a folder: err lists every place looked at), AVM_ERROR_OUT_OF_MEMORY.
+ * Thread-safe (reads the environment and the file system on each call). */
+AVATARMAP_C_API avm_status avm_find_resource(int kind, const char* explicit_folder,
+                                             char* out_folder, size_t folder_size, char* out_rule,
+                                             size_t rule_size, char* err, size_t err_size);
 
 /* ---- retargeting onto an avatar ------------------------------------------------------ */
 
@@ -538,20 +580,19 @@ AVATARMAP_C_API int avm_clip_frame_count(const avm_clip* clip);
  *   .glb         the avatar at avatar_path (required; .vrm, .glb or .gltf) with the clip as a
  *                glTF animation of its joints, bound as `mapping` says (see "mapping tables";
  *                NULL = "auto"); meshes, materials and extensions are kept.
- * `fps` > 0 (at most 1000) resamples the clip at that rate from its first frame (slerp on the
- * shortest arc, linear for positions and weights); 0 keeps the frames' own times (.vrma keys
- * at those times, the proxy .bvh plays them at their mean spacing, .pose.jsonl writes them as
- * they are), except with an avatar (.glb, .bvh of the rig), which needs a fixed rate and is
- * resampled at 30 fps. Times are written from 0 (the first frame's t is subtracted), except
- * in .pose.jsonl at fps 0.
- * The file is written atomically (a temporary file beside `path` renamed over it), so on
+ * `fps` > 0 (at most AVM_MAX_FPS) resamples the clip at that rate from its first frame (slerp on
+ * the shortest arc, linear for positions and weights); 0 keeps the frames' own times (.vrma keys at
+ * those times, the proxy .bvh plays them at their mean spacing, .pose.jsonl writes them as they
+ * are), except with an avatar (.glb, .bvh of the rig), which needs a fixed rate and is resampled at
+ * 30 fps. Times are written from 0 (the first frame's t is subtracted), except in .pose.jsonl at
+ * fps 0. The file is written atomically (a temporary file beside `path` renamed over it), so on
  * failure an existing file at `path` is untouched. The clip is not changed: it may be written
  * again, e.g. in another format.
  * When `err` is not NULL and err_size > 0, a NUL-terminated message (truncated to fit) is
  * written there: "" on success, else what failed, naming the file; avm_clip_last_error() gives
  * the same message.
  * Failures: AVM_ERROR_INVALID_ARGUMENT (clip or path NULL, the clip has no frames, fps
- *     negative, above 1000 or not finite, an unknown extension, .glb without avatar_path,
+ *     negative, above AVM_MAX_FPS or not finite, an unknown extension, .glb without avatar_path,
  *     `mapping` names no table, the clip spans more than 24 hours (86400 s from its first
  *     frame to its last) or would be more than 4194304 frames at the rate written),
  *   AVM_ERROR_IO (cannot write `path`; the avatar, table or mappings folder cannot be read,
@@ -594,12 +635,13 @@ typedef struct avm_image {
 typedef struct avm_estimator_options {
   uint32_t struct_size;          /* sizeof(avm_estimator_options) as the caller knows it */
   const char* models_dir;        /* the converted models (scripts/prepare_capture.sh makes them);
-                                    NULL or "": $AVATARMAP_MODELS/onnx. Read during create only. */
+                                    NULL or "": avm_find_resource(AVM_RESOURCE_MODELS) (first
+                                    $AVATARMAP_MODELS/onnx). Read during create only. */
   int32_t model_complexity;      /* body landmark model: 0 lite, 1 full (default), 2 heavy */
   int32_t hands;                 /* estimate both hands (default 1) */
   int32_t face;                  /* estimate the face mesh (default 1) */
   int32_t hand_model_complexity; /* hand landmark model: 0 lite, 1 full (default) */
-  int32_t threads;               /* ONNX Runtime threads, 1 .. 64 (default 2) */
+  int32_t threads;               /* ONNX Runtime threads, 1 .. AVM_MAX_MODEL_THREADS (default 2) */
   int32_t mirrored;              /* the images are mirrored (a selfie preview); default 0 */
   int32_t static_images;         /* detect on every image (unrelated stills); default 0 */
 } avm_estimator_options;
@@ -627,7 +669,7 @@ typedef struct avm_estimator avm_estimator;
  * avm_estimator_destroy()).
  * Failures (*out is set to NULL whenever out is not NULL):
  *   AVM_ERROR_INVALID_ARGUMENT: out NULL, a field out of range, no models folder given and
- *     $AVATARMAP_MODELS unset;
+ *     none found (avm_find_resource(AVM_RESOURCE_MODELS));
  *   AVM_ERROR_IO: the models are missing or unreadable (the message names the folder);
  *   AVM_ERROR_UNSUPPORTED: this library was built without the ONNX Runtime backend;
  *   AVM_ERROR_OUT_OF_MEMORY; AVM_ERROR_INTERNAL. avm_last_create_error() says which.
@@ -808,14 +850,17 @@ AVATARMAP_C_API avm_status avm_solve_file_to_clip(const char* in_landmarks,
 
 /* ---- clips: more than one pose at a time, and reading pose files ----------------------- */
 
-/* Reads a *.pose.jsonl file (docs/file-formats.md) into a new clip, its frames as written
- * (times as in the file, which must increase as avm_clip_add() requires) and the header's
- * nominal rate (a .pose.jsonl written from the clip at fps 0 keeps it). On success *out is
- * a new handle owned by the caller (free it with avm_clip_destroy()); on failure *out is NULL
- * (when out is not NULL). err as avm_clip_write().
- * Failures: AVM_ERROR_INVALID_ARGUMENT (path or out NULL), AVM_ERROR_IO (cannot open),
- *   AVM_ERROR_PARSE (a malformed line or a time not after the previous frame's:
- *   "FILE:LINE: ..."), AVM_ERROR_OUT_OF_MEMORY. Thread-safe. */
+/* Reads a *.pose.jsonl file (docs/file-formats.md) or a .vrma into a new clip with the
+ * reader avm_convert_file() uses (avm_motion_input_kind()'s rule): the frames put in time
+ * order by its one rule (sorted stably; frames at equal times are kept, the later one winning
+ * when the clip is resampled) and the header's nominal rate (a .pose.jsonl written from the
+ * clip at fps 0 keeps it; 0 for a .vrma). On success *out is a new handle owned by the caller
+ * (free it with avm_clip_destroy()); on failure *out is NULL (when out is not NULL). err as
+ * avm_clip_write().
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (path or out NULL; a landmark file (solve it with
+ *   avm_solve_file_to_clip()) or no motion file), AVM_ERROR_IO (cannot open),
+ *   AVM_ERROR_PARSE (a malformed line: "FILE:LINE: ...", or .vrma), AVM_ERROR_OUT_OF_MEMORY.
+ *   Thread-safe. */
 AVATARMAP_C_API avm_status avm_clip_read(const char* path, avm_clip** out, char* err,
                                          size_t err_size);
 
@@ -831,6 +876,92 @@ AVATARMAP_C_API avm_status avm_clip_get_poses(const avm_clip* clip, int64_t firs
  * Failures: AVM_ERROR_INVALID_ARGUMENT (clip NULL, poses NULL with count > 0, count negative,
  *   a t not finite or not after the previous one's), AVM_ERROR_OUT_OF_MEMORY. */
 AVATARMAP_C_API avm_status avm_clip_add_poses(avm_clip* clip, const avm_pose* poses, int64_t count);
+
+/* ---- convert: a motion file into an animation file ------------------------------------- */
+
+/* The kinds of motion file avm_convert_file() reads. */
+typedef enum avm_motion_input {
+  AVM_MOTION_INPUT_NONE = 0,      /* none of these: avm_convert_file() refuses it */
+  AVM_MOTION_INPUT_LANDMARKS = 1, /* *.landmarks.jsonl: solved first */
+  AVM_MOTION_INPUT_POSES = 2,     /* *.pose.jsonl */
+  AVM_MOTION_INPUT_VRMA = 3       /* *.vrma (VRM Animation) */
+} avm_motion_input;
+
+/* The kind of motion file at `path` (an avm_motion_input), by the library's one rule (the CLI's
+ * `convert` and the Python package use it too): the name's extension in any case
+ * (.landmarks.jsonl, .pose.jsonl, .vrma); else "-" is landmarks; else a regular file's first
+ * bytes ("glTF": .vrma; a JSON header whose "format" is "avatarmap.pose" or
+ * "avatarmap.landmarks"); else a name ending in .jsonl is landmarks; else NONE (NULL too).
+ * *out_stem_length (may be NULL) gets the length of `path` without the extension that decided
+ * (without its last extension when the content did; 0 for NONE). Reads at most the first
+ * 256 bytes of a regular file, never of a FIFO or device. Thread-safe; cannot fail. */
+AVATARMAP_C_API int avm_motion_input_kind(const char* path, size_t* out_stem_length);
+
+/* Called with each warning of avm_convert_file() (one sentence, no "warning:" prefix; the
+ * string is valid during the call only), on the calling thread. */
+typedef void (*avm_warning_fn)(void* user, const char* message);
+
+/* Options of avm_convert_file(). Initialise with avm_convert_options_init(), then change
+ * fields (struct_size as for avm_solver_options). */
+typedef struct avm_convert_options {
+  uint32_t struct_size; /* sizeof(avm_convert_options) as the caller knows it */
+  double fps;           /* 0 (the default): the frames' own times (avatar outputs: 30 fps);
+                           > 0: resampled at that rate, at most AVM_MAX_FPS (as avm_clip_write) */
+  const char* avatar;   /* the avatar file (.vrm, .glb, .gltf): needed by .glb, turns .bvh into
+                           the avatar's rig, unused (not loaded) by .vrma and .pose.jsonl;
+                           NULL (default): none */
+  const char* mapping;  /* how the avatar is bound ("mapping tables" above); NULL = "auto" */
+  int32_t keep_feet_on_ground; /* keep the avatar's lowest foot on the floor; 0 */
+  int32_t root_motion;         /* move the hips as captured (0: keep them at rest); 1 */
+  /* How a landmark input is solved; NULL (default) = avm_solver_options_init()'s defaults.
+   * Must be NULL for other inputs (AVM_ERROR_INVALID_ARGUMENT). Read during the call only. */
+  const avm_solver_options* solver;
+  avm_warning_fn warning; /* NULL (default): warnings are only counted in the summary */
+  void* user;             /* passed to `warning` */
+} avm_convert_options;
+
+/* Fills the first `size` bytes of `options` with the defaults above and sets struct_size =
+ * size, as avm_solver_options_init_sized() (size at least 16, at most 4096, a multiple of 4).
+ * Thread-safe. */
+AVATARMAP_C_API avm_status avm_convert_options_init_sized(avm_convert_options* options,
+                                                          size_t size);
+/* The function, for binaries built before the macro below. */
+AVATARMAP_C_API avm_status avm_convert_options_init(avm_convert_options* options);
+#define avm_convert_options_init(options) \
+  avm_convert_options_init_sized((options), sizeof(avm_convert_options))
+
+/* What avm_convert_file() did (filled as far as it got when it fails). Set struct_size =
+ * sizeof(avm_convert_summary) before the call (a smaller one is refused). */
+typedef struct avm_convert_summary {
+  uint32_t struct_size;
+  int32_t input_kind;          /* an avm_motion_input */
+  int64_t frames_read;         /* poses read (or solved) from the input, before resampling */
+  int64_t frames_out_of_order; /* frames earlier than the one before them (sorted; warned) */
+  int64_t frames_written;
+  double fps;     /* the rate written; 0: the frames' own times */
+  double seconds; /* wall-clock time of the call */
+} avm_convert_summary;
+
+/* `avatarmap convert INPUT -o OUTPUT` as a library call (the same library job: the same input
+ * and options give the same bytes): reads INPUT by avm_motion_input_kind()'s rule (landmarks
+ * solved as avm_solve_file_to_clip() solves them with options->solver), puts its frames in
+ * time order (stably: sorted, with one warning that counts the frames that were out of order;
+ * every input, every output), binds the avatar when the output uses one (before reading: a bad
+ * avatar fails first) and writes OUTPUT as avm_clip_write() would (its formats, resampling and
+ * limits), atomically: on failure an existing file is untouched. `options` NULL means the
+ * defaults. `out_summary` (struct_size set) may be NULL. err as avm_solve_file().
+ * Failures: AVM_ERROR_INVALID_ARGUMENT (a path NULL; bad options or struct_size; an unknown
+ *     input kind or output extension; .glb without options->avatar; options->solver for an
+ *     input that is no landmark file; an input with no frames; a span or size avm_clip_write
+ *     refuses),
+ *   AVM_ERROR_IO (the input, the avatar or a table cannot be read; the output cannot be
+ *     written), AVM_ERROR_PARSE (a malformed line ("FILE:LINE: ...") or .vrma; the avatar or a
+ *     table malformed or unfit), AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL.
+ * Thread-safe (separate files). */
+AVATARMAP_C_API avm_status avm_convert_file(const char* input, const char* output,
+                                            const avm_convert_options* options,
+                                            avm_convert_summary* out_summary, char* err,
+                                            size_t err_size);
 
 /* ---- retargeting many poses ------------------------------------------------------------ */
 
@@ -871,9 +1002,11 @@ typedef void (*avm_progress_fn)(void* user, int64_t done, int64_t total);
  * Frames that cannot be decoded are skipped and counted (frames_not_decoded).
  * Failures: AVM_ERROR_INVALID_ARGUMENT (a path NULL, a device or stream, bad options or
  *   out_summary->struct_size, no models folder), AVM_ERROR_IO (the input cannot be opened or
- *   read, the output cannot be written, the models are missing), AVM_ERROR_UNSUPPORTED
- *   (built without ONNX Runtime or FFmpeg), AVM_ERROR_OUT_OF_MEMORY, AVM_ERROR_INTERNAL (the
- *   estimator failed on a frame: the message gives its time). Thread-safe (separate files). */
+ *   read, the output cannot be written, the models are missing), AVM_ERROR_PARSE (the input
+ *   is not media FFmpeg can read, a model cannot be loaded), AVM_ERROR_UNSUPPORTED (built
+ *   without ONNX Runtime or FFmpeg, a codec this FFmpeg lacks), AVM_ERROR_OUT_OF_MEMORY,
+ *   AVM_ERROR_INTERNAL (the estimator failed on a frame: the message gives its time).
+ *   Thread-safe (separate files). */
 AVATARMAP_C_API avm_status avm_capture_file(const char* input, const char* out_landmarks,
                                             const avm_estimator_options* options,
                                             avm_capture_summary* out_summary,
