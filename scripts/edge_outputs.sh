@@ -5,7 +5,7 @@
 #   scripts/edge_outputs.sh BUILD_A OUT_A; scripts/edge_outputs.sh BUILD_B OUT_B
 #   diff OUT_A/SHA256SUMS OUT_B/SHA256SUMS
 # BUILD_DIR holds avatarmap and bindings/c/libavatarmap_c.so; OUT_DIR must be new or empty.
-# Inputs: $AVATARMAP_TEST_DATA (default /work/shared/data), $AVATARMAP_MODELS (default
+# Inputs: $AVATARMAP_TEST_DATA (default <repo>/../shared/data), $AVATARMAP_MODELS (default
 # <repo>/.cache/avatarmap/models), $PYTHON (default: the first python3 with NumPy).
 # Besides the outputs, the list holds NAME.refused (exit status and message of a command
 # expected to fail, or of a Python call that refuses what the CLI takes), NAME.warnings
@@ -21,7 +21,7 @@ fi
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build=$(cd "$1" && pwd)
 out=$2
-data=${AVATARMAP_TEST_DATA:-/work/shared/data}
+data=${AVATARMAP_TEST_DATA:-$here/../shared/data}
 export AVATARMAP_MODELS=${AVATARMAP_MODELS:-$here/.cache/avatarmap/models}
 pydir=${AVATARMAP_PYTHON_DIR:-$here/bindings/python}
 A=$build/avatarmap

@@ -78,6 +78,8 @@ class text_output {
   /// First write error ("PATH: write failed: No space left on device; the previous file is
   /// unchanged").
   const std::string& error() const { return error_; }
+  /// error() as a status: a write error is an I/O error (status_code::io).
+  status error_status() const { return status::io_error(error_); }
 
  private:
   void discard();

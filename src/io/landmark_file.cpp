@@ -568,7 +568,7 @@ status landmark_writer::open(const std::string& path, const landmark_file_header
 status landmark_writer::write(const landmark_frame& frame) {
   auto& o = impl_->out;
   if (!o.is_open()) return status::error(o.path() + ": write() on a writer that is not open");
-  if (!o.reserve(64)) return status::io_error(o.error());
+  if (!o.reserve(64)) return o.error_status();
   o.put("{\"t\":");
   o.put_number(frame.t);
   for (int p = 0; p < k_frame_part_count; ++p) {
@@ -580,14 +580,14 @@ status landmark_writer::write(const landmark_frame& frame) {
     if (fp == frame_part::face) {
       count = frame.face_count == k_face_mesh_count ? k_face_mesh_count : k_face_mesh_iris_count;
     }
-    if (!o.reserve(32)) return status::io_error(o.error());
+    if (!o.reserve(32)) return o.error_status();
     o.put(",\"");
     o.put(frame_part_key(fp));
     o.put("\":");
     bool five = fp == frame_part::pose || fp == frame_part::pose_world;
-    if (!impl_->put_points(pts, count, five)) return status::io_error(o.error());
+    if (!impl_->put_points(pts, count, five)) return o.error_status();
   }
-  if (!o.reserve(2)) return status::io_error(o.error());
+  if (!o.reserve(2)) return o.error_status();
   o.put("}\n");
   return {};
 }

@@ -322,7 +322,7 @@ status pose_writer::open(const std::string& path, const pose_file_header& header
 status pose_writer::write(const proxy_pose& pose) {
   auto& o = impl_->out;
   if (!o.is_open()) return status::error(o.path() + ": write() on a writer that is not open");
-  if (!io_detail::put_pose_line(o, pose, impl_->options)) return status::io_error(o.error());
+  if (!io_detail::put_pose_line(o, pose, impl_->options)) return o.error_status();
   return {};
 }
 

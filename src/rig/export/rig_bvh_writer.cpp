@@ -224,11 +224,11 @@ status write_impl(const std::string& path, const rig& r, const std::vector<rig_p
     }
     text.push_back('\n');
     if (text.size() > 1 << 16) {
-      if (!out.write(text)) return status::io_error(out.error());
+      if (!out.write(text)) return out.error_status();
       text.clear();
     }
   }
-  if (!out.write(text)) return status::io_error(out.error());
+  if (!out.write(text)) return out.error_status();
   return out.commit();
 }
 

@@ -140,7 +140,7 @@ status write_impl(const std::string& path, const std::vector<proxy_pose>& frames
 
   io_detail::text_output out;
   if (status s = out.open(path); !s) return s;
-  if (!out.write(glb)) return status::io_error(out.error());
+  if (!out.write(glb)) return out.error_status();
   return out.commit();
 }
 
