@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/rig/foot_lock.hpp"
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/synth/random_pose.hpp"
@@ -63,6 +64,34 @@ void BM_retarget_55_bones(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_retarget_55_bones)->Arg(0)->Arg(1);
+
+// The retarget followed by foot locking (rig/foot_lock.hpp) with both feet planted (Arg 1:
+// two legs of IK, the hips lowered where needed, the floor clamp) or free (Arg 0: the forward
+// kinematics and the floor check only). The difference to BM_retarget_55_bones/0 is the lock's
+// cost per frame.
+void BM_retarget_foot_lock(benchmark::State& state) {
+  bone_binding binding;
+  const rig r = make_rig(binding);
+  retargeter rt;
+  if (!rt.build(r, binding).ok()) state.SkipWithError("build failed");
+  foot_lock lock;
+  if (!lock.build(rt).ok() || !lock.leg_enabled(0) || !lock.leg_enabled(1))
+    state.SkipWithError("foot lock build failed");
+  rig_pose out;
+  rt.prepare(out);
+  std::mt19937 rng(4);
+  std::vector<proxy_pose> poses;
+  for (int i = 0; i < 64; ++i) poses.push_back(random_pose(rng));
+  const float c = state.range(0) != 0 ? 1.f : 0.f;
+  const std::array<float, 2> contact = {c, c};
+  size_t i = 0;
+  for (auto _ : state) {
+    rt.apply(poses[i++ & 63], out);
+    lock.apply(contact, out);
+    benchmark::DoNotOptimize(out.local_rotations.data());
+  }
+}
+BENCHMARK(BM_retarget_foot_lock)->Arg(0)->Arg(1);
 
 }  // namespace
 

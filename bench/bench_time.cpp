@@ -1,8 +1,9 @@
 // Time filtering and resampling (avatarmap/time/*): cost per frame of pose_filter on a full
 // proxy_pose (55 rotations + hips + 16 expressions), landmark_filter on a full frame
 // (33 + 33 + 4 x 21 + 478 points), offline_smoother (push + pop) on solved poses of the
-// synthetic noisy scenario, and pose_resampler::sample() (interpolating and extrapolating),
-// with a proxy_pose copy as the floor.
+// synthetic noisy scenario, pose_resampler::sample() (interpolating and extrapolating) and
+// the foot contact stage (causal and both-sided: FK of both feet, contacts, root motion, one
+// pose copy in and one out), with a proxy_pose copy as the floor.
 #include <benchmark/benchmark.h>
 
 #include <cstring>
@@ -12,6 +13,7 @@
 
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/synth/synth_recording.hpp"
+#include "avatarmap/time/foot_contacts.hpp"
 #include "avatarmap/time/offline_smoother.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
@@ -173,6 +175,23 @@ void bm_resampler_sample(benchmark::State& state) {
   }
 }
 BENCHMARK(bm_resampler_sample)->Arg(0)->Arg(1)->ArgName("extrapolate");
+
+void bm_foot_contacts(benchmark::State& state) {
+  pose_cycle c;
+  for (auto& p : c.poses) p.confidence.fill(1.f);
+  foot_contact_stage stage({}, state.range(0) != 0);
+  proxy_pose out;
+  double t = 0.0;
+  int i = 0;
+  for (auto _ : state) {
+    proxy_pose& in = c.poses[i++ & (pose_cycle::k_count - 1)];
+    in.t = t;
+    t += 1.0 / 30.0;
+    benchmark::DoNotOptimize(stage.push(in, out));
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(bm_foot_contacts)->Arg(0)->Arg(1)->ArgName("both_sided");
 
 }  // namespace
 

@@ -8,6 +8,11 @@
 // the text box; the page logs "avatarmap-viewer: first posed frame N ms" and sends
 // {"first_posed_ms": N} to the server once it has drawn its first posed frame (N counted from
 // the start of the page's navigation).
+//
+// Render mode (?render=1; docs/world-benchmark-rendered.md): a fixed camera from the URL, a plain
+// background and floor, no WebSocket, no animation loop — a frame is drawn only when asked:
+// window.avatarmapViewer.renderAt(t) (the clip at time t) or renderPose(pose) (one pose object or
+// *.pose.jsonl line), each a promise resolved once the frame is on screen (for screenshots).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -16,7 +21,56 @@ import { VRMAnimationLoaderPlugin, createVRMAnimationClip } from '@pixiv/three-v
 
 const params = new URLSearchParams(location.search);
 const hudElement = document.getElementById('hud');
-if (params.get('hud') === '0') hudElement.style.display = 'none';
+const renderMode = params.get('render') === '1';
+if (params.get('hud') === '0' || renderMode) hudElement.style.display = 'none';
+
+// Render mode's URL parameters (all optional): w, h (canvas pixels, device pixel ratio 1),
+// cam=x,y,z (metres, the avatar's world: Y up, floor Y = 0, the avatar faces +Z), either
+// look=x,y,z or yaw/pitch (degrees: yaw 0 looks along -Z, positive turns left; pitch positive
+// looks up), roll (degrees, positive turns the camera counterclockwise as it looks: the scene
+// turns clockwise in the image), hfov (horizontal field of view, degrees; converted to three.js's
+// vertical one by tan(v/2) = tan(h/2) * h/w) or vfov, bg and floorColor (RRGGBB), floor=0 (none),
+// performerHips (metres: the performer's standing hips height; poses' hips positions are scaled
+// by the avatar's rest hips height over it and placed absolutely, not relative to the first
+// pose), marker=BONE[,BONE...] (a small magenta dot drawn on top at each bone, for tests).
+// A malformed parameter keeps its default and is named in state.error; ready() then rejects.
+const renderErrors = [];
+function numberList(name, count, fallback) {
+  const text = params.get(name);
+  if (text === null) return fallback;
+  const values = text.split(',').map(Number);
+  if (values.length === count && values.every(Number.isFinite)) return values;
+  renderErrors.push(`render mode: ${name}=${text} is not ${count} comma-separated numbers`);
+  return fallback;
+}
+function number(name, fallback) {
+  const text = params.get(name);
+  if (text === null) return fallback;
+  const value = Number(text);
+  if (text.trim() !== '' && Number.isFinite(value)) return value;
+  renderErrors.push(`render mode: ${name}=${text} is not a number`);
+  return fallback;
+}
+function colour(name, fallback) {
+  const text = params.get(name);
+  return text !== null && /^[0-9a-fA-F]{6}$/.test(text) ? parseInt(text, 16) : fallback;
+}
+const render = renderMode ? {
+  width: Math.round(number('w', 640)),
+  height: Math.round(number('h', 360)),
+  cam: numberList('cam', 3, [0, 1.4, 3.5]),
+  look: numberList('look', 3, null),
+  yaw: number('yaw', 0),
+  pitch: number('pitch', 0),
+  roll: number('roll', 0),
+  hfov: number('hfov', null),
+  vfov: number('vfov', null),
+  background: colour('bg', 0xb4b8bd),
+  floor: params.get('floor') !== '0',
+  floorColour: colour('floorColor', 0x8c8f86),
+  performerHips: number('performerHips', null),
+  markers: (params.get('marker') || '').split(',').filter((m) => m),
+} : null;
 
 const state = {
   avatar: 'none',        // none | loading | ready | failed
@@ -33,15 +87,19 @@ const state = {
   clipDuration: null,
   firstPosedMs: null,
   frames: 0,
-  error: '',
+  error: renderErrors.join('; '),
+  render: renderMode,
+  camera: null,          // render mode: the camera used (position, quaternion, fovs, size)
+  hipsScale: null,       // render mode: avatar metres per performer metre
 };
 window.avatarmapViewer = { state: () => ({ ...state }) };
 
 // ---- scene ----------------------------------------------------------------------------------
 const renderer = new THREE.WebGLRenderer({ antialias: true });
-renderer.setPixelRatio(window.devicePixelRatio);
-renderer.setSize(window.innerWidth, window.innerHeight);
-renderer.setClearColor(0x1e2430);
+renderer.setPixelRatio(renderMode ? 1 : window.devicePixelRatio);
+if (renderMode) renderer.setSize(render.width, render.height);
+else renderer.setSize(window.innerWidth, window.innerHeight);
+renderer.setClearColor(renderMode ? render.background : 0x1e2430);
 renderer.outputColorSpace = THREE.SRGBColorSpace;
 document.body.appendChild(renderer.domElement);
 
@@ -53,11 +111,62 @@ scene.add(sun);
 
 const camera = new THREE.PerspectiveCamera(30, window.innerWidth / window.innerHeight, 0.05, 50);
 camera.position.set(0, 1.2, 4.5);
-const controls = new OrbitControls(camera, renderer.domElement);
-controls.target.set(0, 1.0, 0);
-controls.update();
+const controls = renderMode ? null : new OrbitControls(camera, renderer.domElement);
+if (controls) {
+  controls.target.set(0, 1.0, 0);
+  controls.update();
+}
+const markers = [];
+
+// Render mode: the camera exactly as the URL says (no framing, no orbiting).
+function placeRenderCamera() {
+  const aspect = render.width / render.height;
+  let vfov = render.vfov;
+  if (render.hfov !== null) {
+    vfov = THREE.MathUtils.radToDeg(
+      2 * Math.atan(Math.tan(THREE.MathUtils.degToRad(render.hfov) / 2) / aspect));
+  }
+  if (vfov === null) vfov = 40;
+  camera.fov = vfov;
+  camera.aspect = aspect;
+  camera.near = 0.05;
+  camera.far = 100;
+  camera.position.set(...render.cam);
+  if (render.look) {
+    camera.up.set(0, 1, 0);
+    camera.lookAt(...render.look);
+    camera.rotateZ(THREE.MathUtils.degToRad(render.roll));
+  } else {
+    const rad = THREE.MathUtils.degToRad;
+    camera.rotation.set(rad(render.pitch), rad(render.yaw), rad(render.roll), 'YXZ');
+  }
+  camera.updateProjectionMatrix();
+  camera.updateMatrixWorld(true);
+  const hfov = THREE.MathUtils.radToDeg(
+    2 * Math.atan(Math.tan(THREE.MathUtils.degToRad(vfov) / 2) * aspect));
+  const q = camera.quaternion;
+  state.camera = {
+    position: camera.position.toArray(), quaternion: [q.x, q.y, q.z, q.w], vfov, hfov,
+    width: render.width, height: render.height,
+    focalPixels: render.height / 2 / Math.tan(THREE.MathUtils.degToRad(vfov) / 2),
+  };
+}
+
+if (renderMode) {
+  placeRenderCamera();
+  if (render.floor) {
+    const material = new THREE.MeshStandardMaterial({ color: render.floorColour, roughness: 1 });
+    const floor = new THREE.Mesh(new THREE.PlaneGeometry(40, 40), material);
+    floor.rotation.x = -Math.PI / 2;
+    scene.add(floor);
+    const grid = new THREE.GridHelper(40, 40, 0x6d7068, 0x6d7068);
+    grid.position.y = 0.001;
+    scene.add(grid);
+  }
+}
 
 window.addEventListener('resize', () => {
+  if (renderMode) return;
   camera.aspect = window.innerWidth / window.innerHeight;
   camera.updateProjectionMatrix();
   renderer.setSize(window.innerWidth, window.innerHeight);
@@ -94,6 +203,21 @@ function frameAvatar() {
   controls.update();
 }
 
+// Render mode's test markers: a small magenta dot at each named bone, drawn over everything.
+function addMarkers() {
+  for (const m of markers) m.parent?.remove(m);
+  markers.length = 0;
+  for (const name of render.markers) {
+    const node = vrm.humanoid.getNormalizedBoneNode(name);
+    if (!node) continue;
+    const dot = new THREE.Mesh(new THREE.SphereGeometry(0.012, 12, 8),
+                               new THREE.MeshBasicMaterial({ color: 0xff00ff, depthTest: false }));
+    dot.renderOrder = 10;
+    node.add(dot);
+    markers.push(dot);
+  }
+}
+
 async function loadAvatar(url, name) {
   state.avatar = 'loading';
   state.avatarName = name;
@@ -114,7 +238,8 @@ async function loadAvatar(url, name) {
     restHipsY = Math.max(0.1, rest[1]);
     standingHipsY = 0;
     firstHips = null;
-    frameAvatar();
+    if (renderMode) addMarkers();
+    else frameAvatar();
     state.avatar = 'ready';
     state.error = '';
     if (config.clip) await loadClip(config.clip, config.clip_name || 'clip');
@@ -134,6 +259,7 @@ async function loadClip(url, name) {
     mixer = new THREE.AnimationMixer(vrm.scene);
     clipAction = mixer.clipAction(clip);
     clipAction.setLoop(THREE.LoopRepeat, Infinity).play();
+    if (renderMode) clipAction.paused = true;  // renderAt(t) sets the time
     state.clipName = name;
     state.clipDuration = clip.duration;
     if (state.mode !== 'live') state.mode = 'clip';
@@ -161,7 +287,12 @@ function applyPose(pose) {
   }
   const h = pose.hips_position;
   const hips = vrm.humanoid.getNormalizedBoneNode('hips');
-  if (hips && Array.isArray(h) && h.length === 3 && h.every(Number.isFinite)) {
+  if (renderMode && hips && Array.isArray(h) && h.length === 3 && h.every(Number.isFinite)) {
+    // Absolute placement: the performer's metres times the avatar's over the performer's hips.
+    const s = render.performerHips > 0 ? restHipsY / render.performerHips : 1;
+    state.hipsScale = s;
+    hips.position.set(flip * h[0] * s, h[1] * s, flip * h[2] * s);
+  } else if (hips && Array.isArray(h) && h.length === 3 && h.every(Number.isFinite)) {
     if (!firstHips) firstHips = h;
     standingHipsY = Math.min(2.5, Math.max(standingHipsY, h[1], 0.3));
     const s = restHipsY / standingHipsY;  // performer metres -> avatar metres
@@ -285,6 +416,61 @@ function frame() {
   }
 }
 
+// ---- render mode: one frame on request ------------------------------------------------------
+let renderChain = Promise.resolve();
+let lastRenderT = null;
+
+// Draws one frame after pose(vrm) has posed the avatar; resolves once it has been presented
+// (two animation frames later), with the page's state.
+function drawRequested(t, pose) {
+  const job = renderChain.then(async () => {
+    if (!vrm) throw new Error(state.error || 'the avatar is not loaded');
+    const dt = lastRenderT === null ? 0 : Math.min(0.1, Math.max(0, t - lastRenderT));
+    lastRenderT = t;
+    pose();
+    vrm.update(dt);
+    renderer.render(scene, camera);
+    state.frames++;
+    await new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve)));
+    return { ...state };
+  });
+  renderChain = job.catch(() => {});
+  return job;
+}
+
+function renderAt(t) {
+  return drawRequested(t, () => {
+    if (!mixer) throw new Error('no clip to step: open the page of `avatarmap view CLIP.vrma`');
+    clipAction.paused = false;
+    mixer.setTime(t);
+    clipAction.paused = true;
+    state.mode = 'clip';
+    state.clipTime = clipAction.time;
+  });
+}
+
+function renderPose(pose) {
+  const p = typeof pose === 'string' ? JSON.parse(pose) : pose;
+  return drawRequested(typeof p.t === 'number' ? p.t : 0, () => {
+    state.mode = 'live';
+    applyPose(p);
+  });
+}
+
+// Resolves once the avatar (and the clip, if any) has loaded, or rejects with the page's error.
+async function ready(timeoutMs = 30000) {
+  if (renderErrors.length) throw new Error(renderErrors.join('; '));
+  const start = performance.now();
+  while (state.avatar !== 'ready' || (config.clip && !mixer && !state.error)) {
+    if (state.avatar === 'failed' || performance.now() - start > timeoutMs)
+      throw new Error(state.error || 'the avatar did not load');
+    await new Promise((resolve) => setTimeout(resolve, 20));
+  }
+  return { ...state };
+}
+
+if (renderMode) Object.assign(window.avatarmapViewer, { renderAt, renderPose, ready });
+
 // ---- start ----------------------------------------------------------------------------------
 let config = {};
 try {
@@ -294,6 +480,8 @@ try {
   state.error = `could not read /config.json: ${e.message ?? e}`;
 }
 const scheme = location.protocol === 'https:' ? 'wss' : 'ws';
-connect(config.pose_socket || `${scheme}://${location.host}/pose`);
-requestAnimationFrame(frame);
+if (!renderMode) {
+  connect(config.pose_socket || `${scheme}://${location.host}/pose`);
+  requestAnimationFrame(frame);
+}
 if (config.avatar) loadAvatar(config.avatar, config.avatar_name || 'avatar.vrm');

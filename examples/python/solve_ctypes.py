@@ -65,6 +65,7 @@ class AvmPose(ctypes.Structure):
         ("rotations", (ctypes.c_float * 4) * AVM_BONE_COUNT),  # {x, y, z, w}
         ("confidence", ctypes.c_float * AVM_BONE_COUNT),
         ("expressions", ctypes.c_float * AVM_EXPRESSION_COUNT),
+        ("foot_contact", ctypes.c_float * 2),  # [left, right]: 0 = free .. 1 = planted
     ]
 
 
@@ -91,7 +92,8 @@ class AvmSolverOptions(ctypes.Structure):
         ("expression_d_cutoff", _F),
         ("max_extrapolation_seconds", _F),
         ("file_filter", _I), ("file_smoothing", _F), ("file_threads", _I),
-        ("fit_hand_shape", _I),
+        ("fit_hand_shape", _I), ("fit_body_to_image", _I),
+        ("foot_contacts", _I), ("root_follows_contacts", _I),
     ]
 
 

@@ -19,6 +19,7 @@ int run_import_tfjs(int argc, char** argv);
 int run_backends(int argc, char** argv);
 int run_inspect(int argc, char** argv);
 int run_eval_pose(int argc, char** argv);
+int run_eval_world(int argc, char** argv);
 int run_avatar(int argc, char** argv);
 int run_view(int argc, char** argv);
 int run_options(int argc, char** argv);

@@ -25,7 +25,8 @@ namespace {
 const char* k_convert_help =
     "Usage: avatarmap convert IN -o OUT [options]\n"
     "\n"
-    "IN:  *.landmarks.jsonl (solved as by `avatarmap solve`), *.pose.jsonl or *.vrma\n"
+    "IN:  *.landmarks.jsonl (solved as by `avatarmap solve`), *.pose.jsonl, *.vrma or *.bvh\n"
+    "     (mocap on its own skeleton, bound by the mapping tables)\n"
     "OUT: *.vrma (VRM Animation), *.glb (the avatar with the motion; needs --avatar),\n"
     "     *.bvh (centimetres, ZXY: the avatar's own rig with --avatar, else the proxy\n"
     "     skeleton), *.pose.jsonl\n"
@@ -37,7 +38,8 @@ const char* k_convert_help =
 const cli_flag k_convert_flags[] = {
     {"--output", "-o", "PATH", "output file (required; written atomically)"},
     {"--avatar", nullptr, "FILE",
-     "the avatar (.vrm, .glb, .gltf) to drive (required for .glb; with .bvh: write its rig "
+     "the avatar (.vrm, .glb, .gltf, or a .bvh's skeleton) to drive (required for .glb; with "
+     ".bvh: write its rig "
      "instead of the proxy skeleton)"},
     {"--rig", nullptr, "auto|NAME|FILE.json",
      "how the avatar's joints map to the proxy: auto (default) uses a VRM's own humanoid map, "
@@ -51,13 +53,19 @@ const cli_flag k_convert_flags[] = {
      "times; at most 1000)"},
     {"--ground", nullptr, nullptr, "keep the avatar's lowest foot on the floor every frame"},
     {"--no-root-motion", nullptr, nullptr, "keep the hips where they are at rest"},
+    {"--no-foot-lock", nullptr, nullptr,
+     "let planted feet slide: no foot locking, no hips lowering, no floor clamp (see "
+     "docs/foot-locking.md)"},
     {"--image-size", nullptr, "WxH", "landmark input: image size in pixels, as for solve"},
     {"--filter", nullptr, "offline|live|none", "landmark input: the filter, as for solve"},
     {"--quiet", nullptr, nullptr, "no summary"},
 };
 // The solve-file table's flags convert takes for a landmark input (its --fps is the output's).
-#define AVATARMAP_CONVERT_SOLVE_FLAGS \
-  { "--smoothing", "--min-cutoff", "--beta", "--threads", "--skip-bad-lines" }
+#define AVATARMAP_CONVERT_SOLVE_FLAGS                                         \
+  {                                                                           \
+    "--smoothing", "--min-cutoff", "--beta", "--threads", "--skip-bad-lines", \
+        "--no-foot-contacts", "--no-root-follow"                              \
+  }
 
 void append_position(std::string& s, const std::string& name, glm::dvec3 p, bool first) {
   char buf[96];
@@ -168,6 +176,7 @@ int run_convert(int argc, char** argv) {
   const bool fps_given = a.number("--fps", fps);
   job.keep_feet_on_ground = a.flag("--ground");
   job.root_motion = !a.flag("--no-root-motion");
+  job.foot_lock.enabled = !a.flag("--no-foot-lock");
   const bool quiet = a.flag("--quiet");
   job.solve = make_cli_solve_job();
   std::string error;

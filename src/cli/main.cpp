@@ -31,11 +31,14 @@ const char* k_usage =
     "  avatarmap view [FILE.pose.jsonl|FILE.vrma] --avatar AVATAR.vrm [--port 8080]\n"
     "      Browser viewer: the avatar posed live (live --serve) or playing FILE.\n"
     "  avatarmap convert IN -o OUT [--avatar AVATAR] [--rig auto|NAME|FILE.json] [--fps N]\n"
-    "      Landmarks, poses or .vrma in; .vrma, .glb (animated avatar), .bvh or poses out.\n"
+    "      Landmarks, poses, .vrma or .bvh in; .vrma, .glb (animated avatar), .bvh or poses out.\n"
     "  avatarmap synth -o OUT.landmarks.jsonl [--truth OUT.pose.jsonl] [--scenario clean|noisy]\n"
-    "      Writes a synthetic recording (scripted or random motion) and its ground truth.\n"
+    "      Writes a synthetic recording (scripted or random motion) and its ground truth;\n"
+    "      with --mocap CLIP.bvh the landmarks of a motion capture take seen by a camera.\n"
     "  avatarmap eval-pose TRUTH.pose.jsonl SOLVED.pose.jsonl [--json]\n"
     "      Bone-direction and head-orientation errors of solved poses against the truth.\n"
+    "  avatarmap eval-world TRUTH.bvh SOLVED.pose.jsonl|SOLVED.bvh [--json] [--feet-only]\n"
+    "      World errors (MPJPE, lean, root, foot skate) against motion capture (synth --mocap).\n"
     "  avatarmap demo [--keep DIR]\n"
     "      Synthesises a recording, solves it and prints the summary (no input needed).\n"
     "  avatarmap import-tfjs IMAGE.json WORLD.json --size WxH --fps F -o OUT.landmarks.jsonl\n"
@@ -63,6 +66,7 @@ int dispatch(const std::string& cmd, int argc, char** argv) {
   if (cmd == "backends") return avatarmap::cli::run_backends(argc, argv);
   if (cmd == "inspect") return avatarmap::cli::run_inspect(argc, argv);
   if (cmd == "eval-pose") return avatarmap::cli::run_eval_pose(argc, argv);
+  if (cmd == "eval-world") return avatarmap::cli::run_eval_world(argc, argv);
   if (cmd == "avatar") return avatarmap::cli::run_avatar(argc, argv);
   if (cmd == "view") return avatarmap::cli::run_view(argc, argv);
   if (cmd == "options") return avatarmap::cli::run_options(argc, argv);

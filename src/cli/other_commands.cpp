@@ -10,6 +10,7 @@
 #include "avatarmap/media/video_source.hpp"
 #include "avatarmap/solve/solver_options.hpp"
 #include "avatarmap/time/filter_rules.hpp"
+#include "avatarmap/time/foot_contacts.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
@@ -87,6 +88,8 @@ int run_options(int argc, char** argv) {
     std::printf("%s,\n",
                 option_table_json("resampler", "avm_solver_options", k_pose_resampler_option_table)
                     .c_str());
+    std::printf("%s,\n",
+                option_table_json("foot_contacts", nullptr, k_foot_contact_option_table).c_str());
     std::printf(
         "%s,\n",
         option_table_json("estimator", "avm_estimator_options", k_estimator_option_table).c_str());
@@ -107,6 +110,7 @@ int run_options(int argc, char** argv) {
   list("solver (avm_solver_options):", k_solver_option_table);
   list("solve file (avm_solver_options):", k_solve_file_option_table);
   list("resampler (avm_solver_options):", k_pose_resampler_option_table);
+  list("foot contacts (library only; docs/contacts.md):", k_foot_contact_option_table);
   list("estimator (avm_estimator_options):", k_estimator_option_table);
   list("input:", k_video_source_option_table);
   return 0;

@@ -1,6 +1,7 @@
 // `avatarmap synth`, `demo` and `import-tfjs`.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/io/tfjs_import.hpp"
 #include "avatarmap/jobs/clip_output.hpp"
+#include "avatarmap/jobs/mocap_synth.hpp"
 #include "avatarmap/rig/bound_avatar.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
@@ -20,6 +22,7 @@
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/solve_job.hpp"
+#include "common/atomic_file.hpp"
 
 namespace avatarmap::cli {
 namespace {
@@ -58,7 +61,30 @@ const char* k_synth_help =
     "  --low-vis F           fraction of each limb's time in low-visibility bursts, [0, 0.9]\n"
     "  --low-vis-seconds S   mean burst length (default 1)\n"
     "  --low-vis-noise MM    extra Gaussian noise on a limb's 3-D points in a burst (30)\n"
-    "  --no-hands, --no-face  leave those parts out\n";
+    "  --no-hands, --no-face  leave those parts out\n"
+    "\n"
+    "From real motion capture (the world benchmark, docs/world-benchmark.md):\n"
+    "  avatarmap synth --mocap CLIP.bvh -o OUT.landmarks.jsonl [options]\n"
+    "  writes the pose landmarks (image + world) of the BVH's own joints seen by a pinhole\n"
+    "  camera, and the camera to OUT.camera.json (or --camera-json PATH). The truth is the BVH\n"
+    "  itself: `avatarmap eval-world CLIP.bvh SOLVED` samples it at the solved frames' times.\n"
+    "  --units F             metres per BVH unit (default 0.056444, the CMU clips')\n"
+    "  --fps F               frames per second (default 30), t = k / F from the BVH's start\n"
+    "  --scenario blazepose|clean\n"
+    "                        blazepose (default): world points leaning 10-25 deg toward the\n"
+    "                        camera, 15 mm world noise, image noise 0.3 % of the image height,\n"
+    "                        lower visibility for points turned away; clean: none of it\n"
+    "  --seed N              draws the camera options not given, the lean and the noise (1)\n"
+    "  --camera-height M     above the floor (drawn 0.5-2.0)\n"
+    "  --distance M          horizontal distance to the performer's mean hips (drawn 2.5-5)\n"
+    "  --lateral M           sideways, + to the performer's left (drawn -1..1)\n"
+    "  --pitch DEG           + looks up (drawn: looking at the hips +- 20 % of the vertical\n"
+    "                        field of view, within -30..20)\n"
+    "  --roll DEG            about the optical axis (drawn -8..8)\n"
+    "  --fov DEG             horizontal field of view (drawn 40-90)\n"
+    "  --size WxH            image size (default 1280x720)\n"
+    "  --lean DEG, --world-noise MM, --image-noise PCT   change the scenario's values\n"
+    "  --camera-json PATH    where the camera goes (default OUT with .camera.json)\n";
 
 struct synth_settings {
   std::string output;
@@ -258,6 +284,93 @@ status write_on_builtin_avatar(const std::vector<proxy_pose>& poses, const std::
   return {};
 }
 
+// `synth --mocap CLIP.bvh`: landmarks of a real take (jobs/mocap_synth.hpp).
+int run_mocap_synth(args& a, const std::string& bvh) {
+  std::string output, camera_json, text;
+  double v = 0, fps = 30.0, units = k_cmu_units_to_metres;
+  unsigned seed = 1;
+  std::string err;
+  a.value("--output", output, "-o");
+  a.value("--camera-json", camera_json);
+  if (a.number("--units", v)) units = v;
+  if (a.number("--fps", v)) fps = v;
+  if (a.number("--seed", v)) {
+    if (!(v >= 0 && v <= 4294967295.0 && v == static_cast<double>(static_cast<long long>(v))))
+      err = "--seed must be an integer in [0, 4294967295]";
+    seed = static_cast<unsigned>(std::max(0.0, std::min(v, 4294967295.0)));
+  }
+  mocap_scenario scenario = mocap_scenario::blazepose;
+  if (a.value("--scenario", text)) {
+    if (text == "clean") {
+      scenario = mocap_scenario::clean;
+    } else if (text != "blazepose") {
+      err = "--scenario with --mocap is blazepose or clean, got '" + text + "'";
+    }
+  }
+  mocap_camera_setup cam;
+  cam.seed = seed;
+  auto f = [&](const char* name, float& out) {
+    if (a.number(name, v)) out = static_cast<float>(v);
+  };
+  f("--camera-height", cam.height);
+  f("--distance", cam.distance);
+  f("--lateral", cam.lateral);
+  f("--pitch", cam.pitch_degrees);
+  f("--roll", cam.roll_degrees);
+  f("--fov", cam.fov_degrees);
+  if (a.value("--size", text) && !parse_image_size(text, cam.image_width, cam.image_height))
+    err = "--size wants WxH in pixels, e.g. 1280x720";
+  mocap_synth_options o = mocap_synth_options::preset(scenario, seed);
+  f("--lean", o.lean_degrees);
+  if (a.number("--world-noise", v)) o.world_noise_m = static_cast<float>(v * 0.001);
+  if (a.number("--image-noise", v)) o.image_noise = static_cast<float>(v * 0.01);
+  if (err.empty() && !a.error().empty()) err = a.error();
+  if (err.empty() && (!a.check_no_options() || !a.rest().empty()))
+    err = a.error().empty() ? "unexpected argument (see --help)" : a.error();
+  if (err.empty() && output.empty()) err = "give the output file with -o OUT.landmarks.jsonl";
+  if (err.empty() && !(fps > 0 && fps <= 1000)) err = "--fps must be in (0, 1000]";
+  if (err.empty() && !(units > 0 && units <= 1000)) err = "--units must be in (0, 1000]";
+  if (err.empty()) {
+    if (status st = cam.validate(); !st) err = st.message();
+  }
+  if (err.empty()) {
+    if (status st = o.validate(); !st) err = st.message();
+  }
+  if (!err.empty()) {
+    std::fprintf(stderr, "avatarmap synth: %s\n", err.c_str());
+    return 2;
+  }
+  if (camera_json.empty()) {
+    const std::string suffix = ".landmarks.jsonl";
+    camera_json = output.size() > suffix.size() &&
+                          output.compare(output.size() - suffix.size(), suffix.size(), suffix) == 0
+                      ? output.substr(0, output.size() - suffix.size()) + ".camera.json"
+                      : output + ".camera.json";
+  }
+  mocap_take take;
+  status st = take.load(bvh, static_cast<float>(units));
+  mocap_synth_job job;
+  job.take = &take;
+  job.camera = place_mocap_camera(take, cam);
+  job.options = o;
+  job.fps = fps;
+  job.output = output;
+  mocap_synth_summary sum;
+  if (st) st = job.run(sum);
+  const std::string json = mocap_camera_json(job.camera, sum.lean_degrees);
+  if (st) st = io_detail::write_file_atomically(camera_json, json + "\n");
+  if (!st) {
+    std::fprintf(stderr, "avatarmap synth: %s\n", st.message().c_str());
+    return 1;
+  }
+  std::fprintf(stderr,
+               "wrote %ld frames (%.2f s at %g fps) of %s (skeleton %.2f m, floor %.3f m) to %s;\n"
+               "%.1f %% of the points inside the image; camera: %s\n",
+               sum.frames, take.duration(), fps, bvh.c_str(), take.rest_height(), take.floor_y(),
+               output.c_str(), 100.0 * sum.inside_fraction, json.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int run_synth(int argc, char** argv) {
@@ -265,6 +378,16 @@ int run_synth(int argc, char** argv) {
   if (a.flag("--help") || a.flag("-h")) {
     std::fputs(k_synth_help, stdout);
     return 0;
+  }
+  std::string mocap;
+  if (a.value("--mocap", mocap)) return run_mocap_synth(a, mocap);
+  for (const char* only : {"--units", "--camera-height", "--lateral", "--pitch", "--roll", "--lean",
+                           "--world-noise", "--image-noise", "--camera-json"}) {
+    std::string ignored;
+    if (a.value(only, ignored)) {
+      std::fprintf(stderr, "avatarmap synth: %s is for --mocap CLIP.bvh (see --help)\n", only);
+      return 2;
+    }
   }
   synth_settings s;
   std::string err;

@@ -15,7 +15,8 @@
 
 namespace avatarmap::io_detail {
 
-/// Appends `pose` as one line ("{...}" and, when `newline`, "\n"): t, hips_position, every
+/// Appends `pose` as one line ("{...}" and, when `newline`, "\n"): t, hips_position,
+/// foot_contact ([left, right]), every
 /// bone (VRM 1.0 names, enum order, [x, y, z, w]; identity ones left out with
 /// options.skip_identity), every expression, and confidence with options.write_confidence.
 /// Non-finite numbers are written as null. False when out.reserve() fails (the output says
@@ -33,6 +34,12 @@ bool put_pose_line(Out& o, const proxy_pose& pose, const pose_write_options& opt
   o.put_number(pose.hips_position.y);
   o.put(',');
   o.put_number(pose.hips_position.z);
+  // Two numbers (<= 16 each) + the key.
+  if (!o.reserve(64)) return false;
+  o.put("],\"foot_contact\":[");
+  o.put_number(pose.foot_contact[0]);
+  o.put(',');
+  o.put_number(pose.foot_contact[1]);
   o.put("],\"bones\":{");
   bool first = true;
   for (int b = 0; b < k_bone_count; ++b) {
@@ -115,6 +122,6 @@ class memory_text {
 /// Bytes a pose line can take with every bone and confidence written (the bound the pose
 /// server's buffers are sized by; reserve()'s per-entry room is what makes it a bound).
 inline constexpr std::size_t k_pose_line_max =
-    128 + k_bone_count * 128 + 32 + k_expression_count * 64 + 32 + k_bone_count * 64 + 2;
+    128 + 64 + k_bone_count * 128 + 32 + k_expression_count * 64 + 32 + k_bone_count * 64 + 2;
 
 }  // namespace avatarmap::io_detail

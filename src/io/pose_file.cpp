@@ -1,6 +1,7 @@
 // *.pose.jsonl reader and writer (docs/file-formats.md).
 #include "avatarmap/io/pose_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string_view>
@@ -204,6 +205,13 @@ struct pose_reader::impl {
           if (!parse_fixed_array(c, v, 3, "\"hips_position\"", "3 finite numbers [x, y, z]"))
             return false;
           out.hips_position = glm::vec3(v[0], v[1], v[2]);
+        } else if (key == "foot_contact") {
+          float v[2];
+          if (!parse_fixed_array(c, v, 2, "\"foot_contact\"",
+                                 "2 finite numbers [left, right], 0 = free .. 1 = planted"))
+            return false;
+          // Outside [0, 1] means nothing more than its end: clamped, as the resampler does.
+          for (int f = 0; f < 2; ++f) out.foot_contact[f] = std::clamp(v[f], 0.f, 1.f);
         } else if (key == "bones") {
           if (!parse_bones(c, out)) return false;
         } else if (key == "expressions") {

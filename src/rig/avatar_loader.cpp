@@ -11,7 +11,9 @@
 #include <utility>
 #include <vector>
 
+#include "avatarmap/rig/bvh_rig.hpp"
 #include "rig/gltf_document.hpp"
+#include "rig/jobs/file_extension.hpp"
 
 namespace avatarmap {
 
@@ -333,7 +335,8 @@ status load_avatar(const std::string& path, raw_rig& out) {
   out.file = path;
   status s;
   try {
-    s = load(path, out);
+    // A BVH's HIERARCHY is a skeleton too (rig/bvh_rig.hpp): by the extension, any case.
+    s = jobs_detail::ends_with_nocase(path, ".bvh") ? load_bvh_avatar(path, out) : load(path, out);
   } catch (const std::bad_alloc&) {  // e.g. a huge declared size
     s = status::out_of_memory(path + ": not enough memory to load the file");
   } catch (const std::exception&) {

@@ -105,12 +105,19 @@ status retargeter::build(const rig& r, const bone_binding& binding, const retarg
           }
         if (count == 1 && bone_of_joint_[only] < 0) target = only;
       }
+      glm::vec3 d(0.f);
       if (target >= 0) {
-        const glm::vec3 d = position_of(r.rest_world[target]) - position_of(r.rest_world[j]);
-        const glm::vec3 dv = normalize_or(basis_ * d, glm::vec3(0.f));
-        if (glm::dot(dv, dv) > 0.5f)
-          aligned = rotation_between(dv, bone_rest_direction(static_cast<bone>(b))) * aligned;
+        d = position_of(r.rest_world[target]) - position_of(r.rest_world[j]);
+      } else if (primary_child(b) >= 0 && r.parents[j] >= 0) {
+        // A rig leaf driving a bone the proxy continues (a one-joint finger such as CMU's
+        // LFingers, a hand without fingers): taken to continue its parent joint's bone.
+        bool leaf = true;
+        for (int k = j + 1; k < n && leaf; ++k) leaf = r.parents[k] != j;
+        if (leaf) d = position_of(r.rest_world[j]) - position_of(r.rest_world[r.parents[j]]);
       }
+      const glm::vec3 dv = normalize_or(basis_ * d, glm::vec3(0.f));
+      if (glm::dot(dv, dv) > 0.5f)
+        aligned = rotation_between(dv, bone_rest_direction(static_cast<bone>(b))) * aligned;
     }
     rest_aligned_[j] = glm::normalize(aligned);
   }

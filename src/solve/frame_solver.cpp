@@ -14,6 +14,7 @@
 #include "solve/solve_body.hpp"
 #include "solve/solve_camera.hpp"
 #include "solve/solve_face.hpp"
+#include "solve/solve_fit.hpp"
 #include "solve/solve_geometry.hpp"
 #include "solve/solve_hands.hpp"
 #include "solve/solve_prepare.hpp"
@@ -27,12 +28,27 @@ namespace {
 // the focal length: 60 +-30 % covers ~45-80 degrees).
 constexpr float k_prior_fov_degrees = 60.f;
 constexpr double k_prior_focal_fraction = 0.3;
+// Every k_focal_every-th frame is fitted, until k_focal_max_frames frames have told the focal
+// length.
+constexpr long k_focal_every = 3;
+constexpr long k_focal_max_frames = 600;
+// Most information one frame adds, as a share of the information so far: the estimate moves
+// by at most a tenth of the way per sampled frame, and a few frames that happen to agree
+// cannot outweigh the prior (1.1^-n of it is left after n frames).
+constexpr double k_frame_information_cap = 0.1;
 }  // namespace
 
 frame_solver::frame_solver(const solver_options& options)
-    : options_(options.validate().ok() ? options : solver_options{}) {
+    : options_(options.validate().ok() ? options : solver_options{}),
+      lengths_(std::make_unique<body_lengths>()),
+      gravity_(std::make_unique<camera_gravity>()),
+      fit_(std::make_unique<body_fit>()) {
   reset();
 }
+
+frame_solver::~frame_solver() = default;
+frame_solver::frame_solver(frame_solver&&) noexcept = default;
+frame_solver& frame_solver::operator=(frame_solver&&) noexcept = default;
 
 void frame_solver::reset() {
   for (auto& b : bones_) b = rotation_gate{};
@@ -58,6 +74,9 @@ void frame_solver::reset() {
   focal_information_ = 1.0 / (sd * sd);
   focal_weighted_sum_ = focal_information_ * focal_per_width_;
   focal_frames_ = 0;
+  focal_tick_ = 0;
+  lengths_->reset();
+  gravity_->reset();
 }
 
 float frame_solver::horizontal_fov_degrees() const {
@@ -66,19 +85,44 @@ float frame_solver::horizontal_fov_degrees() const {
 
 void frame_solver::update_focal(const landmark_frame& in) {
   if (options_.horizontal_fov_degrees != 0.f || !(options_.image_width > 0.f)) return;
+  // A sample of the take's frames tells the field of view (consecutive frames are nearly the
+  // same view); the fit's cost stays off most frames.
+  if (focal_frames_ >= k_focal_max_frames || (focal_tick_++ % k_focal_every) != 0) return;
   const focal_evidence e = estimate_focal(in, options_.image_width, options_.image_height);
   if (!(e.information > 0.0)) return;
   // In units of the image width, as focal_per_width_.
   const double w = options_.image_width;
-  focal_information_ += e.information * w * w;
-  focal_weighted_sum_ += e.information * w * w * (e.focal / w);
+  // No frame tells more than a fraction of what is known so far: one frame whose world and
+  // image points happen to agree closely must not swing the estimate (and every depth with
+  // it) at once.
+  const double information =
+      std::min(e.information * w * w, k_frame_information_cap * focal_information_);
+  focal_information_ += information;
+  focal_weighted_sum_ += information * (e.focal / w);
   focal_per_width_ = static_cast<float>(focal_weighted_sum_ / focal_information_);
   ++focal_frames_;
 }
 
+const body_fit* frame_solver::fit_frame(const landmark_frame& in, bool learn, body_fit& out) const {
+  if (!options_.fit_body_to_image || !options_.parts.body || !(options_.image_width > 0.f))
+    return nullptr;
+  // measure() learns nothing: it fits with copies of what was learnt so far.
+  body_lengths lengths = *lengths_;
+  camera_gravity gravity = *gravity_;
+  const bool ok = fit_body(in, options_.image_width, options_.image_height,
+                           focal_per_width_ * options_.image_width, learn,
+                           learn ? *lengths_ : lengths, learn ? *gravity_ : gravity, out);
+  return ok ? &out : nullptr;
+}
+
+float frame_solver::camera_pitch_degrees() const { return gravity_->pitch_degrees(); }
+float frame_solver::camera_roll_degrees() const { return gravity_->roll_degrees(); }
+long frame_solver::gravity_evidence_frames() const { return gravity_->frames; }
+
 void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const {
   prepared_frame f;
-  prepare_frame(in, options_, focal_per_width_, f);
+  body_fit fit;
+  prepare_frame(in, options_, focal_per_width_, f, fit_frame(in, false, fit));
   for (int side = 0; side < 2; ++side)  // the shapes learnt so far; nothing learnt
     if (fits_hand(f, side)) hand_shapes_[side].fit(f.hand[side].p, f.hand[side].c);
   measure_prepared(in, f, m);
@@ -127,7 +171,7 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
 
   frame_measurement& m = scratch_;
   prepared_frame f;
-  prepare_frame(in, options_, focal_per_width_, f);
+  prepare_frame(in, options_, focal_per_width_, f, fit_frame(in, true, *fit_));
   // Stage 1b: each hand fitted to the shape learnt so far, then learnt from (one alignment).
   for (int side = 0; side < 2; ++side)
     if (fits_hand(f, side)) hand_shapes_[side].fit_and_learn(f.hand[side].p, f.hand[side].c);

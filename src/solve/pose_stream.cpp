@@ -49,6 +49,8 @@ pose_stream::pose_stream(const pose_stream_options& options)
     : options_(options),
       solver_(stream_solver_options(options.solver, options.filters.filter_mode)),
       filter_(options.filters.filter),
+      contacts_(options.filters.foot_contacts,
+                options.filters.filter_mode == pose_filter_mode::offline),
       resampler_(options.resampler) {
   assert(options.validate().ok());
   if (options.filters.filter_mode == pose_filter_mode::offline)
@@ -72,10 +74,10 @@ void pose_stream::solve(const landmark_frame& frame) {
       smoother_->push(solved_);
       return;
     case pose_filter_mode::live:
-      filter_pose_channels(filter_, options_.filters.filter_channels, solved_, filtered_);
+      filter_pose_channels(filter_, options_.filters.filter_channels, solved_, staged_);
       break;
     case pose_filter_mode::none:
-      filtered_ = solved_;
+      staged_ = solved_;
       break;
   }
   pending_ = true;
@@ -83,15 +85,26 @@ void pose_stream::solve(const landmark_frame& frame) {
 
 void pose_stream::finish_filter() noexcept {
   if (smoother_) smoother_->finish();
+  finishing_ = true;
 }
 
 bool pose_stream::next_filtered() noexcept {
-  if (smoother_) {
-    if (!smoother_->pop(filtered_)) return false;
-  } else {
-    if (!pending_) return false;
-    pending_ = false;
+  for (;;) {
+    bool got = false;
+    if (smoother_) {
+      got = smoother_->pop(staged_);
+    } else {
+      got = pending_;
+      pending_ = false;
+    }
+    if (got) {
+      if (contacts_.push(staged_, filtered_)) break;
+      continue;  // the both-sided stage holds it until it sees enough ahead
+    }
+    if (finishing_ && contacts_.flush(filtered_)) break;
+    return false;
   }
+  for (int f = 0; f < 2; ++f) stats_.planted_frames[f] += filtered_.foot_contact[f] > 0.5f;
   const float y = filtered_.hips_position.y;
   if (stats_.filtered == 0) {
     stats_.hips_height_min = stats_.hips_height_max = y;
@@ -136,8 +149,9 @@ void pose_stream::reset() {
   filter_.reset();
   if (smoother_) smoother_->reset();
   if (points_) points_->filter.reset();
+  contacts_.reset();
   resampler_.reset();
-  pending_ = pushed_ = false;
+  pending_ = pushed_ = finishing_ = false;
   stats_ = {};
   t_grid0_ = 0.0;
   have_grid_ = false;

@@ -6,6 +6,7 @@
 
 #include "avatarmap/core/rotation.hpp"
 #include "avatarmap/core/spaces.hpp"
+#include "solve/solve_fit.hpp"
 #include "solve/solve_geometry.hpp"
 #include "solve/solve_measurement.hpp"
 
@@ -176,8 +177,16 @@ void measure_hips_position(const landmark_frame& in, const prepared_frame& f,
         floor_y = std::min(floor_y, b.p[i].y);
       glm::vec3 hip_mid = 0.5f * (b.p[idx(pl::left_hip)] + b.p[idx(pl::right_hip)]);
       m.hips_height = hip_mid.y - floor_y;
+      // Fitted to the image: feet above the floor learnt over the take lift the hips (a jump).
+      if (f.fit) m.hips_height += f.fit->feet_above_floor;
       m.hips_height_valid = std::isfinite(m.hips_height);
     }
+  }
+  if (f.fit) {  // the fitted root: a full pinhole fit, turned to gravity (solve_fit.hpp)
+    const float x = o.mirror ? -f.fit->hips.x : f.fit->hips.x;
+    m.hips_ground = glm::vec2(x, -f.fit->hips.z);
+    m.hips_ground_valid = is_finite(glm::vec3(m.hips_ground, 0.f));
+    return;
   }
   if (!in.has(frame_part::pose) || !in.has(frame_part::pose_world)) return;
   // Least-squares fit image_px = s * world_xy + t over confident torso and leg points. The

@@ -9,7 +9,10 @@
 // (du, dv: pixels from the centre). The perspective information is in the points' spread in
 // depth, so one frame tells f only roughly; frame_solver combines the frames of a take, each
 // weighted by how much it tells (the inverse variance of its f once the other three unknowns
-// are solved for), starting from a prior at 60 degrees +-30 %.
+// are solved for), starting from a prior at 60 degrees +-30 %. BlazePose's world points lean
+// toward the camera (docs/solver.md): each frame's fit also searches the lean about the
+// camera's x axis (+-30 degrees) that best explains the image, so the lean does not pass for
+// perspective.
 #pragma once
 
 #include "avatarmap/landmarks/landmark_frame.hpp"

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "solve/solve_fit.hpp"
+
 namespace avatarmap::solve_detail {
 namespace {
 
@@ -12,7 +14,7 @@ void prepare_body(const landmark_frame& in, const solver_options& o, prepared_fr
   b.valid = false;
   const bool world = in.has(frame_part::pose_world);
   if (!world && !in.has(frame_part::pose)) return;
-  const auto& src = world ? in.pose_world : in.pose;
+  const auto& src = world ? (f.fit ? f.fit->world : in.pose_world) : in.pose;
   // world -> VRM (x, -y, -z), or image -> VRM pixels (x W, -y H, -z W); the mirror flips X.
   const float mx = o.mirror ? -1.f : 1.f;
   const float kx = world ? mx : mx * f.width, ky = world ? -1.f : -f.height,
@@ -141,7 +143,8 @@ void prepare_face(const landmark_frame& in, const solver_options& o, prepared_fr
 }  // namespace
 
 void prepare_frame(const landmark_frame& in, const solver_options& o, float focal_per_width,
-                   prepared_frame& f) {
+                   prepared_frame& f, const body_fit* fit) {
+  f.fit = fit != nullptr && fit->valid ? fit : nullptr;
   const bool sized = o.image_width > 0.f && o.image_height > 0.f;
   f.width = sized ? o.image_width : 1.f;
   f.height = sized ? o.image_height : 1.f;

@@ -13,6 +13,8 @@
 
 namespace avatarmap::solve_detail {
 
+struct body_fit;  // solve_fit.hpp
+
 /// A landmark's confidence in [0, 1]: min(visibility, presence), 0 when a coordinate or the
 /// confidence itself is not finite.
 inline float landmark_confidence(const landmark& l) {
@@ -60,12 +62,15 @@ struct prepared_frame {
   face_points face;
   float width = 1.f, height = 1.f;  // image size in pixels (1 x 1 when unknown: square pixels)
   float focal = 1.f;                // pixels, from the horizontal field of view
+  /// The body fitted to the image (solve_fit.hpp) when that stage ran on this frame: its
+  /// points replace pose_world, its hips give the hips' ground position. Null otherwise.
+  const body_fit* fit = nullptr;
 };
 
 /// Fills `out` from `in`. `focal_per_width` is the focal length over the image width (from
 /// the horizontal field of view). Hands and face are prepared before the body, which skips
 /// the pose points they replace.
 void prepare_frame(const landmark_frame& in, const solver_options& o, float focal_per_width,
-                   prepared_frame& out);
+                   prepared_frame& out, const body_fit* fit = nullptr);
 
 }  // namespace avatarmap::solve_detail

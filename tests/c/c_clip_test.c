@@ -294,9 +294,43 @@ static void test_write_glb(avm_clip* clip) {
   }
 }
 
+/* foot_contact goes into a clip, out to .pose.jsonl, back through avm_clip_read, exactly
+ * (clamped to [0, 1], NaN = 0, as avm_clip_add says). */
+static void test_foot_contact_round_trip(void) {
+  static const float in[4][2] = {{0.f, 1.f}, {0.25f, 0.5f}, {-2.f, 7.f}, {NAN, 1.f}};
+  static const float want[4][2] = {{0.f, 1.f}, {0.25f, 0.5f}, {0.f, 1.f}, {0.f, 1.f}};
+  avm_clip* clip = NULL;
+  avm_clip* back = NULL;
+  avm_pose p, got[4];
+  char err[256];
+  int k;
+  CHECK(avm_clip_create(&clip) == AVM_OK);
+  if (clip == NULL) return;
+  for (k = 0; k < 4; ++k) {
+    motion_pose(k, &p);
+    p.foot_contact[0] = in[k][0];
+    p.foot_contact[1] = in[k][1];
+    CHECK(avm_clip_add(clip, &p) == AVM_OK);
+  }
+  CHECK(avm_clip_write(clip, "c_clip_contact.pose.jsonl", 0.0, NULL, NULL, err, sizeof err) ==
+        AVM_OK);
+  CHECK(avm_clip_read("c_clip_contact.pose.jsonl", &back, err, sizeof err) == AVM_OK);
+  if (back != NULL) {
+    CHECK(avm_clip_get_poses(back, 0, 4, got) == AVM_OK);
+    for (k = 0; k < 4; ++k) {
+      CHECK(got[k].foot_contact[0] == want[k][0]);
+      CHECK(got[k].foot_contact[1] == want[k][1]);
+    }
+    avm_clip_destroy(back);
+  }
+  remove("c_clip_contact.pose.jsonl");
+  avm_clip_destroy(clip);
+}
+
 int main(void) {
   avm_clip* clip;
   test_collect();
+  test_foot_contact_round_trip();
   clip = make_clip();
   CHECK(clip != NULL);
   if (clip != NULL) {

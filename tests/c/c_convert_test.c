@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
   CHECK(avm_motion_input_kind("X.POSE.JSONL", &stem) == AVM_MOTION_INPUT_POSES && stem == 1);
   CHECK(avm_motion_input_kind("clip.Vrma", NULL) == AVM_MOTION_INPUT_VRMA);
   CHECK(avm_motion_input_kind("-", NULL) == AVM_MOTION_INPUT_LANDMARKS);
-  CHECK(avm_motion_input_kind("walk.bvh", &stem) == AVM_MOTION_INPUT_NONE && stem == 0);
+  CHECK(avm_motion_input_kind("walk.bvh", &stem) == AVM_MOTION_INPUT_BVH && stem == 4);
   CHECK(avm_motion_input_kind(NULL, &stem) == AVM_MOTION_INPUT_NONE);
 
   /* Defaults and refusals that need no file. */

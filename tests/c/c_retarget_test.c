@@ -162,6 +162,81 @@ static void test_mapping_tables(void) {
   remove(k_rig);
 }
 
+/* Foot locking through the handle: options and their defaults, a planted foot changes the
+ * leg while the hips drift (and only with locking on), a free foot in the air is untouched,
+ * NaN contacts give finite output. The lock's geometry is tested in tests/rig/. */
+static void test_foot_lock(void) {
+  avm_retargeter_options o;
+  avm_retargeter* on = NULL;
+  avm_retargeter* off = NULL;
+  avm_pose pose;
+  float a[4 * 64], b[4 * 64], hips_a[3], hips_b[3];
+  int i, j, n, thigh, differs = 0, same = 1, finite = 1;
+  CHECK(write_mixamo_fixture(k_rig));
+  memset(&o, 0xff, sizeof o);
+  CHECK(avm_retargeter_options_init(&o) == AVM_OK);
+  CHECK(o.struct_size == sizeof o && o.foot_lock == 1 && o.foot_lock_align_foot == 1 &&
+        o.foot_lock_lower_hips == 1 && o.foot_lock_keep_above_floor == 1);
+  CHECK(avm_retargeter_options_init_sized(&o, 4) == AVM_ERROR_INVALID_ARGUMENT);
+  o.struct_size = 0;
+  CHECK(avm_retargeter_create_with_options(k_rig, "mixamo", &o, &on) ==
+            AVM_ERROR_INVALID_ARGUMENT &&
+        on == NULL);
+  CHECK(contains(avm_last_create_error(), "struct_size"));
+  CHECK(avm_retargeter_options_init(&o) == AVM_OK);
+  CHECK(avm_retargeter_create_with_options(k_rig, "mixamo", &o, &on) == AVM_OK && on != NULL);
+  o.foot_lock = 0;
+  CHECK(avm_retargeter_create_with_options(k_rig, "mixamo", &o, &off) == AVM_OK && off != NULL);
+  if (on == NULL || off == NULL) {
+    avm_retargeter_destroy(on);
+    avm_retargeter_destroy(off);
+    return;
+  }
+  /* Every leg of the fixture has its toes: no foot-lock sentence in the description. */
+  CHECK(!contains(avm_retargeter_binding_description(on), "foot locking"));
+  n = avm_retargeter_joint_count(on);
+  CHECK(n <= 64);
+  thigh = avm_retargeter_bone_joint(on, AVM_BONE_LEFT_UPPER_LEG);
+  for (i = 0; i < 30; ++i) {
+    rest_pose(&pose);
+    pose.t = i / 30.0;
+    pose.hips_position[0] = 0.004f * (float)i; /* drifting sideways */
+    pose.hips_position[1] = 0.93f;
+    pose.foot_contact[0] = 1.f;
+    CHECK(avm_retargeter_apply(on, &pose, a, hips_a) == AVM_OK);
+    CHECK(avm_retargeter_apply(off, &pose, b, hips_b) == AVM_OK);
+    if (i > 5 &&
+        fabsf(a[4 * thigh + 3] - b[4 * thigh + 3]) + fabsf(a[4 * thigh + 2] - b[4 * thigh + 2]) >
+            1e-3f)
+      differs = 1;
+  }
+  CHECK(differs);
+  /* Contact 0 and the feet in the air: the lock leaves the pose as retargeted. */
+  avm_retargeter_reset(on);
+  avm_retargeter_reset(NULL);
+  rest_pose(&pose);
+  pose.hips_position[1] = 1.1f;
+  CHECK(avm_retargeter_apply(on, &pose, a, hips_a) == AVM_OK);
+  CHECK(avm_retargeter_apply(off, &pose, b, hips_b) == AVM_OK);
+  for (j = 0; j < 4 * n; ++j)
+    if (a[j] != b[j]) same = 0;
+  for (j = 0; j < 3; ++j)
+    if (hips_a[j] != hips_b[j]) same = 0;
+  CHECK(same);
+  pose.foot_contact[0] = NAN;
+  pose.foot_contact[1] = 1.f;
+  pose.hips_position[1] = 0.5f;
+  CHECK(avm_retargeter_apply(on, &pose, a, hips_a) == AVM_OK);
+  for (j = 0; j < 4 * n; ++j)
+    if (!isfinite(a[j])) finite = 0;
+  for (j = 0; j < 3; ++j)
+    if (!isfinite(hips_a[j])) finite = 0;
+  CHECK(finite);
+  avm_retargeter_destroy(on);
+  avm_retargeter_destroy(off);
+  remove(k_rig);
+}
+
 int main(void) {
   avm_retargeter* r = NULL;
   const char* data = getenv("AVATARMAP_TEST_DATA");
@@ -173,6 +248,7 @@ int main(void) {
   CHECK(avm_retargeter_joint_name(NULL, 0) == NULL);
   CHECK(avm_retargeter_apply(NULL, NULL, NULL, NULL) == AVM_ERROR_INVALID_ARGUMENT);
   test_mapping_tables();
+  test_foot_lock();
   if (data != NULL && data[0] != '\0') {
     char path[4096];
     avm_pose pose;

@@ -12,7 +12,8 @@ foreach(fn avm_version avm_solver_create avm_solver_push avm_solver_sample avm_s
            avm_retargeter_apply_poses avm_capture_file avm_solver_options_init
            avm_solver_options_init_sized avm_estimator_options_init avm_estimator_options_init_sized
            avm_convert_file avm_convert_options_init avm_convert_options_init_sized
-           avm_motion_input_kind)
+           avm_motion_input_kind avm_retargeter_create_with_options avm_retargeter_options_init
+           avm_retargeter_options_init_sized avm_retargeter_reset)
   if(NOT symbols MATCHES " ${fn}\n")
     message(FATAL_ERROR "${LIB} does not export ${fn}")
   endif()

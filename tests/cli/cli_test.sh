@@ -158,6 +158,23 @@ case $case_name in
     run 0 solve in.landmarks.jsonl -o out.pose.jsonl --quiet --filter none --mirror --confidence
     n=$(lines out.pose.jsonl)
     [ "$n" -eq 61 ] || fail "second solve wrote $n lines, expected 61"
+    # Foot contacts (docs/contacts.md): the demo motion stands, so its feet are planted; the
+    # flags turn the stage off (foot_contact 0) or only the hips' following (same contacts,
+    # the solver's hips).
+    run 0 solve in.landmarks.jsonl -o on.pose.jsonl
+    run 0 solve in.landmarks.jsonl -o off.pose.jsonl --no-foot-contacts
+    run 0 solve in.landmarks.jsonl -o nofollow.pose.jsonl --no-root-follow
+    expect_in on.pose.jsonl '"foot_contact":[1,1]'
+    grep -q '"foot_contact":\[1' off.pose.jsonl && fail "--no-foot-contacts still planted a foot"
+    expect_in off.pose.jsonl '"foot_contact":[0,0]'
+    python3 -c 'import json, sys
+def load(p):
+    return [json.loads(l) for l in open(p) if "\"t\"" in l]
+on, off, nf = load("on.pose.jsonl"), load("off.pose.jsonl"), load("nofollow.pose.jsonl")
+assert [a["foot_contact"] for a in nf] == [a["foot_contact"] for a in on]
+assert [a["hips_position"] for a in nf] == [a["hips_position"] for a in off]
+assert [a["hips_position"] for a in on] != [a["hips_position"] for a in off]' ||
+      fail "--no-root-follow is not the contacts with the solver's hips"
     ;;
   solve_threads)
     # Parsing on a second thread changes nothing in the output, and bad lines still stop it.
@@ -212,6 +229,17 @@ case $case_name in
       expect_in err.txt "no mapping table fits"
       run 1 convert in.landmarks.jsonl -o v.glb --rig nonexistent --avatar "$AVATARMAP_TEST_DATA/avatars/gltf_cesium_man.glb"
       expect_in err.txt "unknown rig table 'nonexistent'"
+      # BVH mocap in (on its own skeleton) and a BVH skeleton as the avatar.
+      walk="$AVATARMAP_TEST_DATA/motion/cmu-bvh/131_02.bvh"
+      run 0 convert "$walk" -o truth.pose.jsonl
+      expect_in err.txt "converted 1247 input frames"
+      expect_in truth.pose.jsonl '"fps":120'
+      run 0 convert "$walk" -o walk.vrma
+      run 0 convert in.landmarks.jsonl -o self.bvh --avatar "$walk"
+      expect_in err.txt "detected cmu"
+      expect_in self.bvh "JOINT LHipJoint"
+      run 2 convert in.landmarks.jsonl -o self.glb --avatar "$walk"
+      expect_in err.txt "BVH skeleton"
     fi
     ;;
   capture)

@@ -41,6 +41,7 @@ std::vector<proxy_pose> make_poses(int n, std::uint32_t seed) {
     }
     for (auto& c : p.confidence) c = u(rng);
     for (auto& e : p.expressions) e = u(rng);
+    p.foot_contact = {u(rng), i % 3 == 0 ? 1.f : 0.f};
   }
   return poses;
 }
@@ -58,6 +59,7 @@ void expect_same_pose(const proxy_pose& a, const proxy_pose& b, bool with_confid
   }
   for (int e = 0; e < k_expression_count; ++e)
     EXPECT_TRUE(same_bits(a.expressions[e], b.expressions[e]));
+  for (int f = 0; f < 2; ++f) EXPECT_TRUE(same_bits(a.foot_contact[f], b.foot_contact[f]));
 }
 
 void round_trip(const pose_write_options& options) {
@@ -108,11 +110,37 @@ TEST(pose_file, writer_format) {
   ASSERT_TRUE(w.commit().ok());
   std::string text = read_text(path);
   EXPECT_EQ(text.substr(0, text.find('\n')), "{\"format\":\"avatarmap.pose\",\"version\":1}");
-  EXPECT_NE(text.find("{\"t\":0.5,\"hips_position\":[0,0.95,0],\"bones\":{\"leftUpperArm\":"
+  EXPECT_NE(text.find("{\"t\":0.5,\"hips_position\":[0,0.95,0],\"foot_contact\":[0,0],\"bones\":{"
+                      "\"leftUpperArm\":"
                       "[0.5,-0.5,0.5,0.5]},\"expressions\":{\"blink\":0,\"blinkLeft\":0.25,"),
             std::string::npos)
       << text;
   EXPECT_NE(text.find("\"browDownRight\":0}}\n"), std::string::npos) << text;
+}
+
+TEST(pose_file, foot_contact_is_optional_clamped_and_checked) {
+  // An older file has none: 0, 0. Values outside [0, 1] are clamped; a wrong count or a
+  // non-number is an error naming the key.
+  const std::string text =
+      "{\"t\":0,\"hips_position\":[0,1,0]}\n"
+      "{\"t\":1,\"foot_contact\":[0.25,1]}\n"
+      "{\"t\":2,\"foot_contact\":[-3,7]}\n"
+      "{\"t\":3,\"foot_contact\":[1]}\n";
+  pose_reader r;
+  ASSERT_TRUE(r.open_memory(text.data(), text.size()).ok());
+  proxy_pose p;
+  p.foot_contact = {0.5f, 0.5f};  // stale data must be reset
+  ASSERT_EQ(r.next(p), read_result::frame) << r.error();
+  EXPECT_EQ(p.foot_contact[0], 0.f);
+  EXPECT_EQ(p.foot_contact[1], 0.f);
+  ASSERT_EQ(r.next(p), read_result::frame) << r.error();
+  EXPECT_EQ(p.foot_contact[0], 0.25f);
+  EXPECT_EQ(p.foot_contact[1], 1.f);
+  ASSERT_EQ(r.next(p), read_result::frame) << r.error();
+  EXPECT_EQ(p.foot_contact[0], 0.f);
+  EXPECT_EQ(p.foot_contact[1], 1.f);
+  EXPECT_EQ(r.next(p), read_result::error);
+  EXPECT_NE(r.error().find("\"foot_contact\""), std::string::npos) << r.error();
 }
 
 TEST(pose_file, missing_bones_are_identity_and_quaternions_are_normalised) {

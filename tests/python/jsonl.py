@@ -40,8 +40,8 @@ def read_landmarks_json(path):
 
 
 def read_poses_json(path, bone_names, expression_names):
-    """{"t", "hips_position", "rotations", "confidence", "expressions"} arrays of a
-    *.pose.jsonl (absent confidence: None)."""
+    """{"t", "hips_position", "rotations", "confidence", "expressions", "foot_contact"}
+    arrays of a *.pose.jsonl (absent confidence: None; absent foot_contact: 0, 0)."""
     frames = []
     with open(path, encoding="utf-8") as f:
         for i, line in enumerate(f):
@@ -57,7 +57,10 @@ def read_poses_json(path, bone_names, expression_names):
     conf = np.zeros((n, len(bone_names)), dtype=np.float32) if any(
         "confidence" in fr for fr in frames) else None
     expr = np.zeros((n, len(expression_names)), dtype=np.float32)
+    contact = np.zeros((n, 2), dtype=np.float32)
     for i, fr in enumerate(frames):
+        if "foot_contact" in fr:
+            contact[i] = np.clip(np.float32([_f(v) for v in fr["foot_contact"]]), 0, 1)
         if "hips_position" in fr:
             hips[i] = np.float32([_f(v) for v in fr["hips_position"]])
         for b, name in enumerate(bone_names):
@@ -69,4 +72,4 @@ def read_poses_json(path, bone_names, expression_names):
             if name in fr.get("expressions", {}):
                 expr[i, e] = np.float32(_f(fr["expressions"][name]))
     return {"t": np.array([fr["t"] for fr in frames], dtype=np.float64), "hips_position": hips,
-            "rotations": rot, "confidence": conf, "expressions": expr}
+            "rotations": rot, "confidence": conf, "expressions": expr, "foot_contact": contact}

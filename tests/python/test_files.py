@@ -21,7 +21,7 @@ def test_read_poses_matches_the_json(pose_file):
     poses = am.read_poses(pose_file)
     ref = read_poses_json(pose_file, am.BONE_NAMES, am.EXPRESSION_NAMES)
     assert len(poses) == 120
-    for name in ("t", "hips_position", "rotations", "confidence", "expressions"):
+    for name in ("t", "hips_position", "rotations", "confidence", "expressions", "foot_contact"):
         np.testing.assert_array_equal(getattr(poses, name), ref[name], err_msg=name)
 
 
@@ -36,13 +36,15 @@ def _glb_chunks(data):
 
 def _same_within_float_precision(a, b, ext):
     """Files of the same poses whose quaternions may differ in the last bit (avm_clip_add
-    normalises every rotation it is given, the CLI's own path does not: see docs/python.md)."""
+    normalises every rotation it is given, the CLI's own path does not: see docs/python.md).
+    Foot locking's leg IK (docs/foot-locking.md) turns that bit into up to ~100 ulps: near a
+    straight knee the knee's offset moves ~20x faster than the hip-ankle distance."""
     if ext in (".vrma", ".glb"):
         (ja, ba), (jb, bb) = _glb_chunks(a), _glb_chunks(b)
         assert ja == jb and len(ba) == len(bb)
         fa = np.frombuffer(ba[:len(ba) // 4 * 4], dtype=np.float32)
         fb = np.frombuffer(bb[:len(bb) // 4 * 4], dtype=np.float32)
-        same = (fa.view(np.uint32) == fb.view(np.uint32)) | np.isclose(fa, fb, rtol=1e-6, atol=1e-6)
+        same = (fa.view(np.uint32) == fb.view(np.uint32)) | np.isclose(fa, fb, rtol=1e-5, atol=1e-5)
         assert same.all(), "%d floats differ" % (~same).sum()
     else:  # text: the same words, numbers within print precision of what a quaternion's last
         # bit moves (BVH: Euler degrees to 6 decimals; one float ulp of a quaternion turns a
@@ -53,7 +55,7 @@ def _same_within_float_precision(a, b, ext):
             if x != y:
                 x, y = x.strip("[],{}"), y.strip("[],{}")
                 assert float(x.split(":")[-1]) == pytest.approx(float(y.split(":")[-1]),
-                                                                rel=1e-5, abs=1e-5), (x, y)
+                                                                rel=1e-4, abs=1e-4), (x, y)
 
 
 @pytest.mark.parametrize("ext,fps", [(".vrma", 30), (".bvh", 30), (".bvh", 24),
@@ -144,7 +146,7 @@ def test_motion_input_kind_is_the_librarys_rule(pose_file, cli, tmp_path):
     assert am.motion_input_kind("a/take.landmarks.jsonl") == "landmarks"
     assert am.motion_input_kind("TAKE.POSE.JSONL") == "poses"
     assert am.motion_input_kind("clip.Vrma") == "vrma"
-    assert am.motion_input_kind("walk.bvh") is None
+    assert am.motion_input_kind("walk.bvh") == "bvh"
     # A name that says nothing: the content does.
     odd = tmp_path / "take.json"
     odd.write_bytes(pose_file.read_bytes())
@@ -155,6 +157,16 @@ def test_motion_input_kind_is_the_librarys_rule(pose_file, cli, tmp_path):
     assert out.read_bytes() == ref.read_bytes()
     with pytest.raises(am.InvalidArgumentError, match="unknown input type"):
         am.convert_file(tmp_path / "notes.txt", tmp_path / "x.vrma")
+
+
+def test_bvh_motion_converts_as_the_cli_does(data, cli, tmp_path):
+    # Motion capture read on its own skeleton (the library's read_bvh_motion), same bytes.
+    walk = os.path.join(data, "motion", "cmu-bvh", "131_02.bvh")
+    out, ref = tmp_path / "walk.pose.jsonl", tmp_path / "cli.pose.jsonl"
+    am.convert_file(walk, out)
+    cli("convert", walk, "-o", ref)
+    assert out.read_bytes() == ref.read_bytes()
+    assert len(am.read_poses(out)) == 1247
 
 
 @pytest.mark.parametrize("ext", [".vrma", ".bvh"])
@@ -171,7 +183,7 @@ def test_write_animation_equals_cli_convert(synth_file, cli, tmp_path, ext):
         a = am.read_poses(tmp_path / "mine.pose.jsonl")
         b = am.read_poses(tmp_path / "ref.pose.jsonl")
         assert len(a) == len(b) == 120
-        np.testing.assert_allclose(a.rotations, b.rotations, rtol=0, atol=1e-6)
+        np.testing.assert_allclose(a.rotations, b.rotations, rtol=0, atol=1e-5)  # see above
         np.testing.assert_allclose(a.hips_position, b.hips_position, rtol=0, atol=1e-6)
 
 
@@ -193,17 +205,21 @@ def test_write_animation_glb_with_an_avatar(pose_file, cli, data, tmp_path):
 def test_pose_jsonl_round_trip(pose_file, tmp_path):
     poses = am.read_poses(pose_file)
     out = tmp_path / "again.pose.jsonl"
+    # foot_contact travels too (a view of the records: writing to it changes them).
+    poses.foot_contact[:, 0] = np.linspace(0.0, 1.0, len(poses), dtype=np.float32)
+    poses.foot_contact[:, 1] = (np.arange(len(poses)) % 2).astype(np.float32)
     am.write_animation(poses, out)
     back = am.read_poses(out)
     # (The clip writer writes no confidence, as `avatarmap convert` to .pose.jsonl.)
-    for name in ("t", "hips_position", "expressions"):
+    for name in ("t", "hips_position", "expressions", "foot_contact"):
         np.testing.assert_array_equal(getattr(back, name), getattr(poses, name), err_msg=name)
     # avm_clip_add normalises each rotation again: the last bit may change.
     np.testing.assert_allclose(back.rotations, poses.rotations, rtol=0, atol=2.5e-7)
     # Poses built from plain arrays (not views of records) write the same file.
     plain = am.Poses(t=np.array(poses.t), hips_position=np.array(poses.hips_position),
                      rotations=np.array(poses.rotations), confidence=np.array(poses.confidence),
-                     expressions=np.array(poses.expressions))
+                     expressions=np.array(poses.expressions),
+                     foot_contact=np.array(poses.foot_contact))
     out2 = tmp_path / "plain.pose.jsonl"
     am.write_animation(plain, out2)
     assert out2.read_bytes() == out.read_bytes()

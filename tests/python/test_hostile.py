@@ -233,7 +233,8 @@ def test_read_landmarks_memory_follows_the_data(tmp_path):
 # The header's int32_t flags of avm_solver_options (0 or 1), its other int32_t fields, and
 # (every other field) its floats.
 _BOOL_FIELDS = {"mirror", "solve_body", "solve_hands", "solve_face", "solve_hips_translation",
-                "filter_rotations", "filter_position", "filter_expressions", "fit_hand_shape"}
+                "filter_rotations", "filter_position", "filter_expressions", "fit_hand_shape",
+                "fit_body_to_image", "foot_contacts", "root_follows_contacts"}
 _INT_FIELDS = {"file_filter", "file_threads"}
 _FLOAT_FIELDS = set(am.SOLVER_OPTION_NAMES) - _BOOL_FIELDS - _INT_FIELDS
 
@@ -575,7 +576,8 @@ def test_hostile_poses_for_writers(tmp_path, synth_file):
     # Non-contiguous fields are assembled into records: the same file.
     plain = am.Poses(t=poses.t.copy(), hips_position=np.asfortranarray(poses.hips_position),
                      rotations=poses.rotations[:, :, ::-1][:, :, ::-1],
-                     confidence=poses.confidence, expressions=poses.expressions)
+                     confidence=poses.confidence, expressions=poses.expressions,
+                     foot_contact=np.asfortranarray(poses.foot_contact))
     am.write_animation(poses, tmp_path / "a.pose.jsonl")
     am.write_animation(plain, tmp_path / "b.pose.jsonl")
     assert (tmp_path / "a.pose.jsonl").read_bytes() == (tmp_path / "b.pose.jsonl").read_bytes()

@@ -35,8 +35,10 @@ def test_apply_equals_per_pose_calls(data, poses, avatar):
             np.testing.assert_array_equal(rot[i], one_rot)
             np.testing.assert_array_equal(trans[i], one_trans)
         assert np.allclose(np.linalg.norm(rot, axis=2), 1.0, atol=1e-5)
-        one = r.apply(poses[3])
-        np.testing.assert_array_equal(one[0][0], rot[3])
+        # Foot locking keeps anchors between calls; a clip applied again from its start (a
+        # time not after the previous pose's) starts afresh and gives the same rows.
+        again = r.apply(poses[:4])
+        np.testing.assert_array_equal(again[0][3], rot[3])
     assert r.closed
     with pytest.raises(am.InvalidArgumentError, match="closed"):
         r.apply(poses)

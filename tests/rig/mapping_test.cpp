@@ -73,7 +73,10 @@ const char* k_minimal = R"({"format_version": 1, "name": "t", "bones": {"hips": 
 
 TEST(mapping, every_shipped_table_loads) {
   auto tables = shipped();
-  ASSERT_EQ(tables.size(), 7u);
+  ASSERT_EQ(tables.size(), 8u);
+  // CMU's mocap skeleton (a BVH): one finger segment a hand, no thumbs bound.
+  ASSERT_NE(by_name(tables, "cmu"), nullptr);
+  EXPECT_EQ(by_name(tables, "cmu")->mapped_count(), 24);
   for (const char* n : {"vrm1", "vrm0", "mixamo", "unity_humanoid", "ue4_mannequin",
                         "ue5_mannequin", "character_creator"}) {
     const mapping_table* t = by_name(tables, n);

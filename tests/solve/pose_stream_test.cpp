@@ -1,6 +1,7 @@
 // pose_stream: each filter mode gives exactly what its stages give when assembled by hand
 // (frame_solver, pose_filter with channels, offline_smoother with the gate opened,
-// landmark_filter, pose_resampler), the fixed-rate grid gives the resampler's pose at
+// landmark_filter, the foot contact stage — both-sided after the offline filter, causal
+// otherwise — and pose_resampler), the fixed-rate grid gives the resampler's pose at
 // t0 + j / fps for every j up to the newest pose, and the filter rules (filter_rules.hpp)
 // validate and bound the smoothing strength once.
 #include "avatarmap/solve/pose_stream.hpp"
@@ -15,6 +16,7 @@
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
 #include "avatarmap/time/filter_rules.hpp"
+#include "avatarmap/time/foot_contacts.hpp"
 #include "avatarmap/time/offline_smoother.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
@@ -48,6 +50,7 @@ void expect_same(const proxy_pose& a, const proxy_pose& b, const std::string& wh
   ASSERT_EQ(a.hips_position, b.hips_position) << where;
   for (int e = 0; e < k_expression_count; ++e)
     ASSERT_EQ(a.expressions[e], b.expressions[e]) << where;
+  ASSERT_EQ(a.foot_contact, b.foot_contact) << where;
 }
 
 // Pushes every frame and collects the output poses.
@@ -62,38 +65,52 @@ std::vector<proxy_pose> run(pose_stream& s, const std::vector<landmark_frame>& f
   return out;
 }
 
-TEST(pose_stream, live_is_solver_then_filter_on_its_channels_then_resampler) {
+TEST(pose_stream, live_is_solver_then_filter_on_its_channels_then_contacts_then_resampler) {
   const std::vector<landmark_frame> frames = recording(40);
-  pose_stream_options o;
-  o.filters.filter_mode = pose_filter_mode::live;
-  o.filters.filter_channels.position = false;  // a channel that keeps the solver's value
-  pose_stream s(o);
-  frame_solver solver;
-  pose_filter filter;
-  pose_resampler resampler;
-  proxy_pose raw, want;
-  std::vector<proxy_pose> got;
-  for (size_t i = 0; i < frames.size(); ++i) {
-    solver.solve(frames[i], raw);
-    filter.apply(raw, want);
-    want.hips_position = raw.hips_position;
-    resampler.push(want);
-    got.clear();
-    ASSERT_TRUE(s.push(frames[i], [&](const proxy_pose& p) {
-                   got.push_back(p);
-                   return status{};
-                 }).ok());
-    ASSERT_EQ(got.size(), 1u) << "one pose per frame";
-    expect_same(got[0], want, "frame " + std::to_string(i));
-    proxy_pose a, b;
-    const double t = frames[i].t + 0.01;  // a little past the newest: the extrapolation
-    ASSERT_TRUE(s.sample(t, a));
-    ASSERT_TRUE(resampler.sample(t, b));
-    expect_same(a, b, "sample " + std::to_string(i));
+  for (bool contacts_on : {true, false}) {
+    SCOPED_TRACE(contacts_on ? "contacts" : "no contacts");
+    pose_stream_options o;
+    o.filters.filter_mode = pose_filter_mode::live;
+    o.filters.filter_channels.position = false;  // a channel that keeps the solver's value
+    o.filters.foot_contacts.enabled = contacts_on;
+    pose_stream s(o);
+    frame_solver solver;
+    pose_filter filter;
+    foot_contact_stage contacts({}, false);  // causal: no delay
+    pose_resampler resampler;
+    proxy_pose raw, filtered, want;
+    std::vector<proxy_pose> got;
+    long planted = 0;
+    for (size_t i = 0; i < frames.size(); ++i) {
+      solver.solve(frames[i], raw);
+      filter.apply(raw, filtered);
+      filtered.hips_position = raw.hips_position;
+      if (contacts_on) {
+        ASSERT_TRUE(contacts.push(filtered, want));
+      } else {
+        want = filtered;
+      }
+      planted += want.foot_contact[0] > 0.5f;
+      resampler.push(want);
+      got.clear();
+      ASSERT_TRUE(s.push(frames[i], [&](const proxy_pose& p) {
+                     got.push_back(p);
+                     return status{};
+                   }).ok());
+      ASSERT_EQ(got.size(), 1u) << "one pose per frame";
+      expect_same(got[0], want, "frame " + std::to_string(i));
+      proxy_pose a, b;
+      const double t = frames[i].t + 0.01;  // a little past the newest: the extrapolation
+      ASSERT_TRUE(s.sample(t, a));
+      ASSERT_TRUE(resampler.sample(t, b));
+      expect_same(a, b, "sample " + std::to_string(i));
+    }
+    EXPECT_EQ(s.stats().frames, 40);
+    EXPECT_EQ(s.stats().filtered, 40);
+    EXPECT_EQ(s.stats().emitted, 40);
+    EXPECT_EQ(s.stats().planted_frames[0], planted);
+    if (contacts_on) EXPECT_GT(planted, 0) << "the demo motion stands on its left foot at times";
   }
-  EXPECT_EQ(s.stats().frames, 40);
-  EXPECT_EQ(s.stats().filtered, 40);
-  EXPECT_EQ(s.stats().emitted, 40);
 }
 
 TEST(pose_stream, offline_opens_the_gate_and_smooths_with_the_lookahead) {
@@ -105,15 +122,19 @@ TEST(pose_stream, offline_opens_the_gate_and_smooths_with_the_lookahead) {
   gate_open.confidence.regain_seconds = 0.f;
   frame_solver solver(gate_open);
   offline_smoother smoother;
+  foot_contact_stage contacts({}, true);  // both-sided after the offline filter
   std::vector<proxy_pose> want;
-  proxy_pose raw, p;
+  proxy_pose raw, p, q;
   for (const landmark_frame& f : frames) {
     solver.solve(f, raw);
     smoother.push(raw);
-    while (smoother.pop(p)) want.push_back(p);
+    while (smoother.pop(p))
+      if (contacts.push(p, q)) want.push_back(q);
   }
   smoother.finish();
-  while (smoother.pop(p)) want.push_back(p);
+  while (smoother.pop(p))
+    if (contacts.push(p, q)) want.push_back(q);
+  while (contacts.flush(q)) want.push_back(q);
   const std::vector<proxy_pose> got = run(s, frames);
   ASSERT_EQ(got.size(), frames.size());
   ASSERT_EQ(want.size(), got.size());
@@ -135,13 +156,15 @@ TEST(pose_stream, none_with_points_filters_the_landmarks_before_solving) {
   pose_stream s(o);
   landmark_filter points(o.filters.landmark_filter);
   frame_solver solver;
+  foot_contact_stage contacts({}, false);
   landmark_frame smoothed;
-  proxy_pose want;
+  proxy_pose raw, want;
   const std::vector<proxy_pose> got = run(s, frames);
   ASSERT_EQ(got.size(), frames.size());
   for (size_t i = 0; i < frames.size(); ++i) {
     points.apply(frames[i], smoothed);
-    solver.solve(smoothed, want);
+    solver.solve(smoothed, raw);
+    ASSERT_TRUE(contacts.push(raw, want));
     expect_same(got[i], want, "frame " + std::to_string(i));
   }
 }
@@ -161,13 +184,15 @@ TEST(pose_stream, output_fps_samples_the_grid_up_to_the_newest_pose) {
   // Each is the resampler's pose at its grid time, over the live filter's poses known then.
   frame_solver solver;
   pose_filter filter;
+  foot_contact_stage contacts({}, false);
   pose_resampler resampler;
-  proxy_pose raw, filtered, want;
+  proxy_pose raw, filtered, contacted, want;
   size_t j = 0;
   for (const landmark_frame& f : frames) {
     solver.solve(f, raw);
     filter.apply(raw, filtered);
-    resampler.push(filtered);
+    ASSERT_TRUE(contacts.push(filtered, contacted));
+    resampler.push(contacted);
     for (; j < got.size() && t0 + static_cast<double>(j) / 70.0 <= f.t + 1e-9; ++j) {
       const double t = t0 + static_cast<double>(j) / 70.0;
       ASSERT_TRUE(resampler.sample(t, want));

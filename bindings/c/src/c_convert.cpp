@@ -37,6 +37,7 @@ avm_convert_options default_convert_options() {
   o.solver = nullptr;
   o.warning = nullptr;
   o.user = nullptr;
+  o.foot_lock = job.foot_lock.enabled ? 1 : 0;
   return o;
 }
 
@@ -48,6 +49,8 @@ int kind_code(am::motion_input kind) {
       return AVM_MOTION_INPUT_POSES;
     case am::motion_input::vrma:
       return AVM_MOTION_INPUT_VRMA;
+    case am::motion_input::bvh:
+      return AVM_MOTION_INPUT_BVH;
   }
   return AVM_MOTION_INPUT_NONE;
 }
@@ -141,6 +144,7 @@ AVATARMAP_C_API avm_status avm_convert_file(const char* input, const char* outpu
     job.binding.mappings_folder = given_mappings_folder();
     job.keep_feet_on_ground = o.keep_feet_on_ground != 0;
     job.root_motion = o.root_motion != 0;
+    job.foot_lock.enabled = o.foot_lock != 0;
     job.avatar_name = "options->avatar";
     if (o.warning != nullptr) {
       const avm_warning_fn warn = o.warning;

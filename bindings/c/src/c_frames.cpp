@@ -60,6 +60,7 @@ void to_c_pose(const am::proxy_pose& p, avm_pose& out) noexcept {
     out.confidence[b] = p.confidence[b];
   }
   for (int e = 0; e < AVM_EXPRESSION_COUNT; ++e) out.expressions[e] = p.expressions[e];
+  for (int f = 0; f < 2; ++f) out.foot_contact[f] = p.foot_contact[f];
 }
 
 void to_c_frame(const am::landmark_frame& in, frame_storage& storage, avm_frame& out) noexcept {

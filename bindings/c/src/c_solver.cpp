@@ -43,6 +43,7 @@ am::pose_stream_options stream_options(const core_options& o) {
   so.filters.filter_mode = am::pose_filter_mode::live;  // filter.enabled = false: none
   so.filters.filter = o.filter;
   so.filters.filter_channels = o.channels;
+  so.filters.foot_contacts = o.foot_contacts;
   so.resampler = o.resampler;
   so.name = "avm_solver";
   return so;

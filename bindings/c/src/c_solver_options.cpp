@@ -67,6 +67,9 @@ constexpr c_field k_fields[] = {
     AVM_FIELD(file_smoothing),
     AVM_FIELD(file_threads),
     AVM_FIELD(fit_hand_shape),
+    AVM_FIELD(fit_body_to_image),
+    AVM_FIELD(foot_contacts),
+    AVM_FIELD(root_follows_contacts),
 };
 #undef AVM_FIELD
 static_assert(sizeof(k_fields) / sizeof(k_fields[0]) * 4 + 4 == sizeof(avm_solver_options),
@@ -193,6 +196,7 @@ bool read_options(const avm_solver_options* in, core_options& out, std::string& 
   out.file_filter = lib.file.filter_mode;
   out.file_smoothing = lib.file.offline.strength;
   out.file_threads = lib.file.threads;
+  out.foot_contacts = lib.file.foot_contacts;
   return true;
 }
 
@@ -207,6 +211,7 @@ solve_file_job file_job(const core_options& o) {
   job.filter = o.filter;
   job.filter_channels = o.channels;
   job.threads = o.file_threads;
+  job.foot_contacts = o.foot_contacts;
   return job;
 }
 

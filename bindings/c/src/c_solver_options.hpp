@@ -21,7 +21,8 @@ struct core_options {
   avatarmap::pose_filter_mode file_filter =
       avatarmap::pose_filter_mode::offline;  // avm_solve_file only
   float file_smoothing = 1.f;
-  int file_threads = 2;  // avm_solve_file, avm_solve_file_to_clip
+  int file_threads = 2;                           // avm_solve_file, avm_solve_file_to_clip
+  avatarmap::foot_contact_options foot_contacts;  // both paths (pose_stream_filters)
 };
 
 /// The defaults, as avm_solver_options_init() gives them.

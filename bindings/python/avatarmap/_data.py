@@ -108,7 +108,9 @@ class Poses:
     ``t`` (N,) float64 seconds; ``hips_position`` (N, 3) float32 metres in VRM space (Y =
     hips height above the soles); ``rotations`` (N, 55, 4) float32 local rotations as
     quaternions {x, y, z, w} (identity = VRM T-pose); ``confidence`` (N, 55) 0..1;
-    ``expressions`` (N, 16) weights 0..1 (``EXPRESSION_NAMES`` order). The arrays of poses
+    ``expressions`` (N, 16) weights 0..1 (``EXPRESSION_NAMES`` order); ``foot_contact``
+    (N, 2) float32 per foot, [:, 0] left, [:, 1] right: 0 = free .. 1 = planted
+    (docs/contacts.md; None = all 0 when writing). The arrays of poses
     returned by this package are views of one record array laid out as the C API's avm_pose
     (``records``).
     """
@@ -118,6 +120,7 @@ class Poses:
     rotations: np.ndarray
     confidence: np.ndarray
     expressions: np.ndarray
+    foot_contact: Optional[np.ndarray] = None
     _records: Optional[np.ndarray] = field(default=None, repr=False, compare=False)
 
     def __len__(self) -> int:
@@ -131,7 +134,8 @@ class Poses:
                                        "avatarmap.POSE_DTYPE", 1)
         return cls(t=records["t"], hips_position=records["hips_position"],
                    rotations=records["rotations"], confidence=records["confidence"],
-                   expressions=records["expressions"], _records=records)
+                   expressions=records["expressions"], foot_contact=records["foot_contact"],
+                   _records=records)
 
     @classmethod
     def empty(cls, n: int) -> "Poses":
@@ -152,8 +156,11 @@ class Poses:
         rec = np.empty(n, dtype=POSE_DTYPE)
         for name, shape in (("t", (n,)), ("hips_position", (n, 3)),
                             ("rotations", (n, BONE_COUNT, 4)), ("confidence", (n, BONE_COUNT)),
-                            ("expressions", (n, EXPRESSION_COUNT))):
-            value = np.asarray(getattr(self, name))
+                            ("expressions", (n, EXPRESSION_COUNT)), ("foot_contact", (n, 2))):
+            value = getattr(self, name)
+            if value is None and name == "foot_contact":
+                value = np.zeros(shape, dtype=np.float32)
+            value = np.asarray(value)
             if value.shape != shape:
                 raise InvalidArgumentError("Poses.%s: shape %s, expected %s"
                                            % (name, value.shape, shape), 1)
@@ -161,7 +168,8 @@ class Poses:
         return rec
 
     def _views(self, rec: np.ndarray) -> bool:
-        for name in ("t", "hips_position", "rotations", "confidence", "expressions"):
+        for name in ("t", "hips_position", "rotations", "confidence", "expressions",
+                     "foot_contact"):
             a = getattr(self, name)
             b = rec[name]
             if not isinstance(a, np.ndarray) or a.shape != b.shape or a.strides != b.strides \
@@ -638,8 +646,8 @@ class _Target:
 
 def motion_input_kind(path: PathLike) -> Optional[str]:
     """The kind of motion file convert_file() reads at ``path``, by the library's one rule
-    (avm_motion_input_kind; the CLI's ``convert`` uses it too): "landmarks", "poses" or
-    "vrma", or None when it reads none. The name's extension decides first (any case:
+    (avm_motion_input_kind; the CLI's ``convert`` uses it too): "landmarks", "poses",
+    "vrma" or "bvh", or None when it reads none. The name's extension decides first (any case:
     ``.landmarks.jsonl``, ``.pose.jsonl``, ``.vrma``); else "-" is landmarks; else the first
     bytes of a regular file (a GLB is a .vrma; a JSON header names its format); else a
     ``*.jsonl`` is landmarks."""

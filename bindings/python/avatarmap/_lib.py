@@ -70,7 +70,7 @@ class AvmFrame(ctypes.Structure):
 class AvmPose(ctypes.Structure):
     _fields_ = [("t", _F64), ("hips_position", _F32 * 3),
                 ("rotations", (_F32 * 4) * BONE_COUNT), ("confidence", _F32 * BONE_COUNT),
-                ("expressions", _F32 * EXPRESSION_COUNT)]
+                ("expressions", _F32 * EXPRESSION_COUNT), ("foot_contact", _F32 * 2)]
 
 
 # The avm_pose array as NumPy sees it: one record per pose, same offsets as the C struct
@@ -78,7 +78,8 @@ class AvmPose(ctypes.Structure):
 POSE_DTYPE = np.dtype([("t", "<f8"), ("hips_position", "<f4", (3,)),
                        ("rotations", "<f4", (BONE_COUNT, 4)),
                        ("confidence", "<f4", (BONE_COUNT,)),
-                       ("expressions", "<f4", (EXPRESSION_COUNT,))], align=True)
+                       ("expressions", "<f4", (EXPRESSION_COUNT,)),
+                       ("foot_contact", "<f4", (2,))], align=True)
 
 
 class AvmSolverOptions(ctypes.Structure):
@@ -105,11 +106,13 @@ class AvmSolverOptions(ctypes.Structure):
         ("expression_beta", _F32), ("expression_d_cutoff", _F32),
         ("max_extrapolation_seconds", _F32),
         ("file_filter", _I32), ("file_smoothing", _F32), ("file_threads", _I32),
-        ("fit_hand_shape", _I32),
+        ("fit_hand_shape", _I32), ("fit_body_to_image", _I32),
+        ("foot_contacts", _I32), ("root_follows_contacts", _I32),
     ]
     _kinds_ = {name: BOOL for name in (
         "mirror", "solve_body", "solve_hands", "solve_face", "solve_hips_translation",
-        "filter_rotations", "filter_position", "filter_expressions", "fit_hand_shape")}
+        "filter_rotations", "filter_position", "filter_expressions", "fit_hand_shape",
+        "fit_body_to_image", "foot_contacts", "root_follows_contacts")}
     _ranges_ = {"file_filter": (0, 2),  # avm_file_filter
                 "file_threads": (1, 2)}
 
@@ -148,8 +151,8 @@ class AvmConvertOptions(ctypes.Structure):
     _fields_ = [("struct_size", _U32), ("fps", _F64), ("avatar", ctypes.c_char_p),
                 ("mapping", ctypes.c_char_p), ("keep_feet_on_ground", _I32),
                 ("root_motion", _I32), ("solver", ctypes.POINTER(AvmSolverOptions)),
-                ("warning", WARNING_FN), ("user", _P)]
-    _kinds_ = {name: BOOL for name in ("keep_feet_on_ground", "root_motion")}
+                ("warning", WARNING_FN), ("user", _P), ("foot_lock", _I32)]
+    _kinds_ = {name: BOOL for name in ("keep_feet_on_ground", "root_motion", "foot_lock")}
 
 
 class AvmConvertSummary(ctypes.Structure):
@@ -159,7 +162,7 @@ class AvmConvertSummary(ctypes.Structure):
 
 
 # avm_motion_input
-MOTION_INPUTS = {1: "landmarks", 2: "poses", 3: "vrma"}
+MOTION_INPUTS = {1: "landmarks", 2: "poses", 3: "vrma", 4: "bvh"}
 
 
 class AvmCaptureSummary(ctypes.Structure):

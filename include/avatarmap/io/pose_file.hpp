@@ -1,7 +1,8 @@
 // Streaming reader and writer of *.pose.jsonl (docs/file-formats.md).
 // Quaternions are written [x, y, z, w]; bones are VRM 1.0 names; bones at identity may be
-// omitted when reading (missing bones mean identity). Same error and atomicity rules as
-// landmark_file.hpp.
+// omitted when reading (missing bones mean identity). "foot_contact": [left, right] is always
+// written and optional when reading (older files: 0, 0; values clamped to [0, 1]). Same error
+// and atomicity rules as landmark_file.hpp.
 #pragma once
 
 #include <memory>

@@ -13,6 +13,7 @@
 
 #include "avatarmap/core/limits.hpp"
 #include "avatarmap/core/status.hpp"
+#include "avatarmap/rig/foot_lock.hpp"
 #include "avatarmap/rig/mapping.hpp"
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/rig/rig.hpp"
@@ -62,6 +63,8 @@ struct clip_output_summary {
   std::size_t frames_written = 0;
   double fps = 0.0;                  // the rate written (0: the frames' own times)
   float standing_hips_height = 0.f;  // rig outputs with root motion (metres)
+  /// "" or why foot locking is off for a leg of the avatar (foot_lock::warning()).
+  std::string foot_lock_warning;
 };
 
 /// The job. The caller keeps `frames`, `avatar_rig` and `avatar_table` alive during run().
@@ -87,6 +90,10 @@ struct clip_output_job {
   const mapping_table* avatar_table = nullptr;  // formulas (rig_binding_choice::table_or_null())
   bool keep_feet_on_ground = false;             // see retarget_clip_job
   bool root_motion = true;
+  /// Foot locking (docs/foot-locking.md): on the avatar's rig for avatar outputs
+  /// (retarget_clip_job::foot_lock), on the proxy skeleton for .vrma and proxy .bvh when a
+  /// frame has a foot contact (lock_feet); .pose.jsonl is written as given. Default on.
+  foot_lock_options foot_lock{};
   /// Optional, for diagnostics: the proxy frames that were written (resampled as written) and,
   /// for avatar outputs, the rig poses.
   std::vector<proxy_pose>* out_frames = nullptr;

@@ -33,7 +33,7 @@
 
 namespace avatarmap {
 
-enum class motion_input : std::uint8_t { landmarks, poses, vrma };
+enum class motion_input : std::uint8_t { landmarks, poses, vrma, bvh };
 
 /// One kind of motion input.
 struct motion_input_info {
@@ -43,13 +43,14 @@ struct motion_input_info {
 };
 
 /// Every motion input, in the order messages list them.
-inline constexpr std::array<motion_input_info, 3> k_motion_inputs = {{
+inline constexpr std::array<motion_input_info, 4> k_motion_inputs = {{
     {motion_input::landmarks, ".landmarks.jsonl", "landmarks (solved as `avatarmap solve` does)"},
     {motion_input::poses, ".pose.jsonl", "proxy poses"},
     {motion_input::vrma, ".vrma", "VRM Animation"},
+    {motion_input::bvh, ".bvh", "BVH motion (read on its own skeleton, rig/bvh_rig.hpp)"},
 }};
 
-/// The inputs as a phrase: "*.landmarks.jsonl, *.pose.jsonl or *.vrma".
+/// The inputs as a phrase: "*.landmarks.jsonl, *.pose.jsonl, *.vrma or *.bvh".
 std::string motion_input_list();
 
 /// The kind of motion input at `path`, by one rule:
@@ -60,9 +61,9 @@ std::string motion_input_list();
 ///     "avatarmap.pose" or "avatarmap.landmarks" is that;
 ///  4. another name ending in .jsonl (any case): landmarks (a landmark file need not start
 ///     with a header).
-/// Fails (invalid_argument) naming the path and the inputs when none applies (a .bvh is said to
-/// be an output only). `out_stem` (optional) gets the path without the extension that decided
-/// (rule 3: without the last extension, if any). Never throws but for std::bad_alloc.
+/// Fails (invalid_argument) naming the path and the inputs when none applies. `out_stem` (optional)
+/// gets the path without the extension that decided (rule 3: without the last extension, if any).
+/// Never throws but for std::bad_alloc.
 status find_motion_input(const std::string& path, const motion_input_info*& out,
                          std::string* out_stem = nullptr);
 
@@ -72,7 +73,8 @@ struct motion_clip {
   /// The poses in time order (the rule above). Times are finite.
   std::vector<proxy_pose> frames;
   /// The input's nominal rate: a pose file's header fps, a landmark file's (as `avatarmap
-  /// solve` would write it: solve_file_summary::fps); 0 for a .vrma or when not given.
+  /// solve` would write it: solve_file_summary::fps), a BVH's 1 / Frame Time; 0 for a .vrma or
+  /// when not given.
   double source_fps = 0.0;
   /// Frames that were earlier than the frame before them (0: read in order; nothing moved).
   std::size_t out_of_order = 0;
@@ -81,12 +83,13 @@ struct motion_clip {
 };
 
 /// Reads `path` (find_motion_input) into `out` (replaced): a pose file as written, a .vrma at
-/// its key times (read_vrma), a landmark file solved by `solve` (a copy of it with `input`
-/// and a sink set: its options, filters, threads, progress and warnings apply) — or refused
-/// (invalid_argument) when `solve` is null; then the frames put in time order. Fails with the
-/// reader's status (io: cannot be read; parse: a malformed line, naming the file and line, or
-/// a malformed .vrma), or the solve's. An empty file is no error (no frames). Never throws but
-/// for std::bad_alloc.
+/// its key times (read_vrma), a .bvh at i × Frame Time through its own skeleton
+/// (read_bvh_motion: bound by the tables' "auto", units detected), a landmark file solved by
+/// `solve` (a copy of it with `input` and a sink set: its options, filters, threads, progress and
+/// warnings apply) — or refused (invalid_argument) when `solve` is null; then the frames put in
+/// time order. Fails with the reader's status (io: cannot be read; parse: a malformed line, naming
+/// the file and line, or a malformed .vrma), or the solve's. An empty file is no error (no frames).
+/// Never throws but for std::bad_alloc.
 status read_motion(const std::string& path, const solve_file_job* solve, motion_clip& out);
 
 /// What a convert did.
@@ -126,6 +129,9 @@ struct convert_file_job {
   bind_avatar_options binding{};
   bool keep_feet_on_ground = false;  // see retarget_clip_job
   bool root_motion = true;
+  /// Foot locking on the output (clip_output_job::foot_lock); a leg of the avatar that cannot
+  /// be locked is told through `warning`.
+  foot_lock_options foot_lock{};
   /// What messages call the avatar when a format needs one (the CLI says "--avatar AVATAR").
   std::string avatar_name = "an avatar";
   /// Optional: what the run warns about (frames out of time order; the landmark solve's
@@ -138,7 +144,8 @@ struct convert_file_job {
 
   /// Checks what needs no file: input and output set, the output's extension known
   /// (clip_format_for), fps finite in [0, k_max_output_fps], an avatar given where the format
-  /// needs one ("<ext> output needs <avatar_name> (the model to animate)"), the solve's options
+  /// needs one ("<ext> output needs <avatar_name> (the model to animate)") and is no .bvh
+  /// skeleton there (a .glb animates a mesh), the solve's options
   /// (solve_file_job::validate). All invalid_argument.
   status validate() const;
   /// validate(), then: the input's kind (find_motion_input), the avatar bound when the output

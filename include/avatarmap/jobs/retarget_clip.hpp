@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "avatarmap/core/status.hpp"
+#include "avatarmap/rig/foot_lock.hpp"
 #include "avatarmap/rig/mapping.hpp"
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/rig/rig.hpp"
@@ -42,17 +43,23 @@ struct retarget_clip_job {
   /// height, see standing_hips_height()); false: the hips keep their rest translation and the
   /// standing height is neither needed nor checked.
   bool root_motion = true;
+  /// Foot locking after the retarget, frame by frame in order (rig/foot_lock.hpp,
+  /// docs/foot-locking.md): the feet planted by the frames' foot_contact stay put on the rig.
+  /// foot_lock.enabled = false turns it off.
+  foot_lock_options foot_lock{};
   /// Names the clip in messages (a file name, or the C function).
   std::string what = "clip";
 
-  /// Checks frames (set, not empty), target (set) and binding (every joint index -1 or within
-  /// the rig). The message names the field.
+  /// Checks frames (set, not empty), target (set), binding (every joint index -1 or within
+  /// the rig) and foot_lock (foot_lock_options::validate). The message names the field.
   status validate() const;
   /// validate(), the standing height (root_motion only), retargeter::build, then one rig pose
   /// per frame into `out_poses` (replaced). On failure `out_poses` is empty and the status's
   /// code says why: invalid_argument for the fields and the clip's heights, parse for a
-  /// binding the retargeter refuses. Never throws but for std::bad_alloc.
-  status run(std::vector<rig_pose>& out_poses, float* out_standing_height = nullptr) const;
+  /// binding the retargeter refuses. `out_warning`, when given, gets foot_lock::warning() (""
+  /// when both legs can be locked or locking is off). Never throws but for std::bad_alloc.
+  status run(std::vector<rig_pose>& out_poses, float* out_standing_height = nullptr,
+             std::string* out_warning = nullptr) const;
 };
 
 }  // namespace avatarmap

@@ -60,6 +60,12 @@ struct solve_file_summary {
   float horizontal_fov_degrees = 0.f;
   bool fov_estimated = false;
   long fov_evidence_frames = 0;
+  /// The camera's pitch (degrees, + = looking down) and roll relative to gravity learnt from
+  /// the standing body (frame_solver::camera_pitch_degrees()), from gravity_evidence_frames
+  /// frames (0: a level camera was assumed, or the body was not fitted to the image).
+  float camera_pitch_degrees = 0.f;
+  float camera_roll_degrees = 0.f;
+  long gravity_evidence_frames = 0;
 };
 
 /// The job. Fill the inputs, call run(). Thread-safety: a job may be run from any thread; the
@@ -191,6 +197,20 @@ inline constexpr option_row<solve_file_job> k_solve_file_option_table[] = {
         .integer(1, 2)
         .cli("--threads", "1|2")
         .help("2 parses the input on a second thread; 1 does all on one"),
+    option_row<solve_file_job>("foot_contacts",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, foot_contacts.enabled))
+        .boolean()
+        .cli(nullptr, nullptr, "--no-foot-contacts")
+        .help("--no-foot-contacts: no foot contact detection (foot_contact 0, the hips as "
+              "filtered); default: planted feet are detected and the hips follow them "
+              "(docs/contacts.md)"),
+    option_row<solve_file_job>(
+        "root_follows_contacts",
+        AVATARMAP_OPTION_FIELD(solve_file_job, foot_contacts.root_follows_contacts))
+        .boolean()
+        .cli(nullptr, nullptr, "--no-root-follow")
+        .help("--no-root-follow: detect foot contacts but leave the hips as filtered (default: "
+              "the hips move so that a planted foot stays where it landed)"),
     option_row<solve_file_job>("output_fps", AVATARMAP_OPTION_FIELD(solve_file_job, output_fps))
         .number(0, k_max_fps, true)
         .or_zero()

@@ -30,6 +30,10 @@ namespace avatarmap {
 ///  - none of these: gltf, no humanoid bones, no expressions.
 /// When a file carries both VRMC_vrm and VRM, VRM 1.0 wins. `out.file` is `path`.
 ///
+/// A name ending in .bvh (any case) is read as a BVH skeleton instead (load_bvh_avatar,
+/// rig/bvh_rig.hpp: the HIERARCHY's joints, rest = OFFSETs with zero rotations, units detected
+/// from the height); its errors name the file and line.
+///
 /// The file is untrusted: before any parser that recurses sees it, it must keep the limits of
 /// docs/security.md (at most 1 GiB, JSON nested at most 128 levels, a well-formed GLB
 /// container, core indices within int, bufferViews inside their buffers, buffer and image URIs

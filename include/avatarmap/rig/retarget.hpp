@@ -73,6 +73,14 @@ class retargeter {
   const bone_binding& binding() const { return binding_; }
   /// Height of the rig's hips joint above its lowest foot joint at rest, in world units.
   float rig_hips_height() const { return rig_hips_height_; }
+  /// Height (rig world Y) at which the lowest foot or toe joint stands in the rest pose: where
+  /// the retargeter puts it for a standing performer, the floor of foot locking.
+  float floor_height() const { return floor_vrm_; }
+  /// The direction the rig faces in its own world (VRM's +Z carried back by the basis).
+  glm::vec3 forward() const { return glm::conjugate(basis_) * glm::vec3(0.f, 0.f, 1.f); }
+  /// Factor from the performer's hips motion (metres) to the rig's world units: the rig's
+  /// hips height over options.performer_hips_height (the ratio of the two legs' lengths).
+  float translation_scale() const { return translation_scale_; }
 
  private:
   const rig* rig_ = nullptr;

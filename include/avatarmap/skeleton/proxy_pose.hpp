@@ -23,6 +23,10 @@ struct proxy_pose {
   std::array<glm::quat, k_bone_count> rotations;        // local, {w,x,y,z} in GLM's storage
   std::array<float, k_bone_count> confidence{};         // 0 = not observed .. 1 = observed
   std::array<float, k_expression_count> expressions{};  // 0 .. 1
+  /// Foot contact per foot ([0] left, [1] right): 0 = the foot moves freely .. 1 = planted
+  /// on the floor; values between blend foot locking in and out. Set by the contact stage
+  /// (time/foot_contacts.hpp); 0 when no stage ran.
+  std::array<float, 2> foot_contact{};
 
   proxy_pose() { set_rest(); }
 
@@ -32,6 +36,7 @@ struct proxy_pose {
     rotations.fill(glm::quat(1.f, 0.f, 0.f, 0.f));
     confidence.fill(0.f);
     expressions.fill(0.f);
+    foot_contact.fill(0.f);
   }
 
   glm::quat& operator[](bone b) { return rotations[idx(b)]; }

@@ -10,6 +10,7 @@
 #include <array>
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <memory>
 
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
@@ -21,6 +22,9 @@ namespace avatarmap {
 
 namespace solve_detail {
 struct prepared_frame;  // src/solve/solve_prepare.hpp
+struct body_lengths;    // src/solve/solve_fit.hpp
+struct camera_gravity;
+struct body_fit;
 }  // namespace solve_detail
 
 /// One bone's measurement before confidence gating and its confidence (0 = not measured this
@@ -50,6 +54,9 @@ class frame_solver {
   /// Options must satisfy options.validate(); invalid options are replaced by defaults
   /// (check validate() first to report the error).
   explicit frame_solver(const solver_options& options = {});
+  ~frame_solver();
+  frame_solver(frame_solver&&) noexcept;
+  frame_solver& operator=(frame_solver&&) noexcept;
 
   /// Solves one frame into `out` (out.t = in.t). Input is never modified. Frames with a time
   /// earlier than the previous one reset the solver's state first. Non-finite landmarks are
@@ -69,8 +76,17 @@ class frame_solver {
   /// given, else the estimate so far (60 before any evidence).
   float horizontal_fov_degrees() const;
   /// Frames whose pose told something about the field of view (0 when it was given, or when
-  /// no frame's image and world points formed one pinhole view, e.g. MediaPipe's own output).
+  /// no frame's image and world points formed one pinhole view). Every third frame is
+  /// fitted, up to 600 that told something (consecutive frames are nearly the same view).
   long fov_evidence_frames() const { return focal_frames_; }
+  /// The camera's pitch (degrees, + = looking down) and roll (+ = the world's up leans toward
+  /// the image's right) relative to gravity, learnt from the standing body's vertical when the
+  /// body is fitted to the image (options().fit_body_to_image); 0 before any evidence (a
+  /// level camera is assumed).
+  float camera_pitch_degrees() const;
+  float camera_roll_degrees() const;
+  /// Frames that told the vertical (straight legs, confident points); 0: level assumed.
+  long gravity_evidence_frames() const;
   /// The shape learnt of the avatar's left (0) or right (1) hand (options().fit_hand_shape).
   const hand_shape& learnt_hand(int side) const { return hand_shapes_[side != 0 ? 1 : 0]; }
 
@@ -83,6 +99,10 @@ class frame_solver {
   const glm::quat& previous_world(int b) const;
   // Adds this frame's evidence on the focal length (horizontal_fov_degrees 0 only).
   void update_focal(const landmark_frame& in);
+  // Stage 1c: the body fitted to the image through the camera (src/solve/solve_fit.hpp);
+  // null when it does not run on this frame. `learn` updates the lengths and gravity.
+  const solve_detail::body_fit* fit_frame(const landmark_frame& in, bool learn,
+                                          solve_detail::body_fit& out) const;
   // Whether a prepared hand is fitted to its shape (options, and metric points seen).
   bool fits_hand(const solve_detail::prepared_frame& f, int side) const;
   // The measuring stages on a prepared frame whose hands are fitted already.
@@ -96,6 +116,7 @@ class frame_solver {
   double focal_information_ = 0.0;
   double focal_weighted_sum_ = 0.0;
   long focal_frames_ = 0;
+  long focal_tick_ = 0;  // frames seen, for sampling the focal length's fit
   std::array<rotation_gate, k_bone_count> bones_{};           // output = the local rotation shown
   mutable std::array<glm::quat, k_bone_count> prev_world_{};  // memo of previous_world()
   mutable std::array<unsigned, k_bone_count> world_stamp_{};
@@ -115,6 +136,11 @@ class frame_solver {
   bool started_ = false;
   mutable frame_measurement scratch_{};
   std::array<hand_shape, 2> hand_shapes_{};  // avatar's left, right (canonical space)
+  // The body fit's state (allocated once, at construction): segment lengths learnt over the
+  // take, the camera's gravity, this frame's fit.
+  std::unique_ptr<solve_detail::body_lengths> lengths_;
+  std::unique_ptr<solve_detail::camera_gravity> gravity_;
+  std::unique_ptr<solve_detail::body_fit> fit_;
 };
 
 }  // namespace avatarmap

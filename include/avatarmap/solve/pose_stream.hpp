@@ -1,22 +1,24 @@
 // Landmark frames in, proxy poses out: solve (frame_solver; landmark_filter first when asked)
-// -> filter (time/filter_rules.hpp: offline_smoother, pose_filter or none) -> resample
+// -> filter (time/filter_rules.hpp: offline_smoother, pose_filter or none) -> foot contacts
+// (time/foot_contacts.hpp: foot_contact and the hips following planted feet; both-sided with
+// the offline filter, window_frames more delay, else causal without delay) -> resample
 // (pose_resampler: at any time through sample(), and, with output_fps, on a fixed grid). The
 // one assembly of that chain, used by the solve-file job (files and frames in memory), the
 // capture pipeline (one image at a time; the live session samples it) and the C API's solver
 // handle.
 //
-// Output poses: with output_fps 0, every filtered pose, in order (the offline filter delays
-// them by its lookahead; finish() hands over the rest). With output_fps > 0, the poses at
-// t0 + j / output_fps for j = 0, 1, 2, ... (t0 = the first filtered pose's time) sampled
-// from the resampler as soon as the filtered poses around them are known; a filtered pose
-// whose time is not finite gives none. A counted j (not a time advanced by 1 / fps) keeps the
-// number of poses per frame exact and bounded whatever the times' magnitude.
+// Output poses: with output_fps 0, every filtered pose, in order (the offline filter and the
+// both-sided contact stage delay them by their lookahead; finish() hands over the rest). With
+// output_fps > 0, the poses at t0 + j / output_fps for j = 0, 1, 2, ... (t0 = the first filtered
+// pose's time) sampled from the resampler as soon as the filtered poses around them are known; a
+// filtered pose whose time is not finite gives none. A counted j (not a time advanced by 1 / fps)
+// keeps the number of poses per frame exact and bounded whatever the times' magnitude.
 //
 // Memory: everything is allocated at construction (the offline filter's window only in
-// offline mode, the point filter and its frame only when enabled): push(), finish() and
-// sample() allocate nothing, but the message of an error.
-// Thread-safety: one stream per thread at a time; sample() only reads the resampler (a caller
-// that samples from another thread than the one pushing must lock around both).
+// offline mode, the contact stage's ring, the point filter and its frame only when enabled):
+// push(), finish() and sample() allocate nothing, but the message of an error. Thread-safety: one
+// stream per thread at a time; sample() only reads the resampler (a caller that samples from
+// another thread than the one pushing must lock around both).
 #pragma once
 
 #include <memory>
@@ -28,6 +30,7 @@
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/solve/solver_options.hpp"
 #include "avatarmap/time/filter_rules.hpp"
+#include "avatarmap/time/foot_contacts.hpp"
 #include "avatarmap/time/offline_smoother.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
@@ -66,6 +69,8 @@ struct pose_stream_stats {
   /// Range of the filtered hips_position.y (metres); 0 .. 0 before the first filtered pose.
   float hips_height_min = 0.f;
   float hips_height_max = 0.f;
+  /// Filtered poses with each foot's contact above 0.5 ([0] left, [1] right).
+  long planted_frames[2] = {0, 0};
 };
 
 class pose_stream {
@@ -117,8 +122,8 @@ class pose_stream {
 
   void solve(const landmark_frame& frame);
   void finish_filter() noexcept;
-  // Takes the next filtered pose into filtered_ (counted, pushed to the resampler); false
-  // when none is ready.
+  // Takes the next filtered pose, through the contact stage, into filtered_ (counted, pushed
+  // to the resampler); false when none is ready.
   bool next_filtered() noexcept;
   // The last grid index at or before filtered_.t (the grid starts at the first filtered
   // pose), or the error when the grid would exceed k_max_resampled_frames poses.
@@ -151,10 +156,12 @@ class pose_stream {
   pose_filter filter_;
   std::unique_ptr<offline_smoother> smoother_;  // filter_mode offline only
   std::unique_ptr<point_stage> points_;         // filters.landmark_filter.enabled only
+  foot_contact_stage contacts_;
   pose_resampler resampler_;
-  proxy_pose solved_, filtered_, sampled_;
-  bool pending_ = false;  // live / none: filtered_ holds a pose not yet taken
-  bool pushed_ = false;   // the resampler took filtered_
+  proxy_pose solved_, staged_, filtered_, sampled_;  // staged_: out of the filter
+  bool pending_ = false;    // live / none: staged_ holds a pose not yet taken
+  bool finishing_ = false;  // finish(): the contact stage hands over what it holds
+  bool pushed_ = false;     // the resampler took filtered_
   pose_stream_stats stats_;
   // The grid (output_fps > 0): its start and the next index to write.
   double t_grid0_ = 0.0;

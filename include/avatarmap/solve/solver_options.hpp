@@ -63,6 +63,12 @@ struct solver_options {
   /// Takes a third of the landmark noise's effect off the fingers and changes nothing on exact
   /// landmarks. false = the hand landmarks as they are.
   bool fit_hand_shape = true;
+  /// Fit the body's metric points to its image points through the camera (docs/solver.md,
+  /// "The body in the world"): segments turn in depth as their foreshortening says, with the
+  /// lengths learnt over the take, and the body is turned upright by the camera's pitch and
+  /// roll learnt from the standing body. Needs image_width/height; false = BlazePose's world
+  /// points as they are (they lean toward the camera) in the camera's axes.
+  bool fit_body_to_image = true;
 
   /// Checks every field against k_solver_option_table (the message names the field and its
   /// range), then image_width and image_height both given or neither, and lost_below <=
@@ -144,6 +150,14 @@ inline constexpr option_row<solver_options> k_solver_option_table[] = {
         .help("--no-hand-fit: use the hand landmarks as they are (default: each hand's points "
               "fitted to its shape learnt over the take, a rigid palm and fingers of constant "
               "length; docs/solver.md)"),
+    option_row<solver_options>("fit_body_to_image",
+                               AVATARMAP_OPTION_FIELD(solver_options, fit_body_to_image))
+        .boolean()
+        .cli(nullptr, nullptr, "--no-body-fit")
+        .help("--no-body-fit: use the pose's world points as they are, in the camera's axes "
+              "(default: the body fitted to the image points through the camera, with the "
+              "take's bone lengths, and turned upright by the camera's pitch and roll; "
+              "docs/solver.md)"),
 };
 
 inline status solver_options::validate() const {

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "avatarmap/core/status.hpp"
+#include "avatarmap/rig/foot_lock.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "avatarmap/stream/host_port.hpp"
 #include "avatarmap/stream/osc_writer.hpp"
@@ -28,8 +29,12 @@ class vmc_stream {
   vmc_stream(const vmc_stream&) = delete;
   vmc_stream& operator=(const vmc_stream&) = delete;
 
-  /// Resolves `to` and keeps `skeleton` (copied). Fails as udp_sender::open does.
-  status open(const host_port& to, const vmc_skeleton& skeleton);
+  /// Resolves `to` and keeps `skeleton` (copied). `foot_lock` (docs/foot-locking.md): planted
+  /// feet (proxy_pose::foot_contact) are locked on the 1.70 m proxy skeleton before each pose
+  /// is sent, the anchors kept from one send() to the next; enabled = false sends the poses as
+  /// given. Fails as udp_sender::open does, or (invalid_argument) on invalid foot_lock options.
+  status open(const host_port& to, const vmc_skeleton& skeleton,
+              const foot_lock_options& foot_lock = {});
   void close() { sender_.close(); }
   bool is_open() const { return sender_.is_open(); }
 
@@ -54,6 +59,9 @@ class vmc_stream {
   udp_sender sender_;
   vmc_skeleton skeleton_{};
   long encode_failures_ = 0;
+  proxy_foot_lock lock_;
+  bool lock_on_ = false;
+  proxy_pose locked_;  // scratch: the pose with its feet locked
 };
 
 }  // namespace avatarmap

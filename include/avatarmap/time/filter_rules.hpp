@@ -10,6 +10,7 @@
 
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
+#include "avatarmap/time/foot_contacts.hpp"
 #include "avatarmap/time/offline_smoother.hpp"
 #include "avatarmap/time/one_euro.hpp"
 #include "avatarmap/time/pose_filter.hpp"
@@ -65,11 +66,14 @@ struct pose_stream_filters {
     o.enabled = false;
     return o;
   }();
+  /// Foot contacts and root motion after the filter (time/foot_contacts.hpp): both-sided with
+  /// the offline filter, causal with the others; on by default.
+  foot_contact_options foot_contacts{};
 
   /// Checks the One Euro parameters of `filter` (min_cutoff and d_cutoff finite and > 0, beta
   /// finite and >= 0: "filter.rotation.min_cutoff must be finite and > 0"), filter_mode known,
-  /// and `offline` (offline_smoother_options::validate, whatever the mode). The message names
-  /// the field.
+  /// `offline` (offline_smoother_options::validate, whatever the mode) and `foot_contacts`
+  /// (foot_contact_options::validate). The message names the field.
   status validate() const;
 };
 

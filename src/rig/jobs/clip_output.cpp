@@ -120,16 +120,31 @@ status clip_output_job::run(clip_output_summary& s) const {
     rj.table = avatar_table;
     rj.keep_feet_on_ground = keep_feet_on_ground;
     rj.root_motion = root_motion;
+    rj.foot_lock = foot_lock;
     rj.what = name;
-    if (status st = rj.run(rig_poses, &s.standing_hips_height); !st.ok())
+    if (status st = rj.run(rig_poses, &s.standing_hips_height, &s.foot_lock_warning); !st.ok())
       return st.code() == status_code::parse ? st.with_message(naming(avatar_path, st.message()))
                                              : st;
   }
 
+  // Proxy outputs: the feet locked on the proxy skeleton the writers use, when the clip has
+  // contacts at all (a clip without any is written exactly as given).
+  std::vector<proxy_pose> locked;
+  const bool proxy_output =
+      format.format == clip_format::vrma || (format.format == clip_format::bvh && !on_avatar);
+  if (proxy_output && foot_lock.enabled &&
+      std::any_of(written.begin(), written.end(), [](const proxy_pose& p) {
+        return p.foot_contact[0] > 0.f || p.foot_contact[1] > 0.f;
+      })) {
+    locked = written;
+    if (status st = lock_feet(locked, foot_lock); !st.ok()) return st;
+  }
+  const std::vector<proxy_pose>& proxy_frames = locked.empty() ? written : locked;
+
   status st;
   switch (format.format) {
     case clip_format::vrma: {
-      st = write_vrma(path, written);  // at the written frames' own (resampled) times
+      st = write_vrma(path, proxy_frames);  // at the written frames' own (resampled) times
       break;
     }
     case clip_format::bvh: {
@@ -140,7 +155,7 @@ status clip_output_job::run(clip_output_summary& s) const {
       } else {
         bvh_write_options o;
         o.fps = rate;  // Frame Time 1 / fps (0: the frames' mean spacing)
-        st = write_bvh(path, written, o);
+        st = write_bvh(path, proxy_frames, o);
       }
       break;
     }
@@ -162,7 +177,7 @@ status clip_output_job::run(clip_output_summary& s) const {
     }
   }
   if (!st.ok()) return st.is_out_of_memory() ? st : st.with_message(naming(path, st.message()));
-  if (out_frames != nullptr) *out_frames = written;
+  if (out_frames != nullptr) *out_frames = proxy_frames;
   if (out_rig_poses != nullptr) *out_rig_poses = std::move(rig_poses);
   return {};
 }

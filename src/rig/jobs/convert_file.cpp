@@ -9,6 +9,7 @@
 
 #include "avatarmap/export/vrma.hpp"
 #include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/rig/bvh_rig.hpp"
 #include "avatarmap/time/resample_clip.hpp"
 #include "avatarmap/time/seconds_text.hpp"
 #include "rig/jobs/file_extension.hpp"
@@ -105,9 +106,6 @@ status find_motion_input(const std::string& path, const motion_input_info*& out,
     if (out_stem != nullptr) *out_stem = without_suffix(path, ext);
     return {};
   }
-  if (ends_with_nocase(path, ".bvh"))
-    return status::invalid_argument(path + ": .bvh is written, not read; give " +
-                                    motion_input_list());
   return status::invalid_argument(path + ": unknown input type (give " + motion_input_list() + ")");
 }
 
@@ -125,6 +123,12 @@ status read_motion(const std::string& path, const solve_file_job* solve, motion_
     case motion_input::poses:
       st = read_pose_file(path, out);
       break;
+    case motion_input::bvh: {
+      bvh_motion_summary bvh;
+      st = read_bvh_motion(path, bvh_motion_options{}, out.frames, &bvh);
+      if (st.ok() && bvh.frame_time > 0.0) out.source_fps = 1.0 / bvh.frame_time;
+      break;
+    }
     case motion_input::landmarks: {
       if (solve == nullptr)
         return status::invalid_argument(
@@ -163,6 +167,10 @@ status convert_file_job::validate() const {
   if (format->needs_avatar && avatar.empty())
     return status::invalid_argument(std::string(format->extension) + " output needs " +
                                     avatar_name + " (the model to animate)");
+  if (format->needs_avatar && ends_with_nocase(avatar, ".bvh"))
+    return status::invalid_argument(
+        std::string(format->extension) + " output needs a glTF or VRM avatar (a mesh to " +
+        "animate); " + avatar + " is a BVH skeleton: write .bvh with it instead");
   // The solve's own fields (a landmark input is known only once the file is looked at).
   solve_file_job s = solve;
   s.input = input;
@@ -222,9 +230,12 @@ status convert_file_job::run(convert_file_summary& out) const {
   }
   job.keep_feet_on_ground = keep_feet_on_ground;
   job.root_motion = root_motion;
+  job.foot_lock = foot_lock;
   job.out_frames = out_frames;
   job.out_rig_poses = out_rig_poses;
   if (status st = job.run(out.output); !st.ok()) return st;
+  if (!out.output.foot_lock_warning.empty() && warning)
+    warning(avatar + ": " + out.output.foot_lock_warning);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return {};
 }

@@ -48,12 +48,16 @@ status retarget_clip_job::validate() const {
           "retarget_clip_job.binding[" + std::string(bone_name(static_cast<bone>(b))) + "] is " +
           std::to_string(j) + ": give -1 (unbound) or a joint index below " + std::to_string(n));
   }
+  if (status st = foot_lock.validate(); !st.ok())
+    return status::invalid_argument("retarget_clip_job." + st.message());
   return {};
 }
 
-status retarget_clip_job::run(std::vector<rig_pose>& out_poses, float* out_standing_height) const {
+status retarget_clip_job::run(std::vector<rig_pose>& out_poses, float* out_standing_height,
+                              std::string* out_warning) const {
   out_poses.clear();
   if (out_standing_height != nullptr) *out_standing_height = 0.f;
+  if (out_warning != nullptr) out_warning->clear();
   if (status st = validate(); !st.ok()) return st;
   retarget_options ro;
   ro.keep_feet_on_ground = keep_feet_on_ground;
@@ -68,10 +72,16 @@ status retarget_clip_job::run(std::vector<rig_pose>& out_poses, float* out_stand
   // may be small.
   auto rt = std::make_unique<retargeter>();
   if (status st = rt->build(*target, binding, ro, table); !st.ok()) return st;  // parse
+  auto lock = std::make_unique<avatarmap::foot_lock>();
+  if (foot_lock.enabled) {
+    if (status st = lock->build(*rt, foot_lock); !st.ok()) return st;  // invalid_argument
+    if (out_warning != nullptr) *out_warning = lock->warning();
+  }
   out_poses.resize(frames->size());
   for (std::size_t i = 0; i < frames->size(); ++i) {
     rt->prepare(out_poses[i]);
     rt->apply((*frames)[i], out_poses[i]);
+    if (foot_lock.enabled) lock->apply((*frames)[i].foot_contact, out_poses[i]);
   }
   return {};
 }

@@ -232,6 +232,9 @@ status solve_file_job::run(solve_file_summary& s) const {
   s.horizontal_fov_degrees = stream.solver().horizontal_fov_degrees();
   s.fov_estimated = solve_options.horizontal_fov_degrees == 0.f;
   s.fov_evidence_frames = stream.solver().fov_evidence_frames();
+  s.camera_pitch_degrees = stream.solver().camera_pitch_degrees();
+  s.camera_roll_degrees = stream.solver().camera_roll_degrees();
+  s.gravity_evidence_frames = stream.solver().gravity_evidence_frames();
   return {};
 }
 

@@ -28,7 +28,8 @@ status pose_stream_filters::validate() const {
   if (filter_mode != pose_filter_mode::offline && filter_mode != pose_filter_mode::live &&
       filter_mode != pose_filter_mode::none)
     return status::error("filter_mode must be offline, live or none");
-  return offline.validate();
+  if (status st2 = offline.validate(); !st2.ok()) return st2;
+  return foot_contacts.validate();
 }
 
 status check_smoothing(double value, const std::string& name) {

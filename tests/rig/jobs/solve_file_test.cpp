@@ -16,6 +16,7 @@
 #include "avatarmap/solve/frame_solver.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
+#include "avatarmap/time/foot_contacts.hpp"
 #include "avatarmap/time/offline_smoother.hpp"
 #include "support/temp_dir.hpp"
 
@@ -51,25 +52,29 @@ void write_synthetic(const std::string& path, int frames, bool header = true) {
   ASSERT_TRUE(writer.commit().ok());
 }
 
-// The reference: the file read back with landmark_reader, solved and filtered frame by frame.
+// The reference: the file read back with landmark_reader, solved and filtered frame by frame,
+// then the contact stage (time/foot_contacts.hpp) as the job runs it.
 std::vector<proxy_pose> reference_poses(const std::string& path, const solver_options& options,
                                         const pose_filter_options& filter_options,
-                                        const pose_filter_channels& channels = {}) {
+                                        const pose_filter_channels& channels = {},
+                                        const foot_contact_options& contact_options = {}) {
   std::vector<proxy_pose> out;
   landmark_reader reader;
   EXPECT_TRUE(reader.open(path).ok());
   frame_solver solver(options);
   pose_filter filter(filter_options);
+  foot_contact_stage contacts(contact_options, false);  // causal: one pose in, one out
   landmark_frame frame;
-  proxy_pose raw, filtered;
+  proxy_pose raw, filtered, contacted;
   while (reader.next(frame) == read_result::frame) {
     solver.solve(frame, raw);
     filter.apply(raw, filtered);
     if (!channels.position) filtered.hips_position = raw.hips_position;
     if (!channels.rotations) filtered.rotations = raw.rotations;
     if (!channels.expressions) filtered.expressions = raw.expressions;
-    out.push_back(filtered);
+    if (contacts.push(filtered, contacted)) out.push_back(contacted);
   }
+  while (contacts.flush(contacted)) out.push_back(contacted);
   return out;
 }
 
@@ -92,16 +97,20 @@ std::vector<proxy_pose> reference_offline_poses(const std::string& path, solver_
   EXPECT_TRUE(reader.open(path).ok());
   frame_solver solver(options);
   offline_smoother smoother(smooth);
+  foot_contact_stage contacts(foot_contact_options{}, true);  // both-sided, as for files
   landmark_frame frame;
-  proxy_pose raw, smoothed;
+  proxy_pose raw, smoothed, contacted;
   std::vector<proxy_pose> out;
   while (reader.next(frame) == read_result::frame) {
     solver.solve(frame, raw);
     smoother.push(raw);
-    while (smoother.pop(smoothed)) out.push_back(smoothed);
+    while (smoother.pop(smoothed))
+      if (contacts.push(smoothed, contacted)) out.push_back(contacted);
   }
   smoother.finish();
-  while (smoother.pop(smoothed)) out.push_back(smoothed);
+  while (smoother.pop(smoothed))
+    if (contacts.push(smoothed, contacted)) out.push_back(contacted);
+  while (contacts.flush(contacted)) out.push_back(contacted);
   return out;
 }
 
@@ -250,6 +259,11 @@ TEST_F(solve_file, filter_options_and_channels_are_those_of_the_reference) {
   job.filter_mode = pose_filter_mode::live;  // the live path is exactly pose_filter's
   job.filter = f;
   job.filter_channels = c;
+  // The root following planted feet moves the hips with the (filtered) legs: off here, so
+  // the position channel alone decides the hips.
+  foot_contact_options no_root;
+  no_root.root_follows_contacts = false;
+  job.foot_contacts = no_root;
   std::vector<proxy_pose> got;
   job.sink = [&got](const proxy_pose& p) {
     got.push_back(p);
@@ -257,12 +271,12 @@ TEST_F(solve_file, filter_options_and_channels_are_those_of_the_reference) {
   };
   solve_file_summary s;
   ASSERT_TRUE(job.run(s).ok());
-  const std::vector<proxy_pose> want = reference_poses(input, synth_camera(), f, c);
+  const std::vector<proxy_pose> want = reference_poses(input, synth_camera(), f, c, no_root);
   expect_same_poses(got, want, 0.f);
   // And they differ from the unfiltered solve (the channels matter).
   pose_filter_options off;
   off.enabled = false;
-  const std::vector<proxy_pose> raw = reference_poses(input, synth_camera(), off);
+  const std::vector<proxy_pose> raw = reference_poses(input, synth_camera(), off, {}, no_root);
   float rotation_gap = 0.f;
   for (std::size_t i = 0; i < raw.size(); ++i) {
     EXPECT_EQ(got[i].hips_position, raw[i].hips_position);  // position filtering is off

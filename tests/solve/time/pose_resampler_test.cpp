@@ -142,6 +142,29 @@ TEST(pose_resampler, lerps_position_expressions_and_takes_lower_confidence) {
   EXPECT_EQ(out.confidence[4], 0.1f);
 }
 
+TEST(pose_resampler, lerps_foot_contact_clamped_and_never_nan) {
+  proxy_pose a, b;
+  a.t = 0.0;
+  b.t = 0.1;
+  a.foot_contact = {0.f, 1.f};
+  b.foot_contact = {1.f, 7.f};  // clamped to 1 when pushed
+  pose_resampler r;
+  r.push(a);
+  r.push(b);
+  proxy_pose out;
+  ASSERT_TRUE(r.sample(0.025, out));
+  EXPECT_NEAR(out.foot_contact[0], 0.25f, 1e-6f);
+  EXPECT_EQ(out.foot_contact[1], 1.f);
+  ASSERT_TRUE(r.sample(0.15, out));  // extrapolated past 1: clamped
+  EXPECT_EQ(out.foot_contact[0], 1.f);
+  proxy_pose c = b;
+  c.t = 0.2;
+  c.foot_contact[0] = std::numeric_limits<float>::quiet_NaN();
+  r.push(c);
+  ASSERT_TRUE(r.sample(0.2, out));
+  EXPECT_EQ(out.foot_contact[0], 0.f);
+}
+
 TEST(pose_resampler, before_first_gives_first_and_extrapolation_is_bounded) {
   const motion m(3);
   pose_resampler r;  // default 0.1 s

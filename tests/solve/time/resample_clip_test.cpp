@@ -55,6 +55,21 @@ TEST(ResampleClip, TwentyFiveToSixtyFollowsAConstantSpin) {
   EXPECT_NEAR(kept.front().t, 3.0, 1e-12);
 }
 
+TEST(ResampleClip, FootContactIsInterpolatedLinearly) {
+  std::vector<proxy_pose> clip(2);
+  clip[0].t = 0.0;
+  clip[1].t = 0.1;
+  clip[0].foot_contact = {0.f, 1.f};
+  clip[1].foot_contact = {1.f, 0.f};
+  std::vector<proxy_pose> out;
+  ASSERT_TRUE(resample_clip(clip, 40.0, true, out).ok());  // 0, 0.025, 0.05, 0.075, 0.1
+  ASSERT_EQ(out.size(), 5u);
+  for (size_t k = 0; k < out.size(); ++k) {
+    EXPECT_NEAR(out[k].foot_contact[0], 0.25f * float(k), 1e-6f) << k;
+    EXPECT_NEAR(out[k].foot_contact[1], 1.f - 0.25f * float(k), 1e-6f) << k;
+  }
+}
+
 TEST(ResampleClip, FloatTimesDoNotLoseTheLastFrameAndEdgeCases) {
   std::vector<proxy_pose> clip = spin_clip(30.0, 300, 0.0);
   clip.back().t = static_cast<float>(clip.back().t);  // 9.9666662 instead of 9.9666667

@@ -237,6 +237,12 @@ typedef struct avm_pose {
   float rotations[AVM_BONE_COUNT][4]; /* local rotation {x, y, z, w}, unit length */
   float confidence[AVM_BONE_COUNT];   /* 0 = not observed .. 1 = observed */
   float expressions[AVM_EXPRESSION_COUNT]; /* weights 0 .. 1, see avm_expression */
+  /* Added in 0.1.0 at the end (the struct grew by 8 bytes: arrays of avm_pose built against
+   * an older header have another stride; rebuild against this one). Per foot, [0] left
+   * [1] right: 0 = the foot moves freely .. 1 = planted on the floor (docs/contacts.md);
+   * values between blend foot locking in and out. Read by avm_clip_write (clamped to
+   * [0, 1], NaN = 0). */
+  float foot_contact[2];
 } avm_pose;
 
 /* ---- solver options ------------------------------------------------------------------ */
@@ -312,6 +318,21 @@ typedef struct avm_solver_options {
   int32_t fit_hand_shape; /* fit each hand's world landmarks to its shape learnt over the take
                              (a rigid palm, fingers of constant length; docs/solver.md "The
                              hand's shape"): less finger noise, exact landmarks unchanged; 1 */
+  /* -- added in 0.1.0 after fit_hand_shape (a caller whose struct_size ends before it gets
+   *    the default) -- */
+  int32_t fit_body_to_image; /* fit the body's world points to its image points through the
+                                camera with the take's bone lengths, and turn it upright by
+                                the camera's pitch and roll (docs/solver.md "The body in the
+                                world"); needs image_width/height; 1 */
+  /* -- added in 0.1.0 after fit_body_to_image (a caller whose struct_size ends before them
+   *    gets the defaults) -- */
+  /* Detect planted feet (avm_pose.foot_contact; docs/contacts.md): both-sided in
+   * avm_solve_file's offline filter, causal without delay on the per-frame path; 0 =
+   * foot_contact 0 and the hips as filtered; 1 */
+  int32_t foot_contacts;
+  /* With foot_contacts: move the hips so that a planted foot stays where it landed (0: only
+   * foot_contact is written); 1 */
+  int32_t root_follows_contacts;
 } avm_solver_options;
 
 /* What avm_solve_file does after solving each frame. */
@@ -505,6 +526,45 @@ typedef struct avm_retargeter avm_retargeter;
  * Thread-safe (reads files only). */
 AVATARMAP_C_API avm_status avm_retargeter_create(const char* avatar_path, const char* mapping,
                                                  avm_retargeter** out);
+
+/* Options of a retargeter. Initialise with avm_retargeter_options_init(), then change fields
+ * (struct_size as for avm_solver_options). Booleans are int32_t, 0 or non-zero. */
+typedef struct avm_retargeter_options {
+  uint32_t struct_size; /* sizeof(avm_retargeter_options) as the caller knows it */
+  /* Foot locking (docs/foot-locking.md), kept by the handle across avm_retargeter_apply()
+   * calls, which must then come in time order (a pose whose t is not later than the
+   * previous one's starts a new clip: the anchors are forgotten): a foot whose
+   * avm_pose.foot_contact rises
+   * above 0 is anchored where it stands and held there by two-bone leg IK on the avatar's own
+   * legs while the contact lasts. 1 (default); 0: off (and the three below with it). */
+  int32_t foot_lock;
+  int32_t foot_lock_align_foot;       /* turn a planted foot flat on the floor; 1 */
+  int32_t foot_lock_lower_hips;       /* lower the hips when a leg cannot reach; 1 */
+  int32_t foot_lock_keep_above_floor; /* heels and toes never below the floor; 1 */
+} avm_retargeter_options;
+
+/* Fills the first `size` bytes of *options with the defaults above and sets struct_size =
+ * size, as avm_solver_options_init_sized() (size at least 8, at most 4096, a multiple of 4).
+ * Thread-safe. */
+AVATARMAP_C_API avm_status avm_retargeter_options_init_sized(avm_retargeter_options* options,
+                                                             size_t size);
+/* The function, for binaries built before the macro below. */
+AVATARMAP_C_API avm_status avm_retargeter_options_init(avm_retargeter_options* options);
+#define avm_retargeter_options_init(options) \
+  avm_retargeter_options_init_sized((options), sizeof(avm_retargeter_options))
+
+/* avm_retargeter_create() with options (NULL: the defaults, which avm_retargeter_create()
+ * uses). A leg the avatar cannot lock (no lower leg, foot or toes joint) is not an error: the
+ * binding description (avm_retargeter_binding_description()) ends with a sentence saying
+ * foot locking is off for it. Failures as avm_retargeter_create(), and
+ * AVM_ERROR_INVALID_ARGUMENT for a struct_size below 8 or above 4096. */
+AVATARMAP_C_API avm_status avm_retargeter_create_with_options(const char* avatar_path,
+                                                              const char* mapping,
+                                                              const avm_retargeter_options* options,
+                                                              avm_retargeter** out);
+
+/* Forgets the foot-lock anchors (a new clip, a jump in time). NULL is a no-op. */
+AVATARMAP_C_API void avm_retargeter_reset(avm_retargeter* retargeter);
 
 /* Destroys a retargeter and the strings it owns; NULL is a no-op. The handle must not be in
  * use by another thread. */
@@ -884,7 +944,8 @@ typedef enum avm_motion_input {
   AVM_MOTION_INPUT_NONE = 0,      /* none of these: avm_convert_file() refuses it */
   AVM_MOTION_INPUT_LANDMARKS = 1, /* *.landmarks.jsonl: solved first */
   AVM_MOTION_INPUT_POSES = 2,     /* *.pose.jsonl */
-  AVM_MOTION_INPUT_VRMA = 3       /* *.vrma (VRM Animation) */
+  AVM_MOTION_INPUT_VRMA = 3,      /* *.vrma (VRM Animation) */
+  AVM_MOTION_INPUT_BVH = 4        /* *.bvh: read on its own skeleton (docs/convert.md) */
 } avm_motion_input;
 
 /* The kind of motion file at `path` (an avm_motion_input), by the library's one rule (the CLI's
@@ -918,6 +979,11 @@ typedef struct avm_convert_options {
   const avm_solver_options* solver;
   avm_warning_fn warning; /* NULL (default): warnings are only counted in the summary */
   void* user;             /* passed to `warning` */
+  /* -- added in 0.1.0 after user (a caller whose struct_size ends before it gets the
+   *    default). -- */
+  int32_t foot_lock; /* keep planted feet (the poses' foot_contact) planted on the output,
+                        lower the hips when a leg cannot reach, keep heels and toes above the
+                        floor (docs/foot-locking.md); 0: off; 1 (default) */
 } avm_convert_options;
 
 /* Fills the first `size` bytes of `options` with the defaults above and sets struct_size =

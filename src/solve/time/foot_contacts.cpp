@@ -1,0 +1,261 @@
+#include "avatarmap/time/foot_contacts.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace avatarmap {
+
+namespace {
+
+// Time steps longer than this (or not positive) break a take: no speed across them, and the
+// root motion starts again from the filtered hips.
+constexpr double k_max_step_seconds = 0.5;
+
+bool finite3(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+bool good_step(double t0, double t1) {
+  const double dt = t1 - t0;
+  return std::isfinite(dt) && dt > 0.0 && dt <= k_max_step_seconds;
+}
+
+constexpr bone k_leg_bones[2][3] = {{bone::left_lower_leg, bone::left_foot, bone::left_toes},
+                                    {bone::right_lower_leg, bone::right_foot, bone::right_toes}};
+constexpr bone k_toes[2] = {bone::left_toes, bone::right_toes};
+
+}  // namespace
+
+status foot_contact_options::validate() const {
+  if (status st = check_options(k_foot_contact_option_table, *this, "foot_contacts."); !st.ok())
+    return st;
+  if (!(release_speed >= plant_speed))
+    return status::error("foot_contacts.contact_release_speed must be >= contact_plant_speed");
+  if (!(release_height >= plant_height))
+    return status::error("foot_contacts.contact_release_height must be >= contact_plant_height");
+  return {};
+}
+
+void measure_feet(const proxy_skeleton& skeleton, const proxy_pose& pose, float min_confidence,
+                  proxy_fk& fk, std::array<foot_measure, 2>& out) {
+  compute_proxy_fk(skeleton, pose, fk);
+  float floor = std::numeric_limits<float>::infinity();
+  glm::vec3 heel[2], toe[2];
+  bool finite[2];
+  for (int s = 0; s < 2; ++s) {
+    heel[s] = fk.heels[s];
+    toe[s] = fk.tips[idx(k_toes[s])];
+    finite[s] = finite3(heel[s]) && finite3(toe[s]);
+    if (finite[s]) floor = std::min(floor, std::min(heel[s].y, toe[s].y));
+  }
+  for (int s = 0; s < 2; ++s) {
+    foot_measure& m = out[s];
+    float c = 1.f;
+    for (bone b : k_leg_bones[s]) c = std::min(c, pose.confidence[idx(b)]);
+    m.usable = finite[s] && c >= min_confidence && c > 0.f;  // NaN confidence: not usable
+    if (!finite[s]) {
+      m.point = glm::vec3(0.f);
+      m.height = 0.f;
+      continue;
+    }
+    m.point = 0.5f * (heel[s] + toe[s]);
+    m.height = std::min(heel[s].y, toe[s].y) - floor;
+  }
+}
+
+struct foot_contact_stage::slot {
+  proxy_pose pose;
+  std::array<foot_measure, 2> feet;
+  bool ok = false;  // hips and feet finite
+};
+
+foot_contact_stage::foot_contact_stage(const foot_contact_options& options, bool both_sided,
+                                       const proxy_skeleton& skeleton)
+    : options_(options), both_sided_(both_sided), skeleton_(skeleton) {
+  assert(options.validate().ok());
+  const int w = std::clamp(options.window_frames, 1, k_max_contact_window_frames);
+  // Causal mode keeps the newest and the one before (the speed over the last frame).
+  capacity_ = both_sided ? 2 * w + 1 : 2;
+  ring_.reset(new slot[static_cast<std::size_t>(capacity_)]);
+}
+
+foot_contact_stage::~foot_contact_stage() = default;
+
+foot_contact_stage::slot& foot_contact_stage::at(long i) noexcept {
+  return ring_[static_cast<std::size_t>(i % capacity_)];
+}
+
+void foot_contact_stage::reset() noexcept {
+  pushed_ = emitted_ = 0;
+  planted_.fill(false);
+  contact_.fill(0.f);
+  anchored_.fill(false);
+  have_root_ = false;
+}
+
+bool foot_contact_stage::push(const proxy_pose& in, proxy_pose& out) noexcept {
+  if (!options_.enabled) {
+    out = in;
+    return true;
+  }
+  slot& s = at(pushed_);
+  s.pose = in;
+  measure_feet(skeleton_, in, options_.min_confidence, fk_, s.feet);
+  s.ok = std::isfinite(in.t) && finite3(in.hips_position) && finite3(s.feet[0].point) &&
+         finite3(s.feet[1].point);
+  ++pushed_;
+  const long delay = both_sided_ ? (capacity_ - 1) / 2 : 0;
+  if (pushed_ - emitted_ <= delay) return false;
+  emit(static_cast<int>(emitted_ % capacity_), out);
+  ++emitted_;
+  return true;
+}
+
+bool foot_contact_stage::flush(proxy_pose& out) noexcept {
+  if (!options_.enabled || emitted_ >= pushed_) {
+    reset();
+    return false;
+  }
+  emit(static_cast<int>(emitted_ % capacity_), out);
+  ++emitted_;
+  return true;
+}
+
+void foot_contact_stage::emit(int k, proxy_pose& out) noexcept {
+  const slot& cur = ring_[static_cast<std::size_t>(k)];
+  out = cur.pose;
+  out.foot_contact = {0.f, 0.f};
+  const double t = cur.pose.t;
+  if (!cur.ok) {
+    // Nothing to plant; hips that are not finite keep the last output's (never NaN out of a
+    // stage that had a finite pose).
+    if (have_root_ && !finite3(out.hips_position)) out.hips_position = root_prev_;
+    planted_.fill(false);
+    contact_.fill(0.f);
+    anchored_.fill(false);
+    return;
+  }
+  // Time backwards is a new take: the root motion starts again from the filtered hips. A gap
+  // (or a pose without finite points before) restarts the contacts only, so the hips go on
+  // from where they were.
+  const bool root_continues = have_root_ && std::isfinite(t_prev_) && t > t_prev_;
+  const bool continues = root_continues && good_step(t_prev_, t);
+  if (!continues) {
+    planted_.fill(false);
+    contact_.fill(0.f);
+    anchored_.fill(false);
+  }
+  const float dt = continues ? static_cast<float>(t - t_prev_) : 0.f;
+
+  // Speeds: causal, over the last frame; both-sided, the smaller of the backward and forward
+  // differences over up to window_frames frames (a foot that has just landed or is about to
+  // lift is still over one of them).
+  const long self = emitted_;
+  const long w = both_sided_ ? (capacity_ - 1) / 2 : 1;
+  std::array<float, 2> speed;
+  for (int f = 0; f < 2; ++f) {
+    float best = std::numeric_limits<float>::infinity();
+    bool any = false;
+    for (int dir = -1; dir <= 1; dir += 2) {
+      if (dir > 0 && !both_sided_) continue;
+      // The farthest neighbour in this direction still within the take.
+      long far = self;
+      for (long j = 1; j <= w; ++j) {
+        const long i = self + dir * j;
+        if (i < 0 || i >= pushed_ || i < pushed_ - capacity_) break;
+        const slot& a = at(dir < 0 ? i : i - 1);
+        const slot& b = at(dir < 0 ? i + 1 : i);
+        if (!a.ok || !b.ok || !good_step(a.pose.t, b.pose.t)) break;
+        far = i;
+      }
+      if (far == self) continue;
+      const slot& o = at(far);
+      const double span = std::fabs(o.pose.t - t);
+      const float v = glm::length(o.feet[f].point - cur.feet[f].point) / static_cast<float>(span);
+      if (std::isfinite(v)) {
+        best = std::min(best, v);
+        any = true;
+      }
+    }
+    // No neighbour (the first pose of a take): no evidence of motion; a foot that is low may
+    // plant (a take that starts standing).
+    speed[f] = any ? best : 0.f;
+  }
+
+  // Hysteresis, then the blend towards the state.
+  const float step = dt / options_.blend_seconds;
+  for (int f = 0; f < 2; ++f) {
+    const foot_measure& m = cur.feet[f];
+    if (!m.usable) {
+      planted_[f] = false;
+    } else if (planted_[f]) {
+      if (speed[f] > options_.release_speed || m.height > options_.release_height)
+        planted_[f] = false;
+    } else if (speed[f] < options_.plant_speed && m.height < options_.plant_height) {
+      planted_[f] = true;
+    }
+    if (!continues) {
+      // A take's first pose: a planted foot starts planted (standing still from frame 0).
+      contact_[f] = planted_[f] ? 1.f : 0.f;
+    } else if (planted_[f]) {
+      contact_[f] = std::min(1.f, contact_[f] + step);
+    } else {
+      contact_[f] = std::max(0.f, contact_[f] - step);
+    }
+    if (!m.usable) contact_[f] = 0.f;  // locking off for that leg, at once
+    out.foot_contact[f] = contact_[f];
+  }
+
+  const glm::vec3 measured = cur.pose.hips_position;
+  glm::vec3 root = measured;
+  if (options_.root_follows_contacts) {
+    // Where the hips would be without contacts: the previous output moved by the filtered
+    // hips' motion (X/Z). Y stays the filtered one: the solver already holds the lowest foot
+    // point on the floor, and lowering the hips to put a planted foot that is not the lowest
+    // on it would push the lower foot through the floor.
+    glm::vec3 free = measured;
+    if (root_continues) {
+      free.x = root_prev_.x + (measured.x - measured_prev_.x);
+      free.z = root_prev_.z + (measured.z - measured_prev_.z);
+    }
+    // The hips each anchored foot asks for (its offset from the hips is the FK's).
+    auto blend_root = [&](bool only_anchored) {
+      glm::vec2 sum(0.f);
+      float wsum = 0.f;
+      for (int f = 0; f < 2; ++f) {
+        if (contact_[f] <= 0.f || (only_anchored && !anchored_[f])) continue;
+        const glm::vec3 offset = cur.feet[f].point - measured;
+        sum += contact_[f] * glm::vec2(anchor_[f].x - offset.x, anchor_[f].z - offset.z);
+        wsum += contact_[f];
+      }
+      const float free_w = std::max(0.f, 1.f - wsum);
+      glm::vec3 r;
+      const float total = wsum + free_w;
+      r.x = (sum.x + free_w * free.x) / total;
+      r.z = (sum.y + free_w * free.z) / total;
+      r.y = measured.y;
+      return r;
+    };
+    root = blend_root(true);
+    // New contacts are anchored where the foot is under the hips as held by the others.
+    for (int f = 0; f < 2; ++f) {
+      if (contact_[f] > 0.f && !anchored_[f]) {
+        anchor_[f] = root + (cur.feet[f].point - measured);
+        anchor_[f].y = 0.f;
+        anchored_[f] = true;
+      }
+    }
+    root = blend_root(false);
+    if (!finite3(root)) root = measured;
+    out.hips_position = root;
+  }
+  for (int f = 0; f < 2; ++f)
+    if (contact_[f] <= 0.f) anchored_[f] = false;
+  root_prev_ = root;
+  measured_prev_ = measured;
+  t_prev_ = t;
+  have_root_ = true;
+}
+
+}  // namespace avatarmap
