@@ -29,6 +29,7 @@ pose_stream_options stream_options(const capture_pipeline_options& o) {
   so.solver = o.solver;
   so.filters.filter_mode = pose_filter_mode::live;  // filter.enabled = false: none
   so.filters.filter = o.filter;
+  so.filters.foot_contacts = o.foot_contacts;
   so.resampler = o.resampler;
   so.name = "capture";
   return so;

@@ -18,10 +18,13 @@
 #include "avatarmap/live/live_capture.hpp"
 #include "avatarmap/live/live_session.hpp"
 #include "avatarmap/media/video_source.hpp"
+#include "avatarmap/solve/solver_options.hpp"
 #include "avatarmap/stream/pose_server.hpp"
+#include "avatarmap/time/foot_contacts.hpp"
 #include "cli/capture_setup.hpp"
 #include "cli/commands.hpp"
 #include "cli/live_vmc.hpp"
+#include "cli/option_flags.hpp"
 #include "cli/viewer_setup.hpp"
 
 namespace avatarmap::cli {
@@ -65,6 +68,12 @@ int run_live_command(int argc, char** argv) {
     std::fputs(input_options_help().c_str(), stdout);
     std::fputs(k_live_estimator_help, stdout);
     std::fputs(estimator_options_help(false).c_str(), stdout);
+    std::fputs("\nSolver (docs/solver.md, docs/contacts.md):\n", stdout);
+    std::fputs(option_flags_help(k_solver_option_table, solver_options{}).c_str(), stdout);
+    std::fputs(
+        "  --no-foot-contacts    no foot contacts (foot_contact 0, the hips as solved)\n"
+        "  --no-root-follow      contacts detected, the hips as solved\n",
+        stdout);
     std::fputs("\nVMC protocol output (docs/vmc.md):\n", stdout);
     std::fputs(k_live_vmc_help, stdout);
     return 0;
@@ -85,8 +94,19 @@ int run_live_command(int argc, char** argv) {
   if (const int rc = vmc.read_options(a)) return rc;
   estimator_options ec;
   video_source_options vo;
-  if (!parse_estimator_options(a, false, ec, error) || !parse_input_options(a, vo, error)) {
+  solver_options so;
+  foot_contact_options contacts;
+  contacts.enabled = !a.flag("--no-foot-contacts");
+  contacts.root_follows_contacts = !a.flag("--no-root-follow");
+  if (!parse_estimator_options(a, false, ec, error) || !parse_input_options(a, vo, error) ||
+      !parse_option_flags(a, k_solver_option_table, so, error)) {
     std::fprintf(stderr, "avatarmap live: %s\n", error.c_str());
+    return 2;
+  }
+  if (so.mirror) {
+    std::fprintf(stderr,
+                 "avatarmap live: --mirror is for landmark files; a mirrored camera preview is "
+                 "--mirrored (the input is flipped before estimation)\n");
     return 2;
   }
   if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 1) {
@@ -138,6 +158,8 @@ int run_live_command(int argc, char** argv) {
   const video_info info = source.info();
   live_session_options lso;
   lso.pipeline.estimator = ec;
+  lso.pipeline.solver = so;
+  lso.pipeline.foot_contacts = contacts;
   lso.pipeline.solver.image_width = static_cast<float>(info.width);
   lso.pipeline.solver.image_height = static_cast<float>(info.height);
   lso.pipeline.filter.enabled = filter_name == "live";

@@ -64,13 +64,16 @@ void print_summary(const solve_file_job& job, const solve_file_summary& s, std::
                    "camera field of view: %.1f degrees assumed; the pose's image and world "
                    "points did not tell it (--fov DEG to set it)\n",
                    s.horizontal_fov_degrees);
-    if (s.gravity_evidence_frames > 0)
+    if (s.gravity_evidence_frames > 0 || s.floor_evidence_points > 0)
       std::fprintf(to,
-                   "camera pitch %.1f degrees (+ = looking down), roll %.1f, from the standing "
-                   "body in %ld frames\n",
-                   s.camera_pitch_degrees, s.camera_roll_degrees, s.gravity_evidence_frames);
-    else
-      std::fprintf(to, "camera pitch and roll: level assumed (no frame with straight legs)\n");
+                   "camera pitch %.1f degrees (+ = looking down), roll %.1f, from %ld standing "
+                   "frames and %ld floor points\n",
+                   s.camera_pitch_degrees, s.camera_roll_degrees, s.gravity_evidence_frames,
+                   s.floor_evidence_points);
+    else if (s.image_width > 0.f)
+      std::fprintf(to,
+                   "camera pitch and roll: level assumed (no standing frame, no walk over the "
+                   "floor)\n");
   }
   if (s.image_size_assumed)
     std::fprintf(to,

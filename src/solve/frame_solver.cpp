@@ -79,6 +79,31 @@ void frame_solver::reset() {
   gravity_->reset();
 }
 
+void frame_solver::restart_take(bool keep_view) {
+  const float focal = focal_per_width_;
+  const double information = focal_information_, weighted = focal_weighted_sum_;
+  const long frames = focal_frames_, tick = focal_tick_;
+  const body_lengths lengths = *lengths_;
+  camera_gravity gravity = *gravity_;
+  const std::array<hand_shape, 2> hands = hand_shapes_;
+  reset();
+  focal_per_width_ = focal;
+  focal_information_ = information;
+  focal_weighted_sum_ = weighted;
+  focal_frames_ = frames;
+  focal_tick_ = tick;
+  *lengths_ = lengths;
+  gravity.has_floor = false;  // the floor's height is found again from the start
+  if (keep_view) *gravity_ = gravity;
+  hand_shapes_ = hands;
+}
+
+float frame_solver::performer_leg_length() const {
+  const float thigh = lengths_->get(body_lengths::thigh);
+  const float shin = lengths_->get(body_lengths::shin);
+  return thigh > 0.f && shin > 0.f ? thigh + shin : 0.f;
+}
+
 float frame_solver::horizontal_fov_degrees() const {
   return 2.f * std::atan(0.5f / focal_per_width_) / k_deg;
 }
@@ -100,6 +125,8 @@ void frame_solver::update_focal(const landmark_frame& in) {
   focal_information_ += information;
   focal_weighted_sum_ += information * (e.focal / w);
   focal_per_width_ = static_cast<float>(focal_weighted_sum_ / focal_information_);
+  gravity_->focal_lean_sum += e.lean;  // the lean with the focal length free (solve_fit.hpp)
+  gravity_->focal_lean_frames += 1.0;
   ++focal_frames_;
 }
 
@@ -118,6 +145,10 @@ const body_fit* frame_solver::fit_frame(const landmark_frame& in, bool learn, bo
 float frame_solver::camera_pitch_degrees() const { return gravity_->pitch_degrees(); }
 float frame_solver::camera_roll_degrees() const { return gravity_->roll_degrees(); }
 long frame_solver::gravity_evidence_frames() const { return gravity_->frames; }
+long frame_solver::floor_evidence_points() const {
+  glm::vec3 n;
+  return gravity_->floor_normal(n) ? static_cast<long>(gravity_->floor_n) : 0;
+}
 
 void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const {
   prepared_frame f;

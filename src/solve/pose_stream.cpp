@@ -158,6 +158,33 @@ void pose_stream::reset() {
   j_next_ = 0;
 }
 
+void pose_stream::learn_camera(const landmark_frame& frame) {
+  if (points_) {
+    points_->filter.apply(frame, points_->smoothed);
+    solver_.solve(points_->smoothed, solved_);
+  } else {
+    solver_.solve(frame, solved_);
+  }
+}
+
+void pose_stream::restart_take(bool keep_view) {
+  solver_.restart_take(keep_view);
+  // The contact stage holds feet on the performer's proportions as the warm-up learnt them
+  // (set once here, not per frame: the poses out must not depend on how far the solver runs
+  // ahead of the filters).
+  contacts_.set_leg_length(solver_.performer_leg_length());
+  filter_.reset();
+  if (smoother_) smoother_->reset();
+  if (points_) points_->filter.reset();
+  contacts_.reset();
+  resampler_.reset();
+  pending_ = pushed_ = finishing_ = false;
+  stats_ = {};
+  t_grid0_ = 0.0;
+  have_grid_ = false;
+  j_next_ = 0;
+}
+
 void pose_stream::restart(const solver_options& solver) {
   options_.solver = solver;
   solver_ = frame_solver(stream_solver_options(solver, options_.filters.filter_mode));

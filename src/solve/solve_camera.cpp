@@ -158,6 +158,7 @@ focal_evidence estimate_focal(const landmark_frame& in, float width, float heigh
   if (!solve4(a, unit, col) || !(col[1] > 0.0)) return e;
   e.focal = f;
   e.information = 1.0 / (sigma2 * col[1]);
+  e.lean = best_lean * 3.14159265358979 / 180.0;
   return e;
 }
 

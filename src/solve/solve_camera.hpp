@@ -24,6 +24,9 @@ namespace avatarmap::solve_detail {
 struct focal_evidence {
   double focal = 0.0;
   double information = 0.0;
+  /// The world points' lean about the camera's x axis that the fit found (radians; the turn
+  /// that puts them onto the image, solve_fit.hpp's convention), with the focal length free.
+  double lean = 0.0;
 };
 
 /// Estimate from one frame's pose and pose_world points, for an image of width x height

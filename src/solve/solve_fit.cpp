@@ -25,12 +25,16 @@ constexpr float k_lean_search = 35.f * 3.14159265f / 180.f;
 constexpr float k_lean_coarse = 10.f * 3.14159265f / 180.f;
 constexpr float k_lean_fine = 0.6f * 3.14159265f / 180.f;
 constexpr double k_lean_prior_frames = 1.0;
+// Field-of-view fits (focal length free) that must have told the lean before theirs is used.
+constexpr double k_focal_lean_frames = 5.0;
 // Every k_lean_every-th frame is searched, until k_lean_max_frames frames have told the lean.
 constexpr long k_lean_every = 3;
 constexpr double k_lean_max_frames = 600.0;
 // A leg is straight (a standing frame, evidence of the vertical) when thigh and shin point
 // within ~12 degrees of each other.
 constexpr float k_straight_leg_cos = 0.978f;
+// Most height difference between the ankles (metres) of a standing frame.
+constexpr float k_standing_feet_step = 0.04f;
 // Weight of the level-camera prior, in frames of evidence.
 constexpr double k_gravity_prior_frames = 30.0;
 // A frame's vertical counts only when it is within this angle of the current estimate's
@@ -53,9 +57,8 @@ constexpr double k_floor_rate = 0.05;
 // undone. Their ratio sets where the image's foreshortening overrules the world's depth.
 constexpr float k_sigma_length = 0.05f;
 constexpr float k_sigma_world = 0.04f;
-// The fit's search along a ray: grid points, then golden-section steps.
-constexpr int k_grid = 13;
-constexpr int k_golden_steps = 12;
+// Newton steps of the fit along a ray, from the best starting depth.
+constexpr int k_newton_steps = 3;
 
 inline float conf(const landmark& l) { return landmark_confidence(l); }
 inline glm::vec3 pos(const landmark& l) { return glm::vec3(l.x, l.y, l.z); }
@@ -76,10 +79,10 @@ struct frame_view {
 // over P on the ray (Q: the ray's point nearest the world's target). Where the segment turns
 // in depth its foreshortening pins the depth; seen side-on (perpendicular to its ray) the
 // length says little and the world's depth decides; the world points choose between the two
-// depths a length allows. A grid over the ray, then golden-section refinement.
+// depths a length allows.
 glm::vec3 on_ray(const glm::vec3& ray, const glm::vec3& a, float length,
                  const glm::vec3& world_dir) {
-  const float rr = glm::dot(ray, ray);
+  const float rr = glm::dot(ray, ray), qb = glm::dot(ray, a), qc = glm::dot(a, a) - length * length;
   const glm::vec3 target = a + world_dir;
   const float s_world = glm::dot(target, ray) / rr;
   const float inv_l2 = 1.f / (k_sigma_length * k_sigma_length);
@@ -89,38 +92,40 @@ glm::vec3 on_ray(const glm::vec3& ray, const glm::vec3& a, float length,
     const float e = s - s_world;
     return d * d * inv_l2 + e * e * inv_w2;
   };
-  const float span = 2.f * (length + glm::length(world_dir)) / std::sqrt(rr);
-  const float lo = s_world - span, step = 2.f * span / float(k_grid - 1);
+  // The cost's minima lie near the depths the length allows (the two roots of
+  // |s ray - a| = length, or the ray's closest point when there are none) or near the world's
+  // depth: start from the best of them, then a few Newton steps.
   float best_s = s_world, best = cost(s_world);
-  for (int k = 0; k < k_grid; ++k) {
-    const float s = lo + step * float(k);
+  auto consider = [&](float s) {
     const float c = cost(s);
     if (c < best) {
       best = c;
       best_s = s;
     }
+  };
+  const float disc = qb * qb - rr * qc;
+  if (disc > 0.f) {
+    const float root = std::sqrt(disc);
+    consider((qb - root) / rr);
+    consider((qb + root) / rr);
+  } else {
+    consider(qb / rr);
   }
-  float x0 = best_s - step, x3 = best_s + step;
-  constexpr float g = 0.381966f;
-  float x1 = x0 + g * (x3 - x0), x2 = x3 - g * (x3 - x0);
-  float c1 = cost(x1), c2 = cost(x2);
-  for (int it = 0; it < k_golden_steps; ++it) {
-    if (c1 < c2) {
-      x3 = x2;
-      x2 = x1;
-      c2 = c1;
-      x1 = x0 + g * (x3 - x0);
-      c1 = cost(x1);
-    } else {
-      x0 = x1;
-      x1 = x2;
-      c1 = c2;
-      x2 = x3 - g * (x3 - x0);
-      c2 = cost(x2);
-    }
+  float s = best_s;
+  for (int it = 0; it < k_newton_steps; ++it) {
+    const float d = glm::length(ray * s - a);
+    if (!(d > 1e-6f)) break;
+    const float d1 = (s * rr - qb) / d, d2 = (rr - d1 * d1) / d;
+    const float g1 = 2.f * inv_l2 * (d - length) * d1 + 2.f * inv_w2 * (s - s_world);
+    const float g2 = 2.f * inv_l2 * (d1 * d1 + (d - length) * d2) + 2.f * inv_w2;
+    if (!(g2 > 0.f)) break;
+    const float next = s - g1 / g2;
+    const float c = cost(next);
+    if (!(c <= best)) break;
+    best = c;
+    s = next;
   }
-  const float s_best = c1 < c2 ? x1 : x2;
-  return ray * (std::min(c1, c2) < best ? s_best : best_s);
+  return ray * s;
 }
 
 glm::vec3 rotate_x(const glm::vec3& v, float angle) {
@@ -259,8 +264,13 @@ void camera_gravity::add_floor_point(const glm::dvec3& p) {
 }
 
 glm::vec3 camera_gravity::up() const {
+  glm::vec3 n;
+  return floor_normal(n) ? n : glm::vec3(glm::normalize(up_sum));
+}
+
+bool camera_gravity::floor_normal(glm::vec3& out) const {
   const glm::dvec3 legs = glm::normalize(up_sum);
-  if (floor_n < k_floor_min_points) return glm::vec3(legs);
+  if (floor_n < k_floor_min_points) return false;
   // The floor's normal: the least-spread direction of the feet's resting points (inverse
   // iteration from the legs' vertical), trusted when the points spread over the floor in
   // both its directions and it agrees with the legs.
@@ -277,8 +287,9 @@ glm::vec3 camera_gravity::up() const {
   const double lambda2 = 0.5 * (a + d) - std::sqrt(0.25 * (a - d) * (a - d) + b * b);
   if (!(lambda2 > k_floor_min_spread * k_floor_min_spread) ||
       !(glm::dot(n, legs) > k_gravity_gate_cos) || !std::isfinite(n.x + n.y + n.z))
-    return glm::vec3(legs);
-  return glm::vec3(n);
+    return false;
+  out = glm::vec3(n);
+  return true;
 }
 
 float camera_gravity::pitch_degrees() const {
@@ -311,7 +322,10 @@ bool fit_body(const landmark_frame& in, float width, float height, float focal, 
     gravity.lean_sum += lean;
     gravity.lean_frames += 1.0;
   }
-  const float take_lean = float(gravity.lean_sum / (gravity.lean_frames + k_lean_prior_frames));
+  const float take_lean =
+      gravity.focal_lean_frames >= k_focal_lean_frames
+          ? float(gravity.focal_lean_sum / gravity.focal_lean_frames)
+          : float(gravity.lean_sum / (gravity.lean_frames + k_lean_prior_frames));
   for (auto& p : w) p = rotate_x(p, take_lean);
   glm::vec3 hips;
   double rss = 0.0;
@@ -361,23 +375,34 @@ bool fit_body(const landmark_frame& in, float width, float height, float focal, 
   // Face points hang on the shoulder line's midpoint.
   for (int i = 0; i <= idx(pl::mouth_right); ++i) cam[i] = sm + w[i] - w_sm;
 
-  // Gravity: a straight leg's ankle -> hip direction is the vertical on average over a take
-  // (standing, the stance of a step sweeping about it); each confident straight leg counts.
+  // Gravity: the standing body's vertical (ankles' midpoint to the hips) in frames whose legs
+  // are both straight, confident and parallel, the feet on one level (standing: not a leg
+  // swung out, not a body tipping over on one foot).
   if (learn) {
-    const glm::vec3 current = glm::vec3(glm::normalize(gravity.up_sum));  // the legs' so far
-    for (int side = 0; side < 2; ++side) {
+    bool standing = true;
+    glm::vec3 leg_dir[2];
+    for (int side = 0; side < 2 && standing; ++side) {
       const int hip = lh + side, kn = idx(pl::left_knee) + side, an = idx(pl::left_ankle) + side;
-      if (std::min(std::min(v.c(hip), v.c(kn)), v.c(an)) < k_min_confidence) continue;
+      if (std::min(std::min(v.c(hip), v.c(kn)), v.c(an)) < k_min_confidence) standing = false;
       const glm::vec3 thigh = cam[kn] - cam[hip], shin = cam[an] - cam[kn];
       const float lt = glm::length(thigh), lsh = glm::length(shin);
       if (!(lt > 0.f && lsh > 0.f) || glm::dot(thigh, shin) < k_straight_leg_cos * lt * lsh)
-        continue;
-      const glm::vec3 axis = glm::normalize(cam[hip] - cam[an]);
-      if (!(glm::dot(axis, current) >= k_gravity_gate_cos)) continue;
-      if (gravity.weight == 0.0) gravity.up_sum *= k_gravity_prior_frames;
-      gravity.up_sum += glm::dvec3(axis);
-      gravity.weight += 1.0;
-      ++gravity.frames;
+        standing = false;
+      leg_dir[side] = glm::normalize(cam[hip] - cam[an]);
+    }
+    const glm::vec3 current = glm::vec3(glm::normalize(gravity.up_sum));
+    const float feet_step =
+        std::fabs(glm::dot(cam[idx(pl::left_ankle)] - cam[idx(pl::right_ankle)], current));
+    if (standing && glm::dot(leg_dir[0], leg_dir[1]) >= k_straight_leg_cos &&
+        feet_step <= k_standing_feet_step) {
+      const glm::vec3 ankles = 0.5f * (cam[idx(pl::left_ankle)] + cam[idx(pl::right_ankle)]);
+      const glm::vec3 axis = glm::normalize(hm - ankles);
+      if (glm::dot(axis, current) >= k_gravity_gate_cos) {
+        if (gravity.weight == 0.0) gravity.up_sum *= k_gravity_prior_frames;
+        gravity.up_sum += glm::dvec3(axis);
+        gravity.weight += 1.0;
+        ++gravity.frames;
+      }
     }
   }
   // A point hung on a joint that was not seen (non-finite) keeps its own world position.

@@ -48,6 +48,11 @@ struct camera_gravity {
   /// image), summed over the frames that told it.
   double lean_sum = 0.0;
   double lean_frames = 0.0;
+  /// The same from the field-of-view fits (focal length free, solve_camera.hpp): preferred
+  /// once k_focal_lean_frames frames have told it (a lean searched at a focal length that is
+  /// still being learnt takes some of the focal length's error).
+  double focal_lean_sum = 0.0;
+  double focal_lean_frames = 0.0;
   long lean_tick = 0;  // frames seen, for sampling the lean's search
   bool has_floor = false;
   /// The floor's resting points (camera axes): first and second moments.
@@ -59,6 +64,9 @@ struct camera_gravity {
   /// The camera's up (unit, camera axes): the floor plane's normal once the feet have rested
   /// on enough of the floor (a walk), else the legs' vertical with its prior.
   glm::vec3 up() const;
+  /// The floor plane's normal when it decides the up (enough resting points, spread both
+  /// ways, agreeing with the legs); false otherwise.
+  bool floor_normal(glm::vec3& out) const;
   /// Pitch (degrees, + = the camera looks down) and roll (degrees, + = the world's up leans
   /// toward the image's right) of the camera relative to gravity.
   float pitch_degrees() const;

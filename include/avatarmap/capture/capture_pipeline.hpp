@@ -21,6 +21,7 @@
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "avatarmap/solve/pose_stream.hpp"
 #include "avatarmap/solve/solver_options.hpp"
+#include "avatarmap/time/foot_contacts.hpp"
 #include "avatarmap/time/pose_filter.hpp"
 #include "avatarmap/time/pose_resampler.hpp"
 
@@ -43,6 +44,9 @@ struct capture_pipeline_options {
   solver_options solver;
   /// The live filter (One Euro + short extrapolation; enabled = false: the solver's poses).
   pose_filter_options filter;
+  /// Foot contacts and the root following planted feet (causal: no added latency;
+  /// docs/contacts.md).
+  foot_contact_options foot_contacts;
   /// How far stream().sample() extrapolates past the newest pose (the live session's sample()).
   pose_resampler_options resampler;
 

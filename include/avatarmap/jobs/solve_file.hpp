@@ -61,11 +61,13 @@ struct solve_file_summary {
   bool fov_estimated = false;
   long fov_evidence_frames = 0;
   /// The camera's pitch (degrees, + = looking down) and roll relative to gravity learnt from
-  /// the standing body (frame_solver::camera_pitch_degrees()), from gravity_evidence_frames
-  /// frames (0: a level camera was assumed, or the body was not fitted to the image).
+  /// the standing body and the floor (frame_solver::camera_pitch_degrees()), from
+  /// gravity_evidence_frames standing frames and floor_evidence_points resting points (both
+  /// 0: a level camera was assumed, or the body was not fitted to the image).
   float camera_pitch_degrees = 0.f;
   float camera_roll_degrees = 0.f;
   long gravity_evidence_frames = 0;
+  long floor_evidence_points = 0;  // the feet's resting points, when the floor decided
 };
 
 /// The job. Fill the inputs, call run(). Thread-safety: a job may be run from any thread; the

@@ -69,6 +69,14 @@ class frame_solver {
 
   /// Forgets all state (as if newly constructed with the same options).
   void reset();
+  /// Forgets the take's pose state (gates, held rotations, the root's origin, the floor's
+  /// place) but keeps what was learnt of the camera (field of view, pitch and roll, the world
+  /// points' lean) and of the performer (bone lengths, hand shapes): a file is solved once
+  /// for these (a warm-up over its first seconds), then from its start with them known.
+  /// `keep_view` false also forgets the camera's pitch and roll, the floor and the world
+  /// points' lean (learnt while the field of view was still moving), keeping the field of
+  /// view and the proportions: the warm-up's second pass learns them again.
+  void restart_take(bool keep_view = true);
 
   const solver_options& options() const { return options_; }
 
@@ -85,8 +93,15 @@ class frame_solver {
   /// level camera is assumed).
   float camera_pitch_degrees() const;
   float camera_roll_degrees() const;
-  /// Frames that told the vertical (straight legs, confident points); 0: level assumed.
+  /// The performer's leg length learnt so far when the body is fitted to the image: thigh +
+  /// shin (metres, hip socket to ankle, the running means of the world points' lengths); 0
+  /// while either is unknown. The contact stage scales its skeleton by it (solve/pose_stream).
+  float performer_leg_length() const;
+  /// Frames that told the vertical (both legs straight and parallel, feet level, confident
+  /// points), and the feet's resting points when the floor's plane decides it (a walk over
+  /// enough of the floor); both 0: a level camera is assumed.
   long gravity_evidence_frames() const;
+  long floor_evidence_points() const;
   /// The shape learnt of the avatar's left (0) or right (1) hand (options().fit_hand_shape).
   const hand_shape& learnt_hand(int side) const { return hand_shapes_[side != 0 ? 1 : 0]; }
 

@@ -107,6 +107,14 @@ class pose_stream {
 
   /// Forgets everything: solver, filters, resampler, grid and stats (a new take).
   void reset();
+  /// The file job's warm-up (jobs/solve_file.hpp): learns the camera and the performer's
+  /// proportions from a frame without output (the pose state it also advances is forgotten by
+  /// restart_take()).
+  void learn_camera(const landmark_frame& frame);
+  /// Forgets the pose state, filters included, keeping what the solver learnt of the camera
+  /// and the performer (frame_solver::restart_take(keep_view)); the stream then starts anew.
+  /// The contact stage takes the performer's leg length learnt so far (docs/contacts.md).
+  void restart_take(bool keep_view = true);
   /// New solver options (a new image size): the solver is remade with fresh state and the
   /// filters start again; the resampler, the grid and the stats are kept. Allocates what a
   /// frame_solver does.

@@ -5,10 +5,11 @@
 // confidence, decides with hysteresis whether the foot is planted (slow and low), and writes
 // proxy_pose::foot_contact, which moves from 0 to 1 (and back) over blend_seconds. With
 // root_follows_contacts, a planted foot holds its anchor (where the contact began): the hips'
-// X/Z are moved so that the foot stays there; with both feet planted, each pulls with its
-// weight; with none, the hips move by the filtered hips' frame-to-frame motion from where the
-// corrected hips were (no jump). Y stays the filtered one: the solver holds the lowest foot
-// point on the floor (Y = 0) in every frame, and a planted foot is within release_height of it.
+// X/Z are moved so that the foot stays there, each foot holding by its contact times (files)
+// how slow it is (a planted foot that still moves lets the body go on); with none, the hips move by
+// the filtered hips' frame-to-frame motion from where the corrected hips were (no jump). Y stays
+// the filtered one: the solver holds the lowest foot point on the floor (Y = 0) in every frame, and
+// a planted foot is within release_height of it.
 //
 // Floor: the stage's floor in each frame is that frame's lowest foot point (the solver puts
 // the lowest foot point at Y = 0 in every frame, so the two agree when the proxy's
@@ -55,14 +56,16 @@ struct foot_contact_options {
   /// written (the hips as filtered).
   bool root_follows_contacts = true;
   /// A foot slower than this and lower than plant_height plants ...
-  float plant_speed = 0.25f;
+  float plant_speed = 0.5f;
   float plant_height = 0.05f;
   /// ... and a planted foot lifts when faster than this or higher than release_height.
   float release_speed = 0.5f;
   float release_height = 0.09f;
   /// Below this confidence (the least of the lower leg's, the foot's and the toes') a foot is
-  /// never planted.
-  float min_confidence = 0.3f;
+  /// never planted. Low on purpose: an estimator still reports a foot outside the image or
+  /// turned away with a visibility of a few percent, and its pose is what the avatar shows;
+  /// holding it while it is slow and low beats letting it slide (docs/contacts.md).
+  float min_confidence = 0.01f;
   /// Time foot_contact takes to go from 0 to 1 or back (> 0: no snaps).
   float blend_seconds = 0.1f;
   /// Both-sided mode: frames looked at on each side (the output's delay in frames).
@@ -163,6 +166,15 @@ class foot_contact_stage {
   bool flush(proxy_pose& out) noexcept;
   /// Forgets everything (a new take).
   void reset() noexcept;
+  /// The performer's leg length (hip socket to ankle, metres; frame_solver::
+  /// performer_leg_length()): the skeleton given at construction is scaled so that its thigh +
+  /// shin equals it, so that a held foot stays held on the performer's proportions (and on a
+  /// rig, which `convert` scales by the standing hips height). 0, negative or not finite: the
+  /// skeleton as given. A change under 1 % is ignored. Kept by reset(); the pose stream sets it
+  /// at the file job's warm-up end (pose_stream::restart_take). Allocates nothing.
+  void set_leg_length(float leg_length) noexcept;
+  /// The skeleton in use (scaled by set_leg_length()).
+  const proxy_skeleton& skeleton() const noexcept { return skeleton_; }
 
   const foot_contact_options& options() const noexcept { return options_; }
   bool both_sided() const noexcept { return both_sided_; }
@@ -175,7 +187,9 @@ class foot_contact_stage {
 
   foot_contact_options options_;
   bool both_sided_;
-  proxy_skeleton skeleton_;
+  proxy_skeleton base_skeleton_;  // as given at construction
+  proxy_skeleton skeleton_;       // base_skeleton_ scaled to the leg length in use
+  float leg_length_ = 0.f;        // set_leg_length()'s value in use (0: none)
   proxy_fk fk_;
   std::unique_ptr<slot[]> ring_;
   int capacity_ = 1;

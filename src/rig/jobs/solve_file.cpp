@@ -28,10 +28,22 @@ constexpr long k_warnings_per_kind = 5;
 // The parts of the per-frame work that are large (a landmark frame is ~20 kB, the stream's
 // solver, filters and poses more): on the heap, so that a caller on a small stack (a C API
 // user's thread) is safe.
+// Frames of the warm-up: the solver learns the camera (field of view, pitch and roll, the
+// world points' lean) and the performer's proportions from a file's first frames, then the
+// file is solved from its start with them known (docs/solver.md "Field of view"): no pose
+// is solved with the prior's camera and no depth jumps when the estimate moves. 5 s at 30
+// frames/s; a shorter file is warmed up on all its frames. With the offline filter only (the
+// default for files): the live and no filters stay the frame-by-frame path.
+constexpr std::size_t k_warm_up_frames = 150;
+
 struct solve_state {
-  explicit solve_state(const pose_stream_options& options) : stream(options) {}
-  pose_stream stream;    // solve -> filter -> resample at output_fps
-  landmark_frame frame;  // the direct source's storage (threads == 1)
+  explicit solve_state(const pose_stream_options& options) : stream(options) {
+    warm.reserve(k_warm_up_frames);
+  }
+  pose_stream stream;                // solve -> filter -> resample at output_fps
+  landmark_frame frame;              // the direct source's storage (threads == 1)
+  std::vector<landmark_frame> warm;  // the warm-up's frames, replayed once it ends
+  bool warming = true;
 };
 
 // Reads straight from the reader on this thread (threads == 1); the same interface as
@@ -141,7 +153,24 @@ status solve_file_job::run(solve_file_summary& s) const {
   auto emit = [&](const proxy_pose& p) { return sink ? sink(p) : writer.write(p); };
 
   auto state = std::make_unique<solve_state>(stream_options);
+  // The live and no filters reproduce the frame-by-frame path (the C solver handle, `live`)
+  // exactly: no warm-up.
+  state->warming = filter_mode == pose_filter_mode::offline;
   pose_stream& stream = state->stream;
+  // The warm-up's end: a second pass over its frames learns the camera's pitch and roll, the
+  // floor and the world points' lean again with the field of view the first pass found; then
+  // the pose state is forgotten, the camera kept, and the frames solved for output.
+  auto end_warm_up = [&]() -> status {
+    solve_state& ws = *state;
+    ws.warming = false;
+    ws.stream.restart_take(false);
+    for (const landmark_frame& f : ws.warm) ws.stream.learn_camera(f);
+    ws.stream.restart_take();
+    for (const landmark_frame& f : ws.warm)
+      if (status st = ws.stream.push(f, emit); !st.ok()) return st;
+    ws.warm.clear();
+    return {};
+  };
   auto last_progress = t0;
   const double fps = output_fps;
   const std::string& fps_name = output_fps_name;
@@ -199,7 +228,14 @@ status solve_file_job::run(solve_file_summary& s) const {
       if (frame.has(frame_part::face) && frame.face_count == k_face_mesh_iris_count)
         ++s.face_iris_frames;
 
-      const status pushed = stream.push(frame, emit);
+      status pushed;
+      if (state->warming) {
+        stream.learn_camera(frame);
+        state->warm.push_back(frame);  // reserved: no reallocation
+        if (state->warm.size() == k_warm_up_frames) pushed = end_warm_up();
+      } else {
+        pushed = stream.push(frame, emit);
+      }
       src.release();
       if (!pushed.ok()) return pushed;
       if (progress && (s.frames & 255) == 0) {
@@ -221,6 +257,12 @@ status solve_file_job::run(solve_file_summary& s) const {
     direct_source direct{reader, state->frame};
     st = process(direct);
   }
+  // A file shorter than the warm-up; or an error: the frames before it still reach the
+  // output (as without a warm-up), then the error ends the run.
+  if (state->warming) {
+    const status warmed = end_warm_up();
+    if (st.ok()) st = warmed;
+  }
   if (st.ok()) st = stream.finish(emit);  // the poses the offline filter still holds
   s.poses_written = stream.stats().emitted;
   if (!st.ok()) return st;
@@ -235,6 +277,7 @@ status solve_file_job::run(solve_file_summary& s) const {
   s.camera_pitch_degrees = stream.solver().camera_pitch_degrees();
   s.camera_roll_degrees = stream.solver().camera_roll_degrees();
   s.gravity_evidence_frames = stream.solver().gravity_evidence_frames();
+  s.floor_evidence_points = stream.solver().floor_evidence_points();
   return {};
 }
 

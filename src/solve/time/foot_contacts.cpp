@@ -72,7 +72,7 @@ struct foot_contact_stage::slot {
 
 foot_contact_stage::foot_contact_stage(const foot_contact_options& options, bool both_sided,
                                        const proxy_skeleton& skeleton)
-    : options_(options), both_sided_(both_sided), skeleton_(skeleton) {
+    : options_(options), both_sided_(both_sided), base_skeleton_(skeleton), skeleton_(skeleton) {
   assert(options.validate().ok());
   const int w = std::clamp(options.window_frames, 1, k_max_contact_window_frames);
   // Causal mode keeps the newest and the one before (the speed over the last frame).
@@ -81,6 +81,25 @@ foot_contact_stage::foot_contact_stage(const foot_contact_options& options, bool
 }
 
 foot_contact_stage::~foot_contact_stage() = default;
+
+void foot_contact_stage::set_leg_length(float leg_length) noexcept {
+  const float base = base_skeleton_.lengths[idx(bone::left_upper_leg)] +
+                     base_skeleton_.lengths[idx(bone::left_lower_leg)];
+  if (!(std::isfinite(leg_length) && leg_length > 0.f && base > 0.f)) {
+    if (leg_length_ != 0.f) skeleton_ = base_skeleton_;
+    leg_length_ = 0.f;
+    return;
+  }
+  if (leg_length_ > 0.f && std::fabs(leg_length - leg_length_) < 0.01f * leg_length_) return;
+  leg_length_ = leg_length;
+  const float k = leg_length / base;
+  skeleton_ = base_skeleton_;
+  skeleton_.height *= k;
+  skeleton_.scale *= k;
+  for (glm::vec3& o : skeleton_.offsets) o *= k;
+  for (float& l : skeleton_.lengths) l *= k;
+  skeleton_.heel_offset *= k;
+}
 
 foot_contact_stage::slot& foot_contact_stage::at(long i) noexcept {
   return ring_[static_cast<std::size_t>(i % capacity_)];
@@ -219,21 +238,35 @@ void foot_contact_stage::emit(int k, proxy_pose& out) noexcept {
       free.x = root_prev_.x + (measured.x - measured_prev_.x);
       free.z = root_prev_.z + (measured.z - measured_prev_.z);
     }
+    // How firmly each foot holds the hips: its contact, less (both-sided) as the foot is
+    // faster than half plant_speed, none at release_speed. A planted foot that still moves (a slow
+    // step in a slow walk: both feet low and slow, both planted) must not hold the body back.
+    std::array<float, 2> hold;
+    for (int f = 0; f < 2; ++f) {
+      const float v0 = 0.5f * options_.plant_speed, v1 = options_.release_speed;
+      // Causal: one frame's speed is landmark noise more than motion; a planted foot holds.
+      const float h =
+          both_sided_ && v1 > v0 ? std::clamp((v1 - speed[f]) / (v1 - v0), 0.f, 1.f) : 1.f;
+      hold[f] = contact_[f] * h;
+    }
     // The hips each anchored foot asks for (its offset from the hips is the FK's).
     auto blend_root = [&](bool only_anchored) {
+      // The feet share the firmest hold between them by their holds; the rest is free motion
+      // (two feet that each hold 40 % pin the body 40 %, not 80 %).
       glm::vec2 sum(0.f);
-      float wsum = 0.f;
+      float wsum = 0.f, firm = 0.f;
       for (int f = 0; f < 2; ++f) {
-        if (contact_[f] <= 0.f || (only_anchored && !anchored_[f])) continue;
+        if (hold[f] <= 0.f || (only_anchored && !anchored_[f])) continue;
         const glm::vec3 offset = cur.feet[f].point - measured;
-        sum += contact_[f] * glm::vec2(anchor_[f].x - offset.x, anchor_[f].z - offset.z);
-        wsum += contact_[f];
+        sum += hold[f] * glm::vec2(anchor_[f].x - offset.x, anchor_[f].z - offset.z);
+        wsum += hold[f];
+        firm = std::max(firm, hold[f]);
       }
-      const float free_w = std::max(0.f, 1.f - wsum);
-      glm::vec3 r;
-      const float total = wsum + free_w;
-      r.x = (sum.x + free_w * free.x) / total;
-      r.z = (sum.y + free_w * free.z) / total;
+      glm::vec3 r = free;
+      if (wsum > 0.f) {
+        r.x = firm * sum.x / wsum + (1.f - firm) * free.x;
+        r.z = firm * sum.y / wsum + (1.f - firm) * free.z;
+      }
       r.y = measured.y;
       return r;
     };
@@ -248,6 +281,16 @@ void foot_contact_stage::emit(int k, proxy_pose& out) noexcept {
     }
     root = blend_root(false);
     if (!finite3(root)) root = measured;
+    // A foot that holds only partly slides its anchor along with it by the rest.
+    for (int f = 0; f < 2; ++f) {
+      if (!anchored_[f] || contact_[f] <= 0.f) continue;
+      const float follow = 1.f - hold[f] / contact_[f];
+      if (follow > 0.f) {
+        glm::vec3 here = root + (cur.feet[f].point - measured);
+        here.y = 0.f;
+        anchor_[f] += follow * (here - anchor_[f]);
+      }
+    }
     out.hips_position = root;
   }
   for (int f = 0; f < 2; ++f)

@@ -52,6 +52,22 @@ void write_synthetic(const std::string& path, int frames, bool header = true) {
   ASSERT_TRUE(writer.commit().ok());
 }
 
+// The job's warm-up with the offline filter (src/rig/jobs/solve_file.cpp): the solver learns
+// the camera from the file's first 150 frames, forgets the view and learns it again with the field
+// of view known, then starts the take from the beginning with all of it known.
+void warm_up(frame_solver& solver, const std::string& path) {
+  landmark_reader reader;
+  EXPECT_TRUE(reader.open(path).ok());
+  std::vector<landmark_frame> frames;
+  landmark_frame frame;
+  while (frames.size() < 150 && reader.next(frame) == read_result::frame) frames.push_back(frame);
+  proxy_pose scratch;
+  for (const landmark_frame& f : frames) solver.solve(f, scratch);
+  solver.restart_take(false);
+  for (const landmark_frame& f : frames) solver.solve(f, scratch);
+  solver.restart_take(true);
+}
+
 // The reference: the file read back with landmark_reader, solved and filtered frame by frame,
 // then the contact stage (time/foot_contacts.hpp) as the job runs it.
 std::vector<proxy_pose> reference_poses(const std::string& path, const solver_options& options,
@@ -61,7 +77,7 @@ std::vector<proxy_pose> reference_poses(const std::string& path, const solver_op
   std::vector<proxy_pose> out;
   landmark_reader reader;
   EXPECT_TRUE(reader.open(path).ok());
-  frame_solver solver(options);
+  frame_solver solver(options);  // the live and no filters: no warm-up, as live
   pose_filter filter(filter_options);
   foot_contact_stage contacts(contact_options, false);  // causal: one pose in, one out
   landmark_frame frame;
@@ -96,8 +112,11 @@ std::vector<proxy_pose> reference_offline_poses(const std::string& path, solver_
   landmark_reader reader;
   EXPECT_TRUE(reader.open(path).ok());
   frame_solver solver(options);
+  warm_up(solver, path);
   offline_smoother smoother(smooth);
   foot_contact_stage contacts(foot_contact_options{}, true);  // both-sided, as for files
+  // As the warm-up's end does (pose_stream::restart_take).
+  contacts.set_leg_length(solver.performer_leg_length());
   landmark_frame frame;
   proxy_pose raw, smoothed, contacted;
   std::vector<proxy_pose> out;
@@ -580,6 +599,7 @@ TEST(solve_file_offline, a_hand_found_again_is_its_measurement_at_once) {
   blended.confidence.lost_below = 0.f;
   blended.confidence.found_above = 0.f;
   frame_solver solver(blended);
+  warm_up(solver, path);
   landmark_reader reader;
   ASSERT_TRUE(reader.open(path).ok());
   proxy_pose p;

@@ -148,8 +148,8 @@ TEST(foot_contacts, a_foot_that_is_not_confident_is_never_planted) {
   const proxy_skeleton sk = make_proxy_skeleton();
   auto in = standing_with_drift(sk, 0.f, 0.002f);
   for (size_t i = 0; i < in.size(); ++i) {
-    in[i].confidence[idx(bone::left_lower_leg)] = 0.1f;  // low
-    in[i].confidence[idx(bone::right_toes)] = 0.f;       // never seen
+    in[i].confidence[idx(bone::left_lower_leg)] = 0.005f;  // below min_confidence (0.01)
+    in[i].confidence[idx(bone::right_toes)] = 0.f;         // never seen
   }
   for (bool both : {false, true}) {
     const auto out = run(in, both);
@@ -159,6 +159,108 @@ TEST(foot_contacts, a_foot_that_is_not_confident_is_never_planted) {
       // No foot planted: the hips as measured.
     }
     EXPECT_NEAR(out[200].hips_position.x, in[200].hips_position.x, 1e-5f);
+  }
+}
+
+TEST(foot_contacts, a_foot_reported_outside_the_image_is_planted) {
+  // BlazePose reports a foot outside the image (or turned away) with a visibility of a few
+  // percent; its pose is what the avatar shows, so a still, low foot is held all the same.
+  const proxy_skeleton sk = make_proxy_skeleton();
+  auto in = standing_with_drift(sk, 0.02f, 0.002f);
+  for (proxy_pose& p : in) p.confidence[idx(bone::left_foot)] = 0.02f;
+  for (bool both : {false, true}) {
+    const auto out = run(in, both);
+    EXPECT_EQ(out[100].foot_contact[0], 1.f);
+    EXPECT_EQ(out[100].foot_contact[1], 1.f);
+  }
+}
+
+// Standing on the left foot of skeleton `sk` while the left leg sweeps +-15 degrees about X
+// (1 Hz) and the hips move so that the left sole stays exactly where it is on `sk`; the right
+// leg is raised 40 degrees forward (high: never planted).
+std::vector<proxy_pose> swaying_over_the_left_foot(const proxy_skeleton& sk) {
+  std::vector<proxy_pose> v;
+  proxy_fk fk;
+  glm::vec3 sole0(0.f);
+  for (int i = 0; i < 90; ++i) {
+    proxy_pose p = standing(i / k_fps, sk);
+    const float a = glm::radians(15.f) * std::sin(2.f * k_pi * float(i) / 30.f);
+    p[bone::left_upper_leg] = glm::angleAxis(a, glm::vec3(1.f, 0.f, 0.f));
+    p[bone::right_upper_leg] = glm::angleAxis(glm::radians(-40.f), glm::vec3(1.f, 0.f, 0.f));
+    std::array<foot_measure, 2> m;
+    measure_feet(sk, p, 0.f, fk, m);
+    if (i == 0) sole0 = m[0].point;
+    p.hips_position.x -= m[0].point.x - sole0.x;
+    p.hips_position.z -= m[0].point.z - sole0.z;
+    v.push_back(p);
+  }
+  return v;
+}
+
+TEST(foot_contacts, the_feet_are_held_on_the_performers_leg_length) {
+  // The performer's legs are 15 % shorter than the 1.70 m proxy's. Told the leg length, the
+  // stage sees the sole still and leaves the hips as measured; on the proxy's proportions the
+  // same rotations move the sole, and the stage would move the hips to hold it.
+  const proxy_skeleton proxy = make_proxy_skeleton();
+  const proxy_skeleton performer = make_proxy_skeleton(0.85f * k_proxy_reference_height);
+  const float leg =
+      performer.lengths[idx(bone::left_upper_leg)] + performer.lengths[idx(bone::left_lower_leg)];
+  const auto in = swaying_over_the_left_foot(performer);
+  for (bool told : {true, false}) {
+    SCOPED_TRACE(told ? "told the leg length" : "proxy proportions");
+    foot_contact_stage stage({}, true);
+    if (told) stage.set_leg_length(leg);
+    EXPECT_NEAR(stage.skeleton().lengths[idx(bone::left_upper_leg)] +
+                    stage.skeleton().lengths[idx(bone::left_lower_leg)],
+                told ? leg : leg / 0.85f, 1e-5f);
+    std::vector<proxy_pose> out;
+    proxy_pose p;
+    for (const proxy_pose& q : in)
+      if (stage.push(q, p)) out.push_back(p);
+    while (stage.flush(p)) out.push_back(p);
+    ASSERT_EQ(out.size(), in.size());
+    float worst = 0.f;
+    for (size_t i = 0; i < out.size(); ++i) {
+      EXPECT_EQ(out[i].foot_contact[0], 1.f) << i;
+      EXPECT_EQ(out[i].foot_contact[1], 0.f) << i;
+      worst = std::max(worst, glm::length(out[i].hips_position - in[i].hips_position));
+    }
+    if (told)
+      EXPECT_LT(worst, 1e-4f);
+    else
+      EXPECT_GT(worst, 0.01f);  // the test tells the two apart
+  }
+  // 0, negative, NaN: the skeleton as given.
+  foot_contact_stage stage({}, true);
+  stage.set_leg_length(leg);
+  stage.set_leg_length(std::numeric_limits<float>::quiet_NaN());
+  EXPECT_EQ(stage.skeleton().lengths[idx(bone::left_lower_leg)],
+            proxy.lengths[idx(bone::left_lower_leg)]);
+}
+
+TEST(foot_contacts, a_planted_foot_that_keeps_moving_does_not_hold_the_body_back) {
+  // Both feet low and under plant_speed (0.5 m/s), so both are planted (both-sided). Sliding
+  // at 0.1 m/s (under half plant_speed) they hold the hips fully; at 0.4 m/s (a slow step) each
+  // holds (0.5 - 0.4) / (0.5 - 0.25) = 40 % and its anchor follows it by the rest, so the body
+  // still travels (48 % of the measured path here; all of it held, as before, it stood still).
+  const proxy_skeleton sk = make_proxy_skeleton();
+  for (float v : {0.1f, 0.4f}) {
+    SCOPED_TRACE(v);
+    std::vector<proxy_pose> in;
+    for (int i = 0; i < 60; ++i) {
+      proxy_pose p = standing(i / k_fps, sk);
+      p.hips_position.x = v * float(p.t);
+      in.push_back(p);
+    }
+    const auto out = run(in, true);
+    EXPECT_EQ(out[30].foot_contact[0], 1.f);
+    EXPECT_EQ(out[30].foot_contact[1], 1.f);
+    const float travel = out[59].hips_position.x - out[0].hips_position.x;
+    const float measured = in[59].hips_position.x - in[0].hips_position.x;
+    if (v < 0.2f)
+      EXPECT_LT(travel, 0.01f);
+    else
+      EXPECT_GT(travel, 0.4f * measured);
   }
 }
 
