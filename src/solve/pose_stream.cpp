@@ -61,14 +61,18 @@ pose_stream::pose_stream(const pose_stream_options& options)
 
 pose_stream::~pose_stream() = default;
 
-void pose_stream::solve(const landmark_frame& frame) {
-  ++stats_.frames;
+void pose_stream::solve_points(const landmark_frame& frame) {
   if (points_) {
     points_->filter.apply(frame, points_->smoothed);
     solver_.solve(points_->smoothed, solved_);
   } else {
     solver_.solve(frame, solved_);
   }
+}
+
+void pose_stream::solve(const landmark_frame& frame) {
+  ++stats_.frames;
+  solve_points(frame);
   switch (options_.filters.filter_mode) {
     case pose_filter_mode::offline:
       smoother_->push(solved_);
@@ -146,6 +150,10 @@ status pose_stream::grid_last(long& j_last) {
 
 void pose_stream::reset() {
   solver_.reset();
+  reset_after_solver();
+}
+
+void pose_stream::reset_after_solver() {
   filter_.reset();
   if (smoother_) smoother_->reset();
   if (points_) points_->filter.reset();
@@ -158,14 +166,7 @@ void pose_stream::reset() {
   j_next_ = 0;
 }
 
-void pose_stream::learn_camera(const landmark_frame& frame) {
-  if (points_) {
-    points_->filter.apply(frame, points_->smoothed);
-    solver_.solve(points_->smoothed, solved_);
-  } else {
-    solver_.solve(frame, solved_);
-  }
-}
+void pose_stream::learn_camera(const landmark_frame& frame) { solve_points(frame); }
 
 void pose_stream::restart_take(bool keep_view) {
   solver_.restart_take(keep_view);
@@ -173,16 +174,7 @@ void pose_stream::restart_take(bool keep_view) {
   // (set once here, not per frame: the poses out must not depend on how far the solver runs
   // ahead of the filters).
   contacts_.set_leg_length(solver_.performer_leg_length());
-  filter_.reset();
-  if (smoother_) smoother_->reset();
-  if (points_) points_->filter.reset();
-  contacts_.reset();
-  resampler_.reset();
-  pending_ = pushed_ = finishing_ = false;
-  stats_ = {};
-  t_grid0_ = 0.0;
-  have_grid_ = false;
-  j_next_ = 0;
+  reset_after_solver();
 }
 
 void pose_stream::restart(const solver_options& solver) {

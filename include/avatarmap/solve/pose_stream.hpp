@@ -126,6 +126,10 @@ class pose_stream {
   const frame_solver& solver() const noexcept { return solver_; }
 
  private:
+  // The point filter (when on), then the solver, into solved_.
+  void solve_points(const landmark_frame& frame);
+  // Everything after the solver back to its start: filters, contacts, resampler, grid, stats.
+  void reset_after_solver();
   struct point_stage;  // landmark_filter and its output frame (only when enabled)
 
   void solve(const landmark_frame& frame);
