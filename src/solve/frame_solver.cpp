@@ -10,6 +10,7 @@
 #include "avatarmap/solve/frame_solver.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "solve/solve_body.hpp"
 #include "solve/solve_camera.hpp"
@@ -75,6 +76,7 @@ void frame_solver::reset() {
   focal_weighted_sum_ = focal_information_ * focal_per_width_;
   focal_frames_ = 0;
   focal_tick_ = 0;
+  focal_t_last_ = -std::numeric_limits<double>::infinity();
   lengths_->reset();
   gravity_->reset();
 }
@@ -83,6 +85,7 @@ void frame_solver::restart_take(bool keep_view) {
   const float focal = focal_per_width_;
   const double information = focal_information_, weighted = focal_weighted_sum_;
   const long frames = focal_frames_, tick = focal_tick_;
+  const double t_last = focal_t_last_;
   const body_lengths lengths = *lengths_;
   camera_gravity gravity = *gravity_;
   const std::array<hand_shape, 2> hands = hand_shapes_;
@@ -92,6 +95,7 @@ void frame_solver::restart_take(bool keep_view) {
   focal_weighted_sum_ = weighted;
   focal_frames_ = frames;
   focal_tick_ = tick;
+  focal_t_last_ = t_last;
   *lengths_ = lengths;
   gravity.has_floor = false;  // the floor's height is found again from the start
   if (keep_view) *gravity_ = gravity;
@@ -112,6 +116,9 @@ void frame_solver::update_focal(const landmark_frame& in) {
   if (options_.horizontal_fov_degrees != 0.f || !(options_.image_width > 0.f)) return;
   // A sample of the take's frames tells the field of view (consecutive frames are nearly the
   // same view); the fit's cost stays off most frames.
+  // The file warm-up solves its frames again (restart_take): each frame tells once.
+  if (!(in.t > focal_t_last_)) return;
+  focal_t_last_ = in.t;
   if (focal_frames_ >= k_focal_max_frames || (focal_tick_++ % k_focal_every) != 0) return;
   const focal_evidence e = estimate_focal(in, options_.image_width, options_.image_height);
   if (!(e.information > 0.0)) return;

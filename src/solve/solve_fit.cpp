@@ -316,8 +316,11 @@ bool fit_body(const landmark_frame& in, float width, float height, float focal, 
   float lean = 0.f;
   // The lean changes little over a take: a sample of frames tells it (docs/solver.md), the
   // search's cost stays off most frames.
-  const bool sample =
-      learn && gravity.lean_frames < k_lean_max_frames && (gravity.lean_tick++ % k_lean_every) == 0;
+  // Each frame tells once (the file warm-up solves its frames again).
+  const bool fresh = in.t > gravity.lean_t_last;
+  if (learn && fresh) gravity.lean_t_last = in.t;
+  const bool sample = learn && fresh && gravity.lean_frames < k_lean_max_frames &&
+                      (gravity.lean_tick++ % k_lean_every) == 0;
   if (sample && best_lean(v, w, lean)) {
     gravity.lean_sum += lean;
     gravity.lean_frames += 1.0;
@@ -377,8 +380,8 @@ bool fit_body(const landmark_frame& in, float width, float height, float focal, 
 
   // Gravity: the standing body's vertical (ankles' midpoint to the hips) in frames whose legs
   // are both straight, confident and parallel, the feet on one level (standing: not a leg
-  // swung out, not a body tipping over on one foot).
-  if (learn) {
+  // swung out, not a body tipping over on one foot). Each frame tells once.
+  if (learn && fresh) {
     bool standing = true;
     glm::vec3 leg_dir[2];
     for (int side = 0; side < 2 && standing; ++side) {
@@ -440,7 +443,7 @@ bool fit_body(const landmark_frame& in, float width, float height, float focal, 
         out.feet_above_floor = float(above - k_jump_min_height);
       } else if (learn) {
         gravity.floor_below_camera += k_floor_rate * (below - gravity.floor_below_camera);
-        gravity.add_floor_point(glm::dvec3(cam[lowest_i]));
+        if (fresh) gravity.add_floor_point(glm::dvec3(cam[lowest_i]));
       }
     }
   }

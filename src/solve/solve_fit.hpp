@@ -53,7 +53,8 @@ struct camera_gravity {
   /// still being learnt takes some of the focal length's error).
   double focal_lean_sum = 0.0;
   double focal_lean_frames = 0.0;
-  long lean_tick = 0;  // frames seen, for sampling the lean's search
+  long lean_tick = 0;           // frames seen, for sampling the lean's search
+  double lean_t_last = -1e300;  // the newest frame time searched (each frame tells once)
   bool has_floor = false;
   /// The floor's resting points (camera axes): first and second moments.
   glm::dvec3 floor_m1{0.0};

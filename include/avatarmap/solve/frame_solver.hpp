@@ -131,7 +131,8 @@ class frame_solver {
   double focal_information_ = 0.0;
   double focal_weighted_sum_ = 0.0;
   long focal_frames_ = 0;
-  long focal_tick_ = 0;  // frames seen, for sampling the focal length's fit
+  long focal_tick_ = 0;        // frames seen, for sampling the focal length's fit
+  double focal_t_last_ = 0.0;  // the newest frame time fitted (kept by restart_take)
   std::array<rotation_gate, k_bone_count> bones_{};           // output = the local rotation shown
   mutable std::array<glm::quat, k_bone_count> prev_world_{};  // memo of previous_world()
   mutable std::array<unsigned, k_bone_count> world_stamp_{};
