@@ -140,13 +140,19 @@ void frame_solver::update_focal(const landmark_frame& in) {
 const body_fit* frame_solver::fit_frame(const landmark_frame& in, bool learn, body_fit& out) const {
   if (!options_.fit_body_to_image || !options_.parts.body || !(options_.image_width > 0.f))
     return nullptr;
+  const float focal = focal_per_width_ * options_.image_width;
+  if (learn)
+    return fit_body(in, options_.image_width, options_.image_height, focal, true, *lengths_,
+                    *gravity_, out)
+               ? &out
+               : nullptr;
   // measure() learns nothing: it fits with copies of what was learnt so far.
   body_lengths lengths = *lengths_;
   camera_gravity gravity = *gravity_;
-  const bool ok = fit_body(in, options_.image_width, options_.image_height,
-                           focal_per_width_ * options_.image_width, learn,
-                           learn ? *lengths_ : lengths, learn ? *gravity_ : gravity, out);
-  return ok ? &out : nullptr;
+  return fit_body(in, options_.image_width, options_.image_height, focal, false, lengths, gravity,
+                  out)
+             ? &out
+             : nullptr;
 }
 
 float frame_solver::camera_pitch_degrees() const { return gravity_->pitch_degrees(); }
