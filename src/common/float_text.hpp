@@ -54,6 +54,12 @@ inline constexpr std::uint64_t k_pow10[20] = {1u,
                                               1000000000000000000u,
                                               10000000000000000000u};
 
+// 5^n for n <= 16.
+inline constexpr std::uint64_t k_pow5[17] = {
+    1u,         5u,          25u,         125u,         625u,         3125u,
+    15625u,     78125u,      390625u,     1953125u,     9765625u,     48828125u,
+    244140625u, 1220703125u, 6103515625u, 30517578125u, 152587890625u};
+
 // The eight decimal digits of x < 10^8 as ASCII, the most significant in byte 0: halves of
 // four digits in 32-bit lanes, then pairs in 16-bit lanes, then single digits in bytes
 // (divisions by 100 and 10 as multiply-shifts, exact in these ranges).
@@ -98,22 +104,39 @@ inline char* write_shortest_float(char* out, float v) {
   // k = floor(log10(width)), width = 2^-s (or 3/4 of it): -k = ceil(s log10 2) at most 19.
   int minus_k = (s * 78913 + (1 << 18) - 1) >> 18;  // ceil(s * log10(2)) for 0 <= s <= 59
   if (irregular && (u128{3} * k_pow10[minus_k] >> (s + 2)) == 0) ++minus_k;  // 3/4 2^-s < 10^k
-  const std::uint64_t p = k_pow10[minus_k];
-  // v and the interval's ends in units of 2^-(s+2) * 10^k.
-  const int shift = s + 2;
-  const u128 mid = u128{4 * c} * p;
-  const u128 below = mid - (irregular ? u128{p} : 2 * u128{p});
-  const u128 above = mid + 2 * u128{p};
-  // Arithmetic rather than branches on the low bits, which are random: the first multiple
-  // of 10^k at or above the lower end (above it when open), the last at or below the upper.
+  // The first multiple of 10^k at or above the lower end (above it when open), the last at
+  // or below the upper, and the one nearest to v (ties to even), inside the interval.
+  // Arithmetic rather than branches on the low bits, which are random.
   const unsigned open = closed ? 0u : 1u;
-  const u128 unit = u128{1} << shift;
-  const auto lowest = static_cast<std::uint64_t>((below + unit - (1u - open)) >> shift);
-  const auto highest = static_cast<std::uint64_t>((above - open) >> shift);
-  // The multiple of 10^k nearest to v (ties to even), inside the interval.
-  const auto floor = static_cast<std::uint64_t>(mid >> shift);
-  const auto rest = static_cast<std::uint64_t>(mid) & ((std::uint64_t{1} << shift) - 1);
-  const std::uint64_t half = std::uint64_t{1} << (shift - 1);
+  std::uint64_t lowest, highest, floor, rest, half;
+  if (minus_k <= 16) {
+    // 10^-k = 5^-k 2^-k: v and the interval's ends in units of 2^-(s+2+k) * 10^k, which
+    // fit 64 bits ((4 c + 2) 5^16 < 2^64; s + 2 + k >= 1). Most values take this path.
+    const std::uint64_t p = k_pow5[minus_k];
+    const int shift = s + 2 - minus_k;
+    const std::uint64_t mid = 4 * c * p;
+    const std::uint64_t below = mid - (irregular ? p : 2 * p);
+    const std::uint64_t above = mid + 2 * p;
+    const std::uint64_t unit = std::uint64_t{1} << shift;
+    lowest = (below + unit - (1u - open)) >> shift;
+    highest = (above - open) >> shift;
+    floor = mid >> shift;
+    rest = mid & (unit - 1);
+    half = unit >> 1;
+  } else {
+    // v and the interval's ends in units of 2^-(s+2) * 10^k, 128 bits.
+    const std::uint64_t p = k_pow10[minus_k];
+    const int shift = s + 2;
+    const u128 mid = u128{4 * c} * p;
+    const u128 below = mid - (irregular ? u128{p} : 2 * u128{p});
+    const u128 above = mid + 2 * u128{p};
+    const u128 unit = u128{1} << shift;
+    lowest = static_cast<std::uint64_t>((below + unit - (1u - open)) >> shift);
+    highest = static_cast<std::uint64_t>((above - open) >> shift);
+    floor = static_cast<std::uint64_t>(mid >> shift);
+    rest = static_cast<std::uint64_t>(mid) & ((std::uint64_t{1} << shift) - 1);
+    half = std::uint64_t{1} << (shift - 1);
+  }
   std::uint64_t nearest = floor + (rest + (floor & 1u) > half ? 1u : 0u);
   if (nearest > highest) nearest = floor;
   if (nearest < lowest) nearest = floor + 1;

@@ -32,9 +32,13 @@ int primary_child(int b) {
 
 bool skips_rest_alignment(bone b) {
   // The proxy's foot/toe rest direction (ankle -> toe tip) is an idealisation that differs from
-  // any rig's ankle -> ball; eyes and jaw have no bone direction.
+  // any rig's ankle -> ball; eyes and jaw have no bone direction. A clavicle's rest direction is
+  // the rig's anatomy, not a pose to straighten (CMU's LeftCollar rises 26 degrees from the
+  // chest to the socket): turning it onto the proxy's +X would drop the shoulder sockets, and
+  // the arms with them, by the clavicle's rise (8 cm on the CMU skeleton).
   return b == bone::left_foot || b == bone::right_foot || b == bone::left_toes ||
-         b == bone::right_toes || b == bone::left_eye || b == bone::right_eye || b == bone::jaw;
+         b == bone::right_toes || b == bone::left_eye || b == bone::right_eye || b == bone::jaw ||
+         b == bone::left_shoulder || b == bone::right_shoulder;
 }
 
 }  // namespace
@@ -106,7 +110,17 @@ status retargeter::build(const rig& r, const bone_binding& binding, const retarg
         if (count == 1 && bone_of_joint_[only] < 0) target = only;
       }
       glm::vec3 d(0.f);
-      if (target >= 0) {
+      const int left_leg = binding[idx(bone::left_upper_leg)];
+      const int right_leg = binding[idx(bone::right_upper_leg)];
+      if (target >= 0 && b == idx(bone::hips) && left_leg >= 0 && right_leg >= 0) {
+        // The proxy's hips joint is the hip sockets' midpoint: its hips bone runs from there to
+        // the spine. A rig's hips joint often sits above and behind the sockets (CMU: 9 cm up,
+        // 4 cm back, with a zero-length hips -> lowerback bone), so the midpoint, not the hips
+        // joint, starts the direction that is turned onto the proxy's +Y.
+        const glm::vec3 mid =
+            0.5f * (position_of(r.rest_world[left_leg]) + position_of(r.rest_world[right_leg]));
+        d = position_of(r.rest_world[target]) - mid;
+      } else if (target >= 0) {
         d = position_of(r.rest_world[target]) - position_of(r.rest_world[j]);
       } else if (primary_child(b) >= 0 && r.parents[j] >= 0) {
         // A rig leaf driving a bone the proxy continues (a one-joint finger such as CMU's
@@ -133,11 +147,6 @@ status retargeter::build(const rig& r, const bone_binding& binding, const retarg
     floor = 1e30f;
     for (int j : foot_joints_) floor = std::min(floor, (basis_ * position_of(r.rest_world[j])).y);
   }
-  rig_hips_height_ = hips_vrm.y - floor;
-  if (!(rig_hips_height_ > 0.f))
-    rig_hips_height_ = std::abs(hips_vrm.y) > 0.f ? std::abs(hips_vrm.y) : 1.f;
-  translation_scale_ =
-      options.performer_hips_height > 0.f ? rig_hips_height_ / options.performer_hips_height : 1.f;
   hips_rest_world_ = position_of(r.rest_world[hips]);
   const int hp = r.parents[hips];
   hips_parent_inverse_ = hp < 0 ? glm::mat4(1.f) : glm::inverse(r.rest_world[hp]);
@@ -162,6 +171,36 @@ status retargeter::build(const rig& r, const bone_binding& binding, const retarg
   }
   world_.assign(static_cast<size_t>(n), identity_quat());
   positions_.assign(static_cast<size_t>(n), glm::vec3(0.f));
+
+  // The hips height that a standing performer maps to: measured in the pose the rig takes for
+  // the proxy's rest pose (its bound bones turned onto the proxy's rest directions), not in the
+  // rig's own rest. The two differ when the rig's legs are not straight down at rest (the CMU
+  // skeleton's spread 20 degrees apart): straightened, they reach lower than the rest pose's
+  // feet, and the rest pose's hips height would sink the feet into the floor (5 cm on CMU).
+  float hips_y = hips_vrm.y, lowest = floor;
+  if (!foot_joints_.empty()) {
+    rig_pose aligned;
+    prepare(aligned);
+    apply(proxy_pose{}, aligned);
+    std::vector<glm::mat4> m(static_cast<size_t>(n));
+    for (int j = 0; j < n; ++j) {
+      const transform& t = r.rest_local[j];
+      glm::mat4 local = glm::mat4_cast(aligned.local_rotations[j]);
+      local[0] *= t.scale.x;
+      local[1] *= t.scale.y;
+      local[2] *= t.scale.z;
+      local[3] = glm::vec4(t.translation, 1.f);
+      m[j] = r.parents[j] < 0 ? local : m[r.parents[j]] * local;
+    }
+    hips_y = (basis_ * position_of(m[hips])).y;
+    lowest = 1e30f;
+    for (int j : foot_joints_) lowest = std::min(lowest, (basis_ * position_of(m[j])).y);
+  }
+  rig_hips_height_ = hips_y - lowest;
+  if (!(rig_hips_height_ > 0.f))
+    rig_hips_height_ = std::abs(hips_vrm.y) > 0.f ? std::abs(hips_vrm.y) : 1.f;
+  translation_scale_ =
+      options.performer_hips_height > 0.f ? rig_hips_height_ / options.performer_hips_height : 1.f;
   return {};
 }
 

@@ -117,7 +117,7 @@ void frame_solver::update_focal(const landmark_frame& in) {
   // A sample of the take's frames tells the field of view (consecutive frames are nearly the
   // same view); the fit's cost stays off most frames.
   // The file warm-up solves its frames again (restart_take): each frame tells once.
-  if (!(in.t > focal_t_last_)) return;
+  if (!(in.t > focal_t_last_) || gravity_->view_held) return;
   focal_t_last_ = in.t;
   if (focal_frames_ >= k_focal_max_frames || (focal_tick_++ % k_focal_every) != 0) return;
   const focal_evidence e = estimate_focal(in, options_.image_width, options_.image_height);
@@ -154,6 +154,8 @@ const body_fit* frame_solver::fit_frame(const landmark_frame& in, bool learn, bo
              ? &out
              : nullptr;
 }
+
+void frame_solver::hold_view(bool hold) { gravity_->view_held = hold; }
 
 float frame_solver::camera_pitch_degrees() const { return gravity_->pitch_degrees(); }
 float frame_solver::camera_roll_degrees() const { return gravity_->roll_degrees(); }

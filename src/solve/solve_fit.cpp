@@ -46,11 +46,15 @@ constexpr float k_gravity_gate_cos = 0.8f;  // ~37 degrees
 // narrower direction: a walk, not feet standing in one place.
 constexpr double k_floor_min_points = 30.0;
 constexpr double k_floor_min_spread = 0.15;
+// ... or, along one line only (a straight walk), at least this far (standard deviation).
+constexpr double k_floor_min_line = 0.3;
 // Feet higher than this above the floor are in the air (a jump): the hips rise by the rest.
 constexpr double k_jump_min_height = 0.04;
 // Share of each grounded frame's floor height taken into the running floor (~1 s memory at
 // 30 frames/s: a camera that slowly changes its height is followed).
 constexpr double k_floor_rate = 0.05;
+// Feet above the floor for longer than this are not in a jump (a hop's flight is ~0.3-0.5 s).
+constexpr double k_max_airborne_seconds = 0.8;
 
 // The segment fit's uncertainties (metres): of a learnt length against this frame's image
 // (image noise and the person's own give), and of the world points' depth once their lean is
@@ -87,20 +91,25 @@ glm::vec3 on_ray(const glm::vec3& ray, const glm::vec3& a, float length,
   const float s_world = glm::dot(target, ray) / rr;
   const float inv_l2 = 1.f / (k_sigma_length * k_sigma_length);
   const float inv_w2 = rr / (k_sigma_world * k_sigma_world);
-  auto cost = [&](float s) {
-    const float d = glm::length(ray * s - a) - length;
+  // `dist`: |s ray - a|, which the Newton step at an accepted s reuses (no second sqrt).
+  auto cost = [&](float s, float& dist) {
+    dist = glm::length(ray * s - a);
+    const float d = dist - length;
     const float e = s - s_world;
     return d * d * inv_l2 + e * e * inv_w2;
   };
   // The cost's minima lie near the depths the length allows (the two roots of
   // |s ray - a| = length, or the ray's closest point when there are none) or near the world's
   // depth: start from the best of them, then a few Newton steps.
-  float best_s = s_world, best = cost(s_world);
+  float best_dist = 0.f;
+  float best_s = s_world, best = cost(s_world, best_dist);
   auto consider = [&](float s) {
-    const float c = cost(s);
+    float dist;
+    const float c = cost(s, dist);
     if (c < best) {
       best = c;
       best_s = s;
+      best_dist = dist;
     }
   };
   const float disc = qb * qb - rr * qc;
@@ -112,18 +121,20 @@ glm::vec3 on_ray(const glm::vec3& ray, const glm::vec3& a, float length,
     consider(qb / rr);
   }
   float s = best_s;
+  float d = best_dist;  // |s ray - a|
   for (int it = 0; it < k_newton_steps; ++it) {
-    const float d = glm::length(ray * s - a);
     if (!(d > 1e-6f)) break;
     const float d1 = (s * rr - qb) / d, d2 = (rr - d1 * d1) / d;
     const float g1 = 2.f * inv_l2 * (d - length) * d1 + 2.f * inv_w2 * (s - s_world);
     const float g2 = 2.f * inv_l2 * (d1 * d1 + (d - length) * d2) + 2.f * inv_w2;
     if (!(g2 > 0.f)) break;
     const float next = s - g1 / g2;
-    const float c = cost(next);
+    float next_dist;
+    const float c = cost(next, next_dist);
     if (!(c <= best)) break;
     best = c;
     s = next;
+    d = next_dist;
   }
   return ray * s;
 }
@@ -284,10 +295,20 @@ bool camera_gravity::floor_normal(glm::vec3& out) const {
       glm::cross(n, std::fabs(n.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
   const glm::dvec3 w = glm::cross(n, u);
   const double a = glm::dot(u, c * u), b = glm::dot(u, c * w), d = glm::dot(w, c * w);
-  const double lambda2 = 0.5 * (a + d) - std::sqrt(0.25 * (a - d) * (a - d) + b * b);
-  if (!(lambda2 > k_floor_min_spread * k_floor_min_spread) ||
-      !(glm::dot(n, legs) > k_gravity_gate_cos) || !std::isfinite(n.x + n.y + n.z))
-    return false;
+  const double root = std::sqrt(0.25 * (a - d) * (a - d) + b * b);
+  const double lambda1 = 0.5 * (a + d) + root, lambda2 = 0.5 * (a + d) - root;
+  if (!(lambda2 > k_floor_min_spread * k_floor_min_spread)) {
+    // A walk along one line (toward the camera, or across): the line is level, which decides
+    // the tilt about the other horizontal axis; the tilt about the line stays the legs'.
+    if (!(lambda1 > k_floor_min_line * k_floor_min_line)) return false;
+    // The line's direction: the floor's eigenvector of lambda1 in the (u, w) plane.
+    const double angle = 0.5 * std::atan2(2.0 * b, a - d);
+    const glm::dvec3 line = glm::normalize(std::cos(angle) * u + std::sin(angle) * w);
+    n = legs - glm::dot(legs, line) * line;
+    if (!(glm::length(n) > 1e-6)) return false;
+    n = glm::normalize(n);
+  }
+  if (!(glm::dot(n, legs) > k_gravity_gate_cos) || !std::isfinite(n.x + n.y + n.z)) return false;
   out = glm::vec3(n);
   return true;
 }
@@ -309,7 +330,10 @@ bool fit_body(const landmark_frame& in, float width, float height, float focal, 
       !(height > 0.f) || !(focal > 0.f))
     return false;
   const frame_view v{&in, 0.5f * width, 0.5f * height, width, height, focal};
-  if (learn) learn_lengths(v, lengths);
+  // A held view (frame_solver::hold_view) learns nothing more of the camera or the performer;
+  // the floor's level is still followed.
+  const bool learn_view = learn && !gravity.view_held;
+  if (learn_view) learn_lengths(v, lengths);
   // The world points, then the take's lean undone.
   std::array<glm::vec3, k_pose_landmark_count> w;
   for (int i = 0; i < k_pose_landmark_count; ++i) w[i] = pos(in.pose_world[i]);
@@ -319,7 +343,7 @@ bool fit_body(const landmark_frame& in, float width, float height, float focal, 
   // Each frame tells once (the file warm-up solves its frames again).
   const bool fresh = in.t > gravity.lean_t_last;
   if (learn && fresh) gravity.lean_t_last = in.t;
-  const bool sample = learn && fresh && gravity.lean_frames < k_lean_max_frames &&
+  const bool sample = learn_view && fresh && gravity.lean_frames < k_lean_max_frames &&
                       (gravity.lean_tick++ % k_lean_every) == 0;
   if (sample && best_lean(v, w, lean)) {
     gravity.lean_sum += lean;
@@ -381,7 +405,7 @@ bool fit_body(const landmark_frame& in, float width, float height, float focal, 
   // Gravity: the standing body's vertical (ankles' midpoint to the hips) in frames whose legs
   // are both straight, confident and parallel, the feet on one level (standing: not a leg
   // swung out, not a body tipping over on one foot). Each frame tells once.
-  if (learn && fresh) {
+  if (learn_view && fresh) {
     bool standing = true;
     glm::vec3 leg_dir[2];
     for (int side = 0; side < 2 && standing; ++side) {
@@ -411,7 +435,8 @@ bool fit_body(const landmark_frame& in, float width, float height, float focal, 
   // A point hung on a joint that was not seen (non-finite) keeps its own world position.
   for (int i = 0; i < k_pose_landmark_count; ++i)
     if (!std::isfinite(cam[i].x + cam[i].y + cam[i].z)) cam[i] = hips + w[i];
-  const glm::mat3 r = gravity_rotation(gravity.up());
+  const glm::vec3 up = gravity.up();
+  const glm::mat3 r = gravity_rotation(up);
   for (int i = 0; i < k_pose_landmark_count; ++i) {
     const glm::vec3 p = r * (cam[i] - hm);
     out.world[i] = in.pose_world[i];
@@ -432,18 +457,39 @@ bool fit_body(const landmark_frame& in, float width, float height, float focal, 
   const double below = double(out.hips.y) + double(lowest);
   out.feet_above_floor = 0.f;
   if (feet_seen && std::isfinite(below)) {
+    const glm::dvec3 up_now(up);
     if (!gravity.has_floor) {
       if (learn) {
         gravity.floor_below_camera = below;
+        gravity.floor_up = up_now;
         gravity.has_floor = true;
+        gravity.airborne_since = camera_gravity::k_not_airborne;
       }
     } else {
-      const double above = gravity.floor_below_camera - below;
-      if (above > k_jump_min_height) {
+      // The level was learnt under the vertical of its time: turned to today's (the resting
+      // points' mean along the change), so a vertical that has turned since reads as neither a
+      // jump nor a sunk floor.
+      double level = gravity.floor_below_camera;
+      if (gravity.floor_n > 0.0)
+        level -= glm::dot(up_now - gravity.floor_up, gravity.floor_m1 / gravity.floor_n);
+      const double above = level - below;
+      // A jump is short: feet "in the air" longer than k_max_airborne_seconds stand on a floor
+      // seen higher than learnt (a camera's pitch not yet known tilts the floor along the
+      // walk), which becomes the level.
+      const bool in_air = above > k_jump_min_height;
+      const bool grounded_long = in_air &&
+                                 gravity.airborne_since != camera_gravity::k_not_airborne &&
+                                 in.t - gravity.airborne_since > k_max_airborne_seconds;
+      if (in_air && !grounded_long) {
         out.feet_above_floor = float(above - k_jump_min_height);
+        if (learn && gravity.airborne_since == camera_gravity::k_not_airborne)
+          gravity.airborne_since = in.t;
       } else if (learn) {
-        gravity.floor_below_camera += k_floor_rate * (below - gravity.floor_below_camera);
-        if (fresh) gravity.add_floor_point(glm::dvec3(cam[lowest_i]));
+        gravity.floor_below_camera = grounded_long ? below : level + k_floor_rate * (below - level);
+        gravity.floor_up = up_now;
+        gravity.airborne_since = camera_gravity::k_not_airborne;
+        if (fresh && !grounded_long && learn_view)
+          gravity.add_floor_point(glm::dvec3(cam[lowest_i]));
       }
     }
   }

@@ -44,6 +44,11 @@ struct camera_gravity {
   /// The floor: how far below the camera (metres, gravity's down) the feet's lowest point
   /// rests, a running mean over the frames whose feet are on it (not in a jump).
   double floor_below_camera = 0.0;
+  /// The up floor_below_camera is measured along (it is turned with the up, fit_body).
+  glm::dvec3 floor_up{0.0, -1.0, 0.0};
+  /// Since when the feet have been above the floor (k_not_airborne: on it).
+  double airborne_since = k_not_airborne;
+  static constexpr double k_not_airborne = -1e300;
   /// The world points' lean (radians about the camera's x axis that turns them onto the
   /// image), summed over the frames that told it.
   double lean_sum = 0.0;
@@ -55,6 +60,9 @@ struct camera_gravity {
   double focal_lean_frames = 0.0;
   long lean_tick = 0;           // frames seen, for sampling the lean's search
   double lean_t_last = -1e300;  // the newest frame time searched (each frame tells once)
+  /// The view is held (frame_solver::hold_view): no more evidence of the vertical, the lean,
+  /// the floor's plane or the proportions is taken; the floor's level is still followed.
+  bool view_held = false;
   bool has_floor = false;
   /// The floor's resting points (camera axes): first and second moments.
   glm::dvec3 floor_m1{0.0};

@@ -157,7 +157,7 @@ TEST(BvhRig, BindsByTheTablesWithAndWithoutToes) {
   EXPECT_EQ(a.choice.table.name, "cmu");
   EXPECT_EQ(a.rig.names[a.binding[idx(bone::left_toes)]], "LeftToe");
   EXPECT_EQ(a.rig.names[a.binding[idx(bone::left_hand)]], "lhand");
-  EXPECT_EQ(a.rig.names[a.binding[idx(bone::neck)]], "lowerneck");
+  EXPECT_EQ(a.rig.names[a.binding[idx(bone::neck)]], "Neck");
   // A rig without toes binds without toes.
   test::temp_dir dir2("bvh_rig");
   bound_avatar b;

@@ -7,7 +7,9 @@
 //   W_j  the joint's rest world rotation, C the rotation from the rig's world axes to VRM space
 //        (identity for glTF / VRM 1.0, which face +Z; 180° about Y for VRM 0.x, which faces −Z),
 //   T_j  the swing that turns the joint's rest bone direction onto the proxy's rest direction
-//        (identity for a T-pose rig; straightens an A-pose rig's arms).
+//        (identity for a T-pose rig; straightens an A-pose rig's arms). The hips' direction
+//        runs from the upper legs' midpoint (the proxy's hips joint) to the spine; clavicles,
+//        feet, toes, eyes and jaw keep their rest direction (anatomy, not a pose: T_j = 1).
 // Unbound joints keep their rest local rotation. A proxy bone whose joint the rig lacks (no
 // chest, no upperChest) folds into its children automatically: they receive world
 // orientations, so the missing rotation lands in the nearest present ancestor's child.
@@ -33,10 +35,12 @@ struct retarget_options {
   /// chosen from rig.source (VRM 0.x: 180° about Y; otherwise identity).
   bool auto_basis = true;
   glm::quat basis{1.f, 0.f, 0.f, 0.f};
-  /// Hips translation is scaled by the rig's hips height (above its lowest foot/toe joint at
-  /// rest, the rig's floor reference) over `performer_hips_height` (metres, the performer's
-  /// standing hips height above the soles): a performer standing puts the rig's hips at their
-  /// rest height, half that height puts them halfway down to the floor reference.
+  /// Hips translation is scaled by the rig's hips height (rig_hips_height(): above its lowest
+  /// foot/toe joint, the rig's floor reference, with its legs as the proxy's rest pose turns
+  /// them) over `performer_hips_height` (metres, the performer's standing hips height above the
+  /// soles): a performer standing puts the rig's lowest foot/toe joint on the floor reference
+  /// (the hips at their rest height for a rig whose legs are straight at rest), half that
+  /// height puts the hips halfway down to the floor reference.
   float performer_hips_height = k_default_hips_height;
   /// Move the hips each frame so that the lowest foot/toe joint touches Y = 0 (ground
   /// calibration); else hips_position is applied as is (scaled).
@@ -71,7 +75,9 @@ class retargeter {
 
   const rig& target() const { return *rig_; }
   const bone_binding& binding() const { return binding_; }
-  /// Height of the rig's hips joint above its lowest foot joint at rest, in world units.
+  /// Height of the rig's hips joint above its lowest foot joint in the pose the rig takes for
+  /// the proxy's rest pose (its rest with the bound bones turned onto the proxy's rest
+  /// directions: spread or A-posed legs straightened), in world units.
   float rig_hips_height() const { return rig_hips_height_; }
   /// Height (rig world Y) at which the lowest foot or toe joint stands in the rest pose: where
   /// the retargeter puts it for a standing performer, the floor of foot locking.

@@ -54,6 +54,17 @@ struct proxy_fk {
 /// unit quaternions).
 void compute_proxy_fk(const proxy_skeleton& skeleton, const proxy_pose& pose, proxy_fk& out);
 
+/// The feet's points alone ([0] left, [1] right): what proxy_fk::heels and
+/// proxy_fk::tips[left_toes / right_toes] hold, with the same arithmetic on the legs' bones
+/// only (hips to toes: 9 of the 55 bones), for per-frame foot measurements.
+struct proxy_feet {
+  glm::vec3 heels[2]{};
+  glm::vec3 toe_tips[2]{};
+};
+
+/// Fills `out` for `pose`, bit for bit as compute_proxy_fk would.
+void compute_proxy_feet(const proxy_skeleton& skeleton, const proxy_pose& pose, proxy_feet& out);
+
 /// Joint positions only (VRM, metres), as in proxy_fk::joints.
 void joint_world_positions(const proxy_skeleton& skeleton, const proxy_pose& pose,
                            std::array<glm::vec3, k_bone_count>& out_joints);

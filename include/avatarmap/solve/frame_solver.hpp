@@ -77,6 +77,12 @@ class frame_solver {
   /// points' lean (learnt while the field of view was still moving), keeping the field of
   /// view and the proportions: the warm-up's second pass learns them again.
   void restart_take(bool keep_view = true);
+  /// Holds what was learnt of the camera (field of view, pitch and roll, the floor's plane,
+  /// the world points' lean) and of the performer's proportions: later frames are solved
+  /// with them as they are (one depth scale and one vertical for the whole take), the floor's
+  /// level is still followed. The file job holds the view after its warm-up. reset() and
+  /// restart_take(false) release it.
+  void hold_view(bool hold = true);
 
   const solver_options& options() const { return options_; }
 

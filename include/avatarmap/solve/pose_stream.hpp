@@ -115,6 +115,8 @@ class pose_stream {
   /// and the performer (frame_solver::restart_take(keep_view)); the stream then starts anew.
   /// The contact stage takes the performer's leg length learnt so far (docs/contacts.md).
   void restart_take(bool keep_view = true);
+  /// frame_solver::hold_view.
+  void hold_view(bool hold = true) { solver_.hold_view(hold); }
   /// New solver options (a new image size): the solver is remade with fresh state and the
   /// filters start again; the resampler, the grid and the stats are kept. Allocates what a
   /// frame_solver does.

@@ -2,7 +2,8 @@
 // pose stream (solve/pose_stream.hpp) between the filter and the resampler. Per foot, from the
 // pose's forward kinematics on the proxy skeleton (heel and toe tip; world = hips_position +
 // FK, VRM space, metres), it measures the foot's speed, its height above the floor and its
-// confidence, decides with hysteresis whether the foot is planted (slow and low), and writes
+// confidence, decides with hysteresis whether the foot is planted (slow and low; not the faster
+// of two feet parting fast, not a foot that has stepped release_distance away), and writes
 // proxy_pose::foot_contact, which moves from 0 to 1 (and back) over blend_seconds. With
 // root_follows_contacts, a planted foot holds its anchor (where the contact began): the hips'
 // X/Z are moved so that the foot stays there, each foot holding by its contact times (files)
@@ -59,8 +60,12 @@ struct foot_contact_options {
   float plant_speed = 0.5f;
   float plant_height = 0.05f;
   /// ... and a planted foot lifts when faster than this or higher than release_height.
-  float release_speed = 0.5f;
-  float release_height = 0.09f;
+  float release_speed = 0.8f;
+  float release_height = 0.12f;
+  /// ... or when it has moved this far (metres, horizontally) both from where it planted and
+  /// against the other foot: a slow step stays under release_speed (both feet moving together
+  /// is the hips' measurement drifting). It plants again once settled (under half plant_speed).
+  float release_distance = 0.12f;
   /// Below this confidence (the least of the lower leg's, the foot's and the toes') a foot is
   /// never planted. Low on purpose: an estimator still reports a foot outside the image or
   /// turned away with a visibility of a few percent, and its pose is what the avatar shows;
@@ -113,6 +118,11 @@ inline constexpr option_row<foot_contact_options> k_foot_contact_option_table[] 
         .number(0, 10, true)
         .not_in_c()
         .help("a planted foot higher than this above the floor (m) lifts"),
+    option_row<foot_contact_options>("contact_release_distance",
+                                     AVATARMAP_OPTION_FIELD(foot_contact_options, release_distance))
+        .number(0, 10, true)
+        .not_in_c()
+        .help("a planted foot that has moved this far (m) from where it planted lifts"),
     option_row<foot_contact_options>("contact_min_confidence",
                                      AVATARMAP_OPTION_FIELD(foot_contact_options, min_confidence))
         .number(0, 1)
@@ -197,6 +207,9 @@ class foot_contact_stage {
   long emitted_ = 0;  // poses given out since the take began
   // Per-foot state.
   std::array<bool, 2> planted_{};
+  std::array<bool, 2> stepped_{};           // released by distance: plants again once settled
+  std::array<glm::vec3, 2> plant_point_{};  // the foot's point (filtered hips) when it planted
+  std::array<glm::vec3, 2> plant_apart_{};  // ... less the other foot's, then
   std::array<float, 2> contact_{};
   std::array<bool, 2> anchored_{};
   std::array<glm::vec3, 2> anchor_{};

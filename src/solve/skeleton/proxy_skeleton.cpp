@@ -135,6 +135,28 @@ void compute_proxy_fk(const proxy_skeleton& skeleton, const proxy_pose& pose, pr
       out.joints[idx(bone::right_foot)] + out.world[idx(bone::right_foot)] * skeleton.heel_offset;
 }
 
+void compute_proxy_feet(const proxy_skeleton& skeleton, const proxy_pose& pose, proxy_feet& out) {
+  // compute_proxy_fk's steps for the bones from the hips down each leg, in the same order.
+  constexpr bone k_toes[2] = {bone::left_toes, bone::right_toes};
+  constexpr bone k_feet[2] = {bone::left_foot, bone::right_foot};
+  for (int side = 0; side < 2; ++side) {
+    // The chain from the root to the toes (the hierarchy's order: parents first).
+    int chain[8];
+    int n = 0;
+    for (int b = idx(k_toes[side]); b != k_no_parent; b = bone_parent(b)) chain[n++] = b;
+    glm::quat world = pose.rotations[chain[n - 1]];
+    glm::vec3 joint = pose.hips_position;
+    for (int i = n - 2; i >= 0; --i) {
+      const int b = chain[i];
+      joint = joint + world * skeleton.offsets[b];
+      world = world * pose.rotations[b];
+      if (b == idx(k_feet[side])) out.heels[side] = joint + world * skeleton.heel_offset;
+    }
+    out.toe_tips[side] =
+        joint + world * (skeleton.lengths[chain[0]] * bone_rest_direction(k_toes[side]));
+  }
+}
+
 void joint_world_positions(const proxy_skeleton& skeleton, const proxy_pose& pose,
                            std::array<glm::vec3, k_bone_count>& out_joints) {
   std::array<glm::quat, k_bone_count> world;

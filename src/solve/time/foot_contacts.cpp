@@ -39,13 +39,17 @@ status foot_contact_options::validate() const {
 
 void measure_feet(const proxy_skeleton& skeleton, const proxy_pose& pose, float min_confidence,
                   proxy_fk& fk, std::array<foot_measure, 2>& out) {
-  compute_proxy_fk(skeleton, pose, fk);
+  // The legs' bones only (compute_proxy_fk's heels and toe tips, bit for bit); `fk` is kept
+  // in the signature for callers that pass scratch.
+  (void)fk;
+  proxy_feet feet;
+  compute_proxy_feet(skeleton, pose, feet);
   float floor = std::numeric_limits<float>::infinity();
   glm::vec3 heel[2], toe[2];
   bool finite[2];
   for (int s = 0; s < 2; ++s) {
-    heel[s] = fk.heels[s];
-    toe[s] = fk.tips[idx(k_toes[s])];
+    heel[s] = feet.heels[s];
+    toe[s] = feet.toe_tips[s];
     finite[s] = finite3(heel[s]) && finite3(toe[s]);
     if (finite[s]) floor = std::min(floor, std::min(heel[s].y, toe[s].y));
   }
@@ -108,6 +112,7 @@ foot_contact_stage::slot& foot_contact_stage::at(long i) noexcept {
 void foot_contact_stage::reset() noexcept {
   pushed_ = emitted_ = 0;
   planted_.fill(false);
+  stepped_.fill(false);
   contact_.fill(0.f);
   anchored_.fill(false);
   have_root_ = false;
@@ -151,6 +156,7 @@ void foot_contact_stage::emit(int k, proxy_pose& out) noexcept {
     // stage that had a finite pose).
     if (have_root_ && !finite3(out.hips_position)) out.hips_position = root_prev_;
     planted_.fill(false);
+    stepped_.fill(false);
     contact_.fill(0.f);
     anchored_.fill(false);
     return;
@@ -162,6 +168,7 @@ void foot_contact_stage::emit(int k, proxy_pose& out) noexcept {
   const bool continues = root_continues && good_step(t_prev_, t);
   if (!continues) {
     planted_.fill(false);
+    stepped_.fill(false);
     contact_.fill(0.f);
     anchored_.fill(false);
   }
@@ -172,47 +179,75 @@ void foot_contact_stage::emit(int k, proxy_pose& out) noexcept {
   // lift is still over one of them).
   const long self = emitted_;
   const long w = both_sided_ ? (capacity_ - 1) / 2 : 1;
-  std::array<float, 2> speed;
-  for (int f = 0; f < 2; ++f) {
-    float best = std::numeric_limits<float>::infinity();
-    bool any = false;
-    for (int dir = -1; dir <= 1; dir += 2) {
-      if (dir > 0 && !both_sided_) continue;
-      // The farthest neighbour in this direction still within the take.
-      long far = self;
-      for (long j = 1; j <= w; ++j) {
-        const long i = self + dir * j;
-        if (i < 0 || i >= pushed_ || i < pushed_ - capacity_) break;
-        const slot& a = at(dir < 0 ? i : i - 1);
-        const slot& b = at(dir < 0 ? i + 1 : i);
-        if (!a.ok || !b.ok || !good_step(a.pose.t, b.pose.t)) break;
-        far = i;
-      }
-      if (far == self) continue;
-      const slot& o = at(far);
-      const double span = std::fabs(o.pose.t - t);
-      const float v = glm::length(o.feet[f].point - cur.feet[f].point) / static_cast<float>(span);
-      if (std::isfinite(v)) {
-        best = std::min(best, v);
-        any = true;
-      }
+  // The farthest neighbour on each side still within the take (self: none).
+  long far[2] = {self, self};
+  for (int side = 0; side < 2; ++side) {
+    const int dir = side == 0 ? -1 : 1;
+    if (dir > 0 && !both_sided_) continue;
+    for (long j = 1; j <= w; ++j) {
+      const long i = self + dir * j;
+      if (i < 0 || i >= pushed_ || i < pushed_ - capacity_) break;
+      const slot& a = at(dir < 0 ? i : i - 1);
+      const slot& b = at(dir < 0 ? i + 1 : i);
+      if (!a.ok || !b.ok || !good_step(a.pose.t, b.pose.t)) break;
+      far[side] = i;
     }
-    // No neighbour (the first pose of a take): no evidence of motion; a foot that is low may
-    // plant (a take that starts standing).
-    speed[f] = any ? best : 0.f;
   }
+  // The smaller of the two sides' speeds of a point of the feet; 0 with no neighbour (the
+  // first pose of a take: no evidence of motion; a foot that is low may plant, a take that
+  // starts standing).
+  auto window_speed = [&](auto&& point) {
+    float best = std::numeric_limits<float>::infinity();
+    for (long o_index : far) {
+      if (o_index == self) continue;
+      const slot& o = at(o_index);
+      const double span = std::fabs(o.pose.t - t);
+      const float v = glm::length(point(o) - point(cur)) / static_cast<float>(span);
+      if (std::isfinite(v)) best = std::min(best, v);
+    }
+    return std::isfinite(best) ? best : 0.f;
+  };
+  std::array<float, 2> speed;
+  for (int f = 0; f < 2; ++f)
+    speed[f] = window_speed([f](const slot& x) { return x.feet[f].point; });
+  // The feet's speed relative to each other: the hips' (and the camera's) motion cancels. A
+  // walk's swing foot moves against the stance foot; standing or in double support the feet
+  // keep their distance. When they part faster than release_speed, the faster foot is not
+  // planted, whatever its own speed says (a slow walk's swing foot, measured against noisy
+  // hips, can stay under release_speed: holding both feet held the body back by half its
+  // path on the benchmark's slow walk and bent the rig's legs to reach both anchors).
+  const float apart = window_speed([](const slot& x) { return x.feet[0].point - x.feet[1].point; });
+  const int swinging = apart > options_.release_speed ? (speed[0] > speed[1] ? 0 : 1) : -1;
 
   // Hysteresis, then the blend towards the state.
   const float step = dt / options_.blend_seconds;
   for (int f = 0; f < 2; ++f) {
     const foot_measure& m = cur.feet[f];
-    if (!m.usable) {
+    if (!m.usable || f == swinging) {
       planted_[f] = false;
     } else if (planted_[f]) {
-      if (speed[f] > options_.release_speed || m.height > options_.release_height)
+      // A planted foot that has left where it was planted by more than release_distance, and
+      // as far from the other foot, has stepped, however slowly: a slow walk's swing foot stays
+      // under release_speed. (Both feet moving together is the hips' measurement drifting
+      // under a person standing still.) It plants again only once settled (under half
+      // plant_speed), not at once a little further on.
+      const glm::vec3 other = cur.feet[1 - f].point;
+      const glm::vec3 moved = m.point - plant_point_[f];
+      const glm::vec3 parted = (m.point - other) - plant_apart_[f];
+      const float away = std::min(std::sqrt(moved.x * moved.x + moved.z * moved.z),
+                                  std::sqrt(parted.x * parted.x + parted.z * parted.z));
+      if (speed[f] > options_.release_speed || m.height > options_.release_height) {
         planted_[f] = false;
-    } else if (speed[f] < options_.plant_speed && m.height < options_.plant_height) {
+      } else if (away > options_.release_distance) {
+        planted_[f] = false;
+        stepped_[f] = true;
+      }
+    } else if (speed[f] < (stepped_[f] ? 0.5f : 1.f) * options_.plant_speed &&
+               m.height < options_.plant_height) {
       planted_[f] = true;
+      stepped_[f] = false;
+      plant_point_[f] = m.point;
+      plant_apart_[f] = m.point - cur.feet[1 - f].point;
     }
     if (!continues) {
       // A take's first pose: a planted foot starts planted (standing still from frame 0).
@@ -239,11 +274,13 @@ void foot_contact_stage::emit(int k, proxy_pose& out) noexcept {
       free.z = root_prev_.z + (measured.z - measured_prev_.z);
     }
     // How firmly each foot holds the hips: its contact, less (both-sided) as the foot is
-    // faster than half plant_speed, none at release_speed. A planted foot that still moves (a slow
-    // step in a slow walk: both feet low and slow, both planted) must not hold the body back.
+    // faster than half plant_speed, none at plant_speed (a foot may stay planted up to
+    // release_speed: the rig's foot lock holds it, but the body is not held back by it). A
+    // planted foot that still moves (a slow step in a slow walk: both feet low and slow, both
+    // planted) must not hold the body back.
     std::array<float, 2> hold;
     for (int f = 0; f < 2; ++f) {
-      const float v0 = 0.5f * options_.plant_speed, v1 = options_.release_speed;
+      const float v0 = 0.5f * options_.plant_speed, v1 = options_.plant_speed;
       // Causal: one frame's speed is landmark noise more than motion; a planted foot holds.
       const float h =
           both_sided_ && v1 > v0 ? std::clamp((v1 - speed[f]) / (v1 - v0), 0.f, 1.f) : 1.f;

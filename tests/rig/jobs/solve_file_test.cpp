@@ -53,19 +53,20 @@ void write_synthetic(const std::string& path, int frames, bool header = true) {
 }
 
 // The job's warm-up with the offline filter (src/rig/jobs/solve_file.cpp): the solver learns
-// the camera from the file's first 150 frames, forgets the view and learns it again with the field
-// of view known, then starts the take from the beginning with all of it known.
+// the camera from the file's first 300 frames, forgets the view and learns it again with the
+// field of view known, then starts the take from the beginning with all of it known and held.
 void warm_up(frame_solver& solver, const std::string& path) {
   landmark_reader reader;
   EXPECT_TRUE(reader.open(path).ok());
   std::vector<landmark_frame> frames;
   landmark_frame frame;
-  while (frames.size() < 150 && reader.next(frame) == read_result::frame) frames.push_back(frame);
+  while (frames.size() < 300 && reader.next(frame) == read_result::frame) frames.push_back(frame);
   proxy_pose scratch;
   for (const landmark_frame& f : frames) solver.solve(f, scratch);
   solver.restart_take(false);
   for (const landmark_frame& f : frames) solver.solve(f, scratch);
   solver.restart_take(true);
+  solver.hold_view();
 }
 
 // The reference: the file read back with landmark_reader, solved and filtered frame by frame,

@@ -264,6 +264,75 @@ TEST(foot_contacts, a_planted_foot_that_keeps_moving_does_not_hold_the_body_back
   }
 }
 
+TEST(foot_contacts, feet_that_part_faster_than_release_speed_are_not_both_planted) {
+  // A slow walk seen with noisy hips: each foot slower than plant_speed in the world (~0.44
+  // and ~0.48 m/s), but parting from each other at ~0.9 m/s, faster than release_speed (0.8):
+  // the swing foot (the faster) is not planted, the stance foot is.
+  const proxy_skeleton sk = make_proxy_skeleton();
+  const float leg = sk.lengths[idx(bone::left_upper_leg)] + sk.lengths[idx(bone::left_lower_leg)];
+  std::vector<proxy_pose> in;
+  for (int i = 0; i < 16; ++i) {
+    proxy_pose p = standing(i / k_fps, sk);
+    const float t = float(p.t);
+    // The left foot swings back, the right forward, about the hips (the sole's middle is a
+    // little farther from the hip than the ankle: ~9 % faster than these rates say).
+    p[bone::left_upper_leg] = glm::angleAxis(0.40f / leg * t, glm::vec3(1.f, 0.f, 0.f));
+    p[bone::right_upper_leg] = glm::angleAxis(-0.44f / leg * t, glm::vec3(1.f, 0.f, 0.f));
+    in.push_back(p);
+  }
+  // Both below plant_speed and low (the known answer of the measure itself).
+  const auto a = feet_of(in[7], sk), b = feet_of(in[9], sk);
+  EXPECT_LT(glm::length(b[0].point - a[0].point) * k_fps / 2.0, 0.5);
+  EXPECT_LT(glm::length(b[1].point - a[1].point) * k_fps / 2.0, 0.5);
+  EXPECT_GT(glm::length((b[0].point - b[1].point) - (a[0].point - a[1].point)) * k_fps / 2.0, 0.8);
+  // The distance rule (release_distance) would also lift the feet after 12 cm: this is the
+  // speed rule's test.
+  foot_contact_options o;
+  o.release_distance = 5.f;
+  const auto out = run(in, true, o);
+  ASSERT_EQ(out.size(), in.size());
+  for (int i = 2; i < 14; ++i) {
+    EXPECT_EQ(out[i].foot_contact[1], 0.f) << i;  // the faster, swinging foot
+    EXPECT_GT(out[i].foot_contact[0], 0.f) << i;  // the stance foot
+  }
+}
+
+TEST(foot_contacts, a_slow_step_lifts_the_foot_once_it_has_moved_release_distance) {
+  // The right foot slides 20 cm forward at 0.3 m/s (under plant_speed: planted by speed alone;
+  // 2 cm up at the end, under plant_height)
+  // while the left stands: released once 12 cm from where it planted (and from the left foot),
+  // planted again where it settles. Both feet moving together (the hips' measurement drifting
+  // under a standing person) lift nothing: the first test above.
+  const proxy_skeleton sk = make_proxy_skeleton();
+  const float leg = sk.lengths[idx(bone::left_upper_leg)] + sk.lengths[idx(bone::left_lower_leg)];
+  std::vector<proxy_pose> in;
+  for (int i = 0; i < 90; ++i) {
+    proxy_pose p = standing(i / k_fps, sk);
+    // Still for 0.5 s, then 0.67 s at ~0.3 m/s (0.20 m), then still.
+    const float s = std::clamp(float(p.t) - 0.5f, 0.f, 0.667f) * 0.3f;
+    p[bone::right_upper_leg] = glm::angleAxis(-s / leg, glm::vec3(1.f, 0.f, 0.f));
+    in.push_back(p);
+  }
+  const auto out = run(in, true);
+  ASSERT_EQ(out.size(), in.size());
+  const auto start = feet_of(in[0], sk);
+  int lifted = -1, replanted = -1;
+  for (int i = 0; i < 90; ++i) {
+    EXPECT_EQ(out[i].foot_contact[0], 1.f) << i;  // the standing foot
+    if (lifted < 0 && out[i].foot_contact[1] < 1.f) lifted = i;
+    if (lifted >= 0 && replanted < 0 && i > lifted && out[i].foot_contact[1] == 1.f) replanted = i;
+  }
+  ASSERT_GE(lifted, 0);
+  // Lifted after 12 cm of the step (0.4 s at 0.3 m/s; give or take the sole's radius) ...
+  const float moved = glm::length(feet_of(in[lifted], sk)[1].point - start[1].point);
+  EXPECT_GT(moved, 0.10f);
+  EXPECT_LT(moved, 0.18f);
+  // ... and planted again as the step ends (frame 35; the both-sided speed looks 4 frames
+  // ahead, and the contact takes 3 frames to reach 1), not while it still moves.
+  EXPECT_GT(replanted, 30);
+  EXPECT_LT(replanted, 45);
+}
+
 // The left leg hangs 30 degrees forward (12 cm up), comes down at 180 degrees/s and stops at
 // frame `land`.
 std::vector<proxy_pose> landing(const proxy_skeleton& sk, int land, int frames) {
