@@ -74,10 +74,14 @@ status bvh_rig_from_clip(const bvh_clip& clip, const std::string& file,
                              ? bvh_length_unit{options.metres_per_unit, "as given"}
                              : detect_bvh_units(clip);
   const float s = unit.metres_per_unit;
-  // Lift every root by the same height so that the lowest joint stands on Y = 0.
+  // Lift every root by the same height so that the lowest joint or End Site (the toes' tips,
+  // below the toe joints) stands on Y = 0: the floor of the rest pose.
   const std::vector<glm::vec3> p = rest_positions(clip);
   float lowest = p[0].y;
-  for (const glm::vec3& q : p) lowest = std::min(lowest, q.y);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    lowest = std::min(lowest, p[i].y);
+    if (clip.joints[i].has_end_site) lowest = std::min(lowest, p[i].y + clip.joints[i].end_site.y);
+  }
   out.nodes.resize(clip.joints.size());
   for (std::size_t i = 0; i < clip.joints.size(); ++i) {
     const bvh_joint& j = clip.joints[i];
@@ -85,9 +89,11 @@ status bvh_rig_from_clip(const bvh_clip& clip, const std::string& file,
     n.name = j.name;
     n.parent = j.parent;
     n.rest.translation = j.offset * s;
+    if (j.has_end_site) n.tip = j.end_site * s;
     if (j.parent < 0) n.rest.translation.y -= lowest * s;
   }
   out.source = rig_source::unknown;
+  out.floor_y = 0.f;
   if (out_unit != nullptr) *out_unit = unit;
   return {};
 }

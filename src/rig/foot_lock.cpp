@@ -125,10 +125,21 @@ status foot_lock::build(const rig& r, const bone_binding& binding, float floor,
       continue;
     }
     l.foot_rest = r.rest_world_rotation[l.foot];
+    l.toes_rest = r.rest_world_rotation[l.toes];
     l.ankle_height = std::max(0.f, ankle.y - floor_);
     l.heel_local = glm::conjugate(l.foot_rest) * (glm::vec3(ankle.x, floor_, ankle.z) - ankle);
+    // The sole's front: under the toes' tip when the rig knows it (a BVH's End Site), else
+    // under the toe joint.
+    glm::vec3 front = toe;
+    const glm::vec3 tip_local = static_cast<std::size_t>(l.toes) < r.tips.size()
+                                    ? r.tips[static_cast<std::size_t>(l.toes)]
+                                    : glm::vec3(std::nanf(""));
+    if (is_finite(tip_local)) {
+      const glm::vec3 tip = toe + glm::mat3(r.rest_world[l.toes]) * tip_local;
+      if (is_finite(tip)) front = tip;
+    }
     l.ball_local = glm::conjugate(r.rest_world_rotation[l.toes]) *
-                   (glm::vec3(toe.x, std::min(floor_, toe.y), toe.z) - toe);
+                   (glm::vec3(front.x, std::min(floor_, front.y), front.z) - toe);
     l.ok = true;
   }
   return {};
@@ -172,7 +183,7 @@ float foot_lock::sole_sink(const leg& l) const {
 }
 
 void foot_lock::place_leg(leg& l, const glm::vec3& ankle_target, const glm::quat* foot_rot,
-                          rig_pose& io) {
+                          rig_pose& io, const glm::quat* toes_rot) {
   const rig& r = *rig_;
   const glm::vec3 hip = position(l.upper);
   const glm::vec3 knee = position(l.lower);
@@ -201,6 +212,11 @@ void foot_lock::place_leg(leg& l, const glm::vec3& ankle_target, const glm::quat
     io.local_rotations[l.foot] = normalized(glm::conjugate(world_rot_[p]) * *foot_rot);
     path_kinematics(l, io);
   }
+  if (toes_rot != nullptr && is_finite(*toes_rot)) {
+    const int p = r.parents[l.toes];
+    io.local_rotations[l.toes] = normalized(glm::conjugate(world_rot_[p]) * *toes_rot);
+    path_kinematics(l, io);
+  }
 }
 
 void foot_lock::apply(const std::array<float, 2>& contact, rig_pose& io) {
@@ -211,7 +227,7 @@ void foot_lock::apply(const std::array<float, 2>& contact, rig_pose& io) {
   forward_kinematics(io);
   float weight[2] = {0.f, 0.f};
   glm::vec3 target[2];
-  glm::quat target_rot[2];
+  glm::quat target_rot[2], target_toes[2];
   for (int s = 0; s < 2; ++s) {
     leg& l = legs_[s];
     if (!l.ok) continue;
@@ -242,6 +258,12 @@ void foot_lock::apply(const std::array<float, 2>& contact, rig_pose& io) {
     weight[s] = c;
     target[s] = ankle + (l.anchor_pos - ankle) * c;
     target_rot[s] = slerp_shortest(foot, l.anchor_rot, c);
+    // The toes flat with the foot (their rest turn from it), so that the toe tips stay on the
+    // floor with the sole (the retargeted toes may point down: 1 cm under on the CMU rig).
+    const glm::quat toes_flat =
+        normalized(l.anchor_rot * glm::conjugate(l.foot_rest) * l.toes_rest);
+    target_toes[s] =
+        options_.align_foot ? slerp_shortest(world_rot_[l.toes], toes_flat, c) : world_rot_[l.toes];
   }
   if (options_.lower_hips && (weight[0] > 0.f || weight[1] > 0.f)) {
     float drop = 0.f, shortest = 1e30f;
@@ -270,7 +292,7 @@ void foot_lock::apply(const std::array<float, 2>& contact, rig_pose& io) {
   for (int s = 0; s < 2; ++s) {
     leg& l = legs_[s];
     if (!l.ok) continue;
-    if (weight[s] > 0.f) place_leg(l, target[s], &target_rot[s], io);
+    if (weight[s] > 0.f) place_leg(l, target[s], &target_rot[s], io, &target_toes[s]);
     if (!options_.keep_above_floor) continue;
     const float sink = sole_sink(l);
     if (sink > 0.f && std::isfinite(sink)) {

@@ -147,6 +147,12 @@ status retargeter::build(const rig& r, const bone_binding& binding, const retarg
     floor = 1e30f;
     for (int j : foot_joints_) floor = std::min(floor, (basis_ * position_of(r.rest_world[j])).y);
   }
+  // The rig's floor when the file tells it (a BVH's toe tips, below the toe joints): the soles
+  // stand there, a standing performer's soles map onto it and foot locking keeps them above it.
+  float sole_depth = 0.f;  // how far that floor lies below the lowest foot joint
+  if (!foot_joints_.empty() && std::isfinite(r.floor_y))
+    sole_depth = std::max(0.f, floor - (basis_ * glm::vec3(0.f, r.floor_y, 0.f)).y);
+  floor -= sole_depth;
   hips_rest_world_ = position_of(r.rest_world[hips]);
   const int hp = r.parents[hips];
   hips_parent_inverse_ = hp < 0 ? glm::mat4(1.f) : glm::inverse(r.rest_world[hp]);
@@ -195,6 +201,7 @@ status retargeter::build(const rig& r, const bone_binding& binding, const retarg
     hips_y = (basis_ * position_of(m[hips])).y;
     lowest = 1e30f;
     for (int j : foot_joints_) lowest = std::min(lowest, (basis_ * position_of(m[j])).y);
+    lowest -= sole_depth;
   }
   rig_hips_height_ = hips_y - lowest;
   if (!(rig_hips_height_ > 0.f))

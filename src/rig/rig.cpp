@@ -97,12 +97,14 @@ status build_rig(const raw_rig& raw, rig& out) {
   out.rest_local.resize(static_cast<size_t>(n));
   out.rest_world.resize(static_cast<size_t>(n));
   out.rest_world_rotation.resize(static_cast<size_t>(n));
+  out.tips.resize(static_cast<size_t>(n));
   out.source_index = order;
   for (int k = 0; k < n; ++k) {
     const raw_rig::node& node = raw.nodes[static_cast<size_t>(order[k])];
     out.names[k] = node.name;
     out.parents[k] = node.parent < 0 ? -1 : new_index[static_cast<size_t>(node.parent)];
     out.rest_local[k] = node.rest;
+    out.tips[k] = node.tip;
     out.rest_local[k].rotation = glm::normalize(node.rest.rotation);
     const glm::mat4 local = to_matrix(out.rest_local[k]);
     out.rest_world[k] = out.parents[k] < 0 ? local : out.rest_world[out.parents[k]] * local;
@@ -135,6 +137,7 @@ status build_rig(const raw_rig& raw, rig& out) {
   out.expressions = raw.expressions;
   out.source = raw.source;
   out.file = raw.file;
+  out.floor_y = raw.floor_y;
   return {};
 }
 

@@ -134,7 +134,13 @@ TEST(BvhRig, HierarchyIsTheRigNamesOffsetsUnitsAndFloor) {
     if (clip.joints[i].parent < 0) expect.y += 16.1f * k;
     EXPECT_NEAR(glm::length(raw.nodes[i].rest.translation - expect), 0.f, 1e-6f) << i;
     EXPECT_EQ(raw.nodes[i].rest.rotation, identity_quat());
+    // End Sites are the joints' tips (the toes' tips: where the sole ends), in metres.
+    if (clip.joints[i].has_end_site)
+      EXPECT_NEAR(glm::length(raw.nodes[i].tip - clip.joints[i].end_site * k), 0.f, 1e-6f) << i;
+    else
+      EXPECT_TRUE(std::isnan(raw.nodes[i].tip.x)) << i;
   }
+  EXPECT_EQ(raw.floor_y, 0.f);
   // Units given win over detection; centimetres and metres are detected too.
   ASSERT_TRUE(load_bvh_avatar(path, raw, {0.01f}).ok());
   EXPECT_NEAR(raw.nodes[3].rest.translation.y, -0.072f, 1e-6f);     // LeftKnee
@@ -307,6 +313,12 @@ void round_trip_through_file(const std::string& source, const test::temp_dir& di
     EXPECT_EQ(out_clip.joints[i].parent, in_clip.joints[i].parent);
     if (in_clip.joints[i].parent >= 0)
       EXPECT_LT(glm::length(out_clip.joints[i].offset - in_clip.joints[i].offset * to_cm), 2e-5f)
+          << in_clip.joints[i].name;
+    // The avatar's own End Sites, not invented ones (a toe's tip is where the sole ends).
+    EXPECT_EQ(out_clip.joints[i].has_end_site, in_clip.joints[i].has_end_site);
+    if (in_clip.joints[i].has_end_site)
+      EXPECT_LT(glm::length(out_clip.joints[i].end_site - in_clip.joints[i].end_site * to_cm),
+                2e-5f)
           << in_clip.joints[i].name;
   }
   std::vector<proxy_pose> back;

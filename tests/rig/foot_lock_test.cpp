@@ -30,7 +30,8 @@ struct test_rig {
 
 // A rig with the proxy's bones from the hips down plus a spine: legs scaled by `leg_scale`,
 // standing on Y = 0; `toes` / `lower_leg` false leave those joints out.
-test_rig make_leg_rig(float leg_scale, bool toes = true, bool lower_leg = true, uint32_t seed = 3) {
+test_rig make_leg_rig(float leg_scale, bool toes = true, bool lower_leg = true, uint32_t seed = 3,
+                      bool toe_tips = false) {
   const proxy_skeleton sk = make_proxy_skeleton(1.70f);
   const bone kept[] = {
       bone::hips,       bone::spine,     bone::left_upper_leg,  bone::left_lower_leg,
@@ -76,6 +77,9 @@ test_rig make_leg_rig(float leg_scale, bool toes = true, bool lower_leg = true, 
     n.parent = parent;
     n.rest.rotation = glm::normalize(glm::conjugate(world_rot[parent]) * wr);
     n.rest.translation = glm::conjugate(world_rot[parent]) * (wp - world_pos[parent]) * 100.f;
+    // The toes' tips (as a BVH's End Sites), 6 cm ahead of the toe joint, level at rest.
+    if (toe_tips && (b == bone::left_toes || b == bone::right_toes))
+      n.tip = glm::conjugate(wr) * glm::vec3(0.f, 0.f, 6.f);
     node_of[idx(b)] = static_cast<int>(raw.nodes.size());
     raw.nodes.push_back(n);
     world_rot.push_back(wr);
@@ -197,6 +201,45 @@ TEST_P(FootLockRigs, BlendsInAndOutWithoutJumps) {
 }
 
 INSTANTIATE_TEST_SUITE_P(LongerAndShorterLegs, FootLockRigs, ::testing::Values(1.2f, 0.8f));
+
+TEST(FootLock, ToeTipsTheRigKnowsStayAboveTheFloor) {
+  // The performer's toes curl 35 degrees down (into the floor); the rig knows where its toes
+  // end (a BVH's End Sites). Planted, the toes lie flat with the foot; free, the foot is lifted
+  // so the tip stays on the floor. A free foot of a rig that does not know its tips is guarded
+  // at the toe joint only: the same pose puts the tip under the floor (not vacuous).
+  for (bool tips : {true, false}) {
+    SCOPED_TRACE(tips);
+    const test_rig t = make_leg_rig(1.f, true, true, 3, true);
+    test_rig blind = t;
+    if (!tips) blind.r.tips.assign(blind.r.tips.size(), glm::vec3(std::nanf("")));
+    for (float contact : {1.f, 0.f}) {
+      SCOPED_TRACE(contact);
+      driven d;
+      build_driven(blind, d);
+      const float floor = d.rt.floor_height();
+      const int toe = t.binding[idx(bone::left_toes)];
+      const glm::vec3 tip_local = t.r.tips[static_cast<std::size_t>(toe)];
+      float lowest_tip = 1e9f;
+      for (int i = 0; i < 30; ++i) {
+        proxy_pose p = drifting_pose(i, contact, 0.f);
+        p[bone::left_foot] = axis_angle({1, 0, 0}, 0.f);  // the foot level
+        p[bone::left_upper_leg] = identity_quat();
+        p[bone::left_lower_leg] = identity_quat();
+        p[bone::left_toes] = axis_angle({1, 0, 0}, 35.f * k_deg);
+        d.rt.apply(p, d.pose);
+        d.lock.apply(p.foot_contact, d.pose);
+        ASSERT_TRUE(all_finite(d.pose));
+        const glm::vec3 tip =
+            glm::vec3(test::posed_matrices(t.r, d.pose)[toe] * glm::vec4(tip_local, 1.f));
+        lowest_tip = std::min(lowest_tip, tip.y - floor);
+      }
+      if (tips || contact > 0.f)
+        EXPECT_GE(lowest_tip, -1e-4f);  // planted: the toes lie flat, tips known or not
+      else
+        EXPECT_LT(lowest_tip, -0.005f);
+    }
+  }
+}
 
 TEST(FootLock, FreeLegsAboveTheFloorAreUntouched) {
   const test_rig t = make_leg_rig(1.f);

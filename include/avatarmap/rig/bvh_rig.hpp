@@ -8,7 +8,8 @@
 // centimetres or millimetres) that makes the rest pose's height (highest minus lowest joint or
 // End Site) closest to 1.7 m, unless the caller gives metres_per_unit. Axes: Y up (the BVH
 // convention); a rig facing +Z with its left at +X (CMU, Mixamo) is in VRM space as is.
-// The floor: the rest pose is lifted so that its lowest joint stands at Y = 0, and the motion's
+// The floor: the rest pose is lifted so that its lowest joint or End Site (the toes' tips) stands
+// at Y = 0, the rig's floor (raw_rig::floor_y), and the motion's
 // root positions are taken as they are, in a world whose floor is Y = 0 (CMU and Mixamo exports
 // stand on Y = 0).
 #pragma once
@@ -51,11 +52,11 @@ struct bvh_rig_options {
 
 /// Builds the rig of `clip`'s HIERARCHY into `out` (replaced): one node per joint, file order
 /// and names, rest translation = OFFSET × metres per unit, rest rotation identity, scale 1;
-/// every root lifted by the same height so that the lowest joint stands at Y = 0. End Sites
-/// are not joints. source = unknown, no declared humanoid, no expressions; out.file = `file`.
-/// `out_unit` (optional) gets the unit used. Fails (parse, naming `file`) when the clip has no
-/// joints or metres_per_unit is negative or not finite; the names and the hierarchy are
-/// build_rig's to check.
+/// every root lifted by the same height so that the lowest joint or End Site stands at Y = 0
+/// (floor_y = 0). End Sites are not joints. source = unknown, no declared humanoid, no expressions;
+/// out.file = `file`. `out_unit` (optional) gets the unit used. Fails (parse, naming `file`) when
+/// the clip has no joints or metres_per_unit is negative or not finite; the names and the hierarchy
+/// are build_rig's to check.
 status bvh_rig_from_clip(const bvh_clip& clip, const std::string& file,
                          const bvh_rig_options& options, raw_rig& out,
                          bvh_length_unit* out_unit = nullptr);

@@ -102,6 +102,7 @@ class foot_lock {
     glm::vec3 heel_local{0.f};  // sole point under the ankle, in the foot's rest frame
     glm::vec3 ball_local{0.f};  // sole point under the toe joint, in the toes' rest frame
     glm::quat foot_rest{1.f, 0.f, 0.f, 0.f};  // the foot's rest world rotation
+    glm::quat toes_rest{1.f, 0.f, 0.f, 0.f};  // the toes' rest world rotation
     bool locked = false;
     glm::vec3 anchor_pos{0.f};
     glm::quat anchor_rot{1.f, 0.f, 0.f, 0.f};
@@ -110,7 +111,8 @@ class foot_lock {
   void path_kinematics(const leg& l, const rig_pose& pose);
   glm::vec3 position(int j) const { return glm::vec3(world_[j][3]); }
   float sole_sink(const leg& l) const;
-  void place_leg(leg& l, const glm::vec3& ankle_target, const glm::quat* foot_rot, rig_pose& io);
+  void place_leg(leg& l, const glm::vec3& ankle_target, const glm::quat* foot_rot, rig_pose& io,
+                 const glm::quat* toes_rot = nullptr);
 
   const rig* rig_ = nullptr;
   foot_lock_options options_{};

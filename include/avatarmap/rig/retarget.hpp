@@ -75,12 +75,14 @@ class retargeter {
 
   const rig& target() const { return *rig_; }
   const bone_binding& binding() const { return binding_; }
-  /// Height of the rig's hips joint above its lowest foot joint in the pose the rig takes for
-  /// the proxy's rest pose (its rest with the bound bones turned onto the proxy's rest
-  /// directions: spread or A-posed legs straightened), in world units.
+  /// Height of the rig's hips joint above its lowest foot joint (above its floor, rig::floor_y,
+  /// when the file tells one) in the pose the rig takes for the proxy's rest pose (its rest
+  /// with the bound bones turned onto the proxy's rest directions: spread or A-posed legs
+  /// straightened), in world units.
   float rig_hips_height() const { return rig_hips_height_; }
-  /// Height (rig world Y) at which the lowest foot or toe joint stands in the rest pose: where
-  /// the retargeter puts it for a standing performer, the floor of foot locking.
+  /// The rig's floor (rig world Y): where its lowest foot or toe joint stands in the rest pose,
+  /// or rig::floor_y below it when the file tells one (a BVH's toe tips); where the retargeter
+  /// puts a standing performer's soles, the floor of foot locking.
   float floor_height() const { return floor_vrm_; }
   /// The direction the rig faces in its own world (VRM's +Z carried back by the basis).
   glm::vec3 forward() const { return glm::conjugate(basis_) * glm::vec3(0.f, 0.f, 1.f); }
@@ -101,7 +103,7 @@ class retargeter {
   float translation_scale_ = 1.f;
   glm::mat4 hips_parent_inverse_{1.f};  // world -> hips parent's space
   glm::vec3 hips_rest_world_{0.f};
-  float floor_vrm_ = 0.f;  // rest height of the lowest foot joint
+  float floor_vrm_ = 0.f;  // floor_height()
   struct formula_bone {
     int joint;
     int bone;

@@ -7,6 +7,7 @@
 #include <array>
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,9 @@ struct raw_rig {
     std::string name;
     int parent = -1;  // index into nodes, -1 for a root
     transform rest;   // local rest transform
+    /// Where the joint's segment ends, in its local frame, when the file says (a BVH's End
+    /// Site); NaN: not known.
+    glm::vec3 tip{std::numeric_limits<float>::quiet_NaN()};
   };
   std::vector<node> nodes;
   rig_source source = rig_source::unknown;
@@ -41,6 +45,10 @@ struct raw_rig {
   /// Expression (blend shape group) names the file declares, e.g. VRM presets.
   std::vector<std::string> expressions;
   std::string file;  // for messages
+  /// The floor the rest pose stands on (Y of the rig's world), when the file tells it: a BVH's
+  /// lowest End Site (the toes' tips, below the toe joints). NaN: unknown (the retargeter takes
+  /// the lowest foot or toe joint).
+  float floor_y = std::numeric_limits<float>::quiet_NaN();
 
   raw_rig() { declared_humanoid.fill(-1); }
 };
@@ -53,10 +61,12 @@ struct rig {
   std::vector<glm::mat4> rest_world;  // world rest matrices (all ancestors, scale included)
   std::vector<glm::quat> rest_world_rotation;       // rotation part of rest_world (unit)
   std::vector<int> source_index;                    // raw_rig node index of each joint
+  std::vector<glm::vec3> tips;                      // raw_rig::node::tip of each joint
   std::array<int, k_bone_count> declared_humanoid;  // joint index per proxy bone, or -1
   std::vector<std::string> expressions;
   rig_source source = rig_source::unknown;
   std::string file;
+  float floor_y = std::numeric_limits<float>::quiet_NaN();  // raw_rig::floor_y
 
   int joint_count() const { return static_cast<int>(names.size()); }
   /// Joint index of `name` (exact), or -1.

@@ -86,7 +86,7 @@ rig_bvh_layout make_layout(const rig& r, int hips) {
 }
 
 void write_hierarchy(std::string& s, const rig_bvh_layout& l, const std::vector<glm::dvec3>& rest,
-                     int k, int depth, double scale) {
+                     const std::vector<glm::dvec3>& tips, int k, int depth, double scale) {
   const std::string indent(static_cast<std::size_t>(depth), '\t');
   const bool root = k == 0;
   s += indent + (root ? "ROOT " : "JOINT ") + l.names[k] + "\n" + indent + "{\n" + indent +
@@ -102,10 +102,14 @@ void write_hierarchy(std::string& s, const rig_bvh_layout& l, const std::vector<
     // Rig order is parent-first and children of one parent keep their relative order, so a
     // depth-first walk over increasing indices matches joint_order below.
     for (std::size_t c = static_cast<std::size_t>(k) + 1; c < l.joints.size(); ++c)
-      if (l.bvh_parent[c] == k) write_hierarchy(s, l, rest, static_cast<int>(c), depth + 1, scale);
+      if (l.bvh_parent[c] == k)
+        write_hierarchy(s, l, rest, tips, static_cast<int>(c), depth + 1, scale);
   } else {
     s += indent + "\tEnd Site\n" + indent + "\t{\n" + indent + "\t\tOFFSET ";
-    append_vec(s, 0.5 * offset, scale);
+    // The rig's own end (a BVH avatar's End Site), else half the joint's own offset.
+    const glm::dvec3& tip = tips[l.joints[k]];
+    const bool known = std::isfinite(tip.x) && std::isfinite(tip.y) && std::isfinite(tip.z);
+    append_vec(s, known ? tip : 0.5 * offset, scale);
     s += "\n" + indent + "\t}\n";
   }
   s += indent + "}\n";
@@ -170,7 +174,11 @@ status write_impl(const std::string& path, const rig& r, const std::vector<rig_p
   io_detail::text_output out;
   if (status s = out.open(path); !s) return s;
   std::string text = "HIERARCHY\n";
-  write_hierarchy(text, layout, rest_pos, 0, 0, scale);
+  // The rig's segment ends (End Sites) turned into world axes as the offsets are.
+  std::vector<glm::dvec3> tips(rest_world.size(), glm::dvec3(std::nan("")));
+  for (int j = 0; j < n && static_cast<std::size_t>(j) < r.tips.size(); ++j)
+    tips[j] = glm::dmat3(rest_world[j]) * glm::dvec3(r.tips[j]);
+  write_hierarchy(text, layout, rest_pos, tips, 0, 0, scale);
   text += "MOTION\nFrames: " + std::to_string(frames.size()) + "\nFrame Time: ";
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.9g", 1.0 / options.fps);
