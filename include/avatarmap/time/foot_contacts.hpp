@@ -62,9 +62,10 @@ struct foot_contact_options {
   /// ... and a planted foot lifts when faster than this or higher than release_height.
   float release_speed = 0.8f;
   float release_height = 0.12f;
-  /// ... or when it has moved this far (metres, horizontally) both from where it planted and
-  /// against the other foot: a slow step stays under release_speed (both feet moving together
-  /// is the hips' measurement drifting). It plants again once settled (under half plant_speed).
+  /// ... or when it has moved this far (metres, horizontally) from where it planted: a slow
+  /// step stays under release_speed. Not when the other foot moved with it slower than 5 cm/s
+  /// since the plant (the hips' measurement drifting under a person standing still). It plants
+  /// again once settled (under half plant_speed).
   float release_distance = 0.12f;
   /// Below this confidence (the least of the lower leg's, the foot's and the toes') a foot is
   /// never planted. Low on purpose: an estimator still reports a foot outside the image or
@@ -210,6 +211,7 @@ class foot_contact_stage {
   std::array<bool, 2> stepped_{};           // released by distance: plants again once settled
   std::array<glm::vec3, 2> plant_point_{};  // the foot's point (filtered hips) when it planted
   std::array<glm::vec3, 2> plant_apart_{};  // ... less the other foot's, then
+  std::array<double, 2> plant_t_{};         // ... and when
   std::array<float, 2> contact_{};
   std::array<bool, 2> anchored_{};
   std::array<glm::vec3, 2> anchor_{};

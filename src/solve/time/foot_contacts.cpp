@@ -25,6 +25,12 @@ constexpr bone k_leg_bones[2][3] = {{bone::left_lower_leg, bone::left_foot, bone
                                     {bone::right_lower_leg, bone::right_foot, bone::right_toes}};
 constexpr bone k_toes[2] = {bone::left_toes, bone::right_toes};
 
+// The measured hips' drift under a person standing still (m/s): both feet carried together
+// slower than this since a plant are not a step (docs/contacts.md).
+constexpr float k_drift_speed = 0.05f;
+// A foot lifted by release_distance plants again once slower than this share of plant_speed.
+constexpr float k_settled = 0.5f;
+
 }  // namespace
 
 status foot_contact_options::validate() const {
@@ -226,28 +232,32 @@ void foot_contact_stage::emit(int k, proxy_pose& out) noexcept {
     if (!m.usable || f == swinging) {
       planted_[f] = false;
     } else if (planted_[f]) {
-      // A planted foot that has left where it was planted by more than release_distance, and
-      // as far from the other foot, has stepped, however slowly: a slow walk's swing foot stays
-      // under release_speed. (Both feet moving together is the hips' measurement drifting
-      // under a person standing still.) It plants again only once settled (under half
-      // plant_speed), not at once a little further on.
-      const glm::vec3 other = cur.feet[1 - f].point;
+      // A planted foot that has left where it was planted by more than release_distance has
+      // moved, however slowly: a slow walk's swing foot stays under release_speed. Unless the
+      // other foot moved with it, slower than k_drift_speed on average since the plant: that
+      // is the hips' measurement drifting under a person standing still. (Both feet carried
+      // faster, the body travelling on legs the capture barely shows swing, are let go: held,
+      // they pulled the rig's hips 28 cm down to reach anchors left behind.) It plants again
+      // only once settled, not at once a little further on.
       const glm::vec3 moved = m.point - plant_point_[f];
-      const glm::vec3 parted = (m.point - other) - plant_apart_[f];
-      const float away = std::min(std::sqrt(moved.x * moved.x + moved.z * moved.z),
-                                  std::sqrt(parted.x * parted.x + parted.z * parted.z));
+      const glm::vec3 parted = (m.point - cur.feet[1 - f].point) - plant_apart_[f];
+      const float own = std::sqrt(moved.x * moved.x + moved.z * moved.z);
+      const float apart = std::sqrt(parted.x * parted.x + parted.z * parted.z);
+      const float drift = k_drift_speed * static_cast<float>(t - plant_t_[f]);
       if (speed[f] > options_.release_speed || m.height > options_.release_height) {
         planted_[f] = false;
-      } else if (away > options_.release_distance) {
+      } else if (own > options_.release_distance &&
+                 (apart > options_.release_distance || own > options_.release_distance + drift)) {
         planted_[f] = false;
         stepped_[f] = true;
       }
-    } else if (speed[f] < (stepped_[f] ? 0.5f : 1.f) * options_.plant_speed &&
+    } else if (speed[f] < (stepped_[f] ? k_settled : 1.f) * options_.plant_speed &&
                m.height < options_.plant_height) {
       planted_[f] = true;
       stepped_[f] = false;
       plant_point_[f] = m.point;
       plant_apart_[f] = m.point - cur.feet[1 - f].point;
+      plant_t_[f] = t;
     }
     if (!continues) {
       // A take's first pose: a planted foot starts planted (standing still from frame 0).
