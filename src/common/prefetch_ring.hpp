@@ -48,10 +48,19 @@ class prefetch_ring {
 
   /// Waits for the next item; valid until release() hands it back. The caller may hold
   /// several items (each next() takes one more, release() gives back the oldest held), at
-  /// most capacity - 1 at a time.
+  /// most capacity - 1 at a time. Past the producer's last item (a caller that goes on after
+  /// an item that was the last without saying so, e.g. an error): a default-constructed Slot,
+  /// not taken (do not release it), never a slot already consumed.
   Slot& next() {
-    const size_t t = taken_++;  // only this thread touches taken_
-    if (head_.load() == t) wait_for_items(t);
+    const size_t t = taken_;  // only this thread touches taken_
+    if (head_.load() == t) {
+      wait_for_items(t);
+      if (head_.load() == t) {  // done, and nothing more will come
+        past_end_ = Slot{};
+        return past_end_;
+      }
+    }
+    ++taken_;
     return slots_[t % slots_.size()];
   }
   /// Hands the oldest item the caller holds back to the producer.
@@ -105,6 +114,7 @@ class prefetch_ring {
 
   std::function<bool(Slot&)> fill_;
   std::vector<Slot> slots_;
+  Slot past_end_{};  // what next() returns past the last item
   size_t batch_ = 1;
   std::mutex mutex_;  // only for sleeping and waking
   std::condition_variable not_empty_, not_full_;

@@ -1,7 +1,7 @@
 // prefetch_ring (src/common/prefetch_ring.hpp): every item once and in order whatever the
 // capacity, batch and which side is slower; the last item reaches the caller even when it
 // does not fill a batch; a producer that waits on its caller still makes progress; destroying
-// the ring with the producer blocked on a full ring returns.
+// the ring with the producer blocked on a full ring returns; past the last item a default slot.
 #include "common/prefetch_ring.hpp"
 
 #include <gtest/gtest.h>
@@ -50,6 +50,29 @@ TEST(prefetch_ring, delivers_every_item_once_in_order) {
           }
         }
       }
+    }
+  }
+}
+
+TEST(prefetch_ring, past_the_last_item_next_gives_a_default_slot_not_an_old_one) {
+  // The producer's last item is an error the caller cannot tell from any other (capture: the
+  // input could not be reopened for the next loop); the caller warns and asks again. It must get
+  // a default slot (the users' "end"), not the slots it consumed before (which replayed old
+  // frames forever).
+  for (int capacity : {1, 4}) {
+    long produced = 0;
+    prefetch_ring<item> ring(capacity, [&](item& it) {
+      it.value = produced++;
+      return produced < 3;  // three items, the third the last
+    });
+    for (long i = 0; i < 3; ++i) {
+      EXPECT_EQ(ring.next().value, i);
+      ring.release();
+    }
+    for (int again = 0; again < 5; ++again) {
+      const item& it = ring.next();
+      EXPECT_EQ(it.value, -1) << "capacity " << capacity;
+      EXPECT_FALSE(it.last);
     }
   }
 }
