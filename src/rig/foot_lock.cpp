@@ -14,15 +14,6 @@ constexpr glm::vec3 k_up(0.f, 1.f, 0.f);
 
 glm::vec3 position_of(const glm::mat4& m) { return glm::vec3(m[3]); }
 
-glm::mat4 local_matrix(const glm::vec3& t, const glm::quat& r, const glm::vec3& s) {
-  glm::mat4 m = glm::mat4_cast(r);
-  m[0] *= s.x;
-  m[1] *= s.y;
-  m[2] *= s.z;
-  m[3] = glm::vec4(t, 1.f);
-  return m;
-}
-
 float clamp_contact(float c) { return std::isfinite(c) ? std::clamp(c, 0.f, 1.f) : 0.f; }
 
 // The unit direction of `v`, or zero.
@@ -157,7 +148,7 @@ void foot_lock::forward_kinematics(const rig_pose& pose) {
     const transform& t = r.rest_local[j];
     const glm::vec3 tr = j == pose.hips_joint ? pose.hips_translation : t.translation;
     const glm::quat q = pose.local_rotations[j];
-    const glm::mat4 m = local_matrix(tr, q, t.scale);
+    const glm::mat4 m = joint_matrix(tr, q, t.scale);
     const int p = r.parents[j];
     world_[j] = p < 0 ? m : world_[p] * m;
     world_rot_[j] = p < 0 ? q : world_rot_[p] * q;
@@ -169,7 +160,7 @@ void foot_lock::path_kinematics(const leg& l, const rig_pose& pose) {
   for (int j : l.path) {
     const transform& t = r.rest_local[j];
     const glm::quat q = pose.local_rotations[j];
-    const glm::mat4 m = local_matrix(t.translation, q, t.scale);
+    const glm::mat4 m = joint_matrix(t.translation, q, t.scale);
     const int p = r.parents[j];
     world_[j] = p < 0 ? m : world_[p] * m;
     world_rot_[j] = p < 0 ? q : world_rot_[p] * q;

@@ -191,11 +191,7 @@ status retargeter::build(const rig& r, const bone_binding& binding, const retarg
     std::vector<glm::mat4> m(static_cast<size_t>(n));
     for (int j = 0; j < n; ++j) {
       const transform& t = r.rest_local[j];
-      glm::mat4 local = glm::mat4_cast(aligned.local_rotations[j]);
-      local[0] *= t.scale.x;
-      local[1] *= t.scale.y;
-      local[2] *= t.scale.z;
-      local[3] = glm::vec4(t.translation, 1.f);
+      const glm::mat4 local = joint_matrix(t.translation, aligned.local_rotations[j], t.scale);
       m[j] = r.parents[j] < 0 ? local : m[r.parents[j]] * local;
     }
     hips_y = (basis_ * position_of(m[hips])).y;

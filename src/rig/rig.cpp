@@ -28,14 +28,19 @@ bool finite_transform(const transform& t) {
   return is_finite(t.translation) && is_finite(t.rotation) && is_finite(t.scale);
 }
 glm::mat4 to_matrix(const transform& t) {
-  glm::mat4 m = glm::mat4_cast(glm::normalize(t.rotation));
-  m[0] *= t.scale.x;
-  m[1] *= t.scale.y;
-  m[2] *= t.scale.z;
-  m[3] = glm::vec4(t.translation, 1.f);
-  return m;
+  return joint_matrix(t.translation, glm::normalize(t.rotation), t.scale);
 }
 }  // namespace
+
+glm::mat4 joint_matrix(const glm::vec3& translation, const glm::quat& rotation,
+                       const glm::vec3& scale) {
+  glm::mat4 m = glm::mat4_cast(rotation);
+  m[0] *= scale.x;
+  m[1] *= scale.y;
+  m[2] *= scale.z;
+  m[3] = glm::vec4(translation, 1.f);
+  return m;
+}
 
 status build_rig(const raw_rig& raw, rig& out) {
   out = rig{};

@@ -58,8 +58,10 @@ struct camera_gravity {
   /// still being learnt takes some of the focal length's error).
   double focal_lean_sum = 0.0;
   double focal_lean_frames = 0.0;
-  long lean_tick = 0;           // frames seen, for sampling the lean's search
-  double lean_t_last = -1e300;  // the newest frame time searched (each frame tells once)
+  long lean_tick = 0;  // frames seen, for sampling the lean's search
+  // The newest frame time learnt from: each frame tells the lean, the vertical and the floor
+  // once (the file warm-up solves its frames again).
+  double lean_t_last = -1e300;
   /// The view is held (frame_solver::hold_view): no more evidence of the vertical, the lean,
   /// the floor's plane or the proportions is taken; the floor's level is still followed.
   bool view_held = false;
@@ -70,11 +72,12 @@ struct camera_gravity {
   double floor_n = 0.0;
   void reset() { *this = camera_gravity{}; }
   void add_floor_point(const glm::dvec3& p);
-  /// The camera's up (unit, camera axes): the floor plane's normal once the feet have rested
-  /// on enough of the floor (a walk), else the legs' vertical with its prior.
+  /// The camera's up (unit, camera axes): floor_normal() once the feet have rested on enough
+  /// of the floor (a walk), else the legs' vertical with its prior.
   glm::vec3 up() const;
-  /// The floor plane's normal when it decides the up (enough resting points, spread both
-  /// ways, agreeing with the legs); false otherwise.
+  /// The floor's normal when it decides the up (enough resting points, agreeing with the legs
+  /// within ~37 degrees): the plane's, when they spread both ways; when they lie along one line
+  /// (a straight walk), the legs' vertical turned level with that line. False otherwise.
   bool floor_normal(glm::vec3& out) const;
   /// Pitch (degrees, + = the camera looks down) and roll (degrees, + = the world's up leans
   /// toward the image's right) of the camera relative to gravity.

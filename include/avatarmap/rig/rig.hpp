@@ -73,6 +73,10 @@ struct rig {
   int find(const std::string& name) const;
 };
 
+/// A joint's local matrix: translate · rotate · scale (rotation taken as given: unit).
+glm::mat4 joint_matrix(const glm::vec3& translation, const glm::quat& rotation,
+                       const glm::vec3& scale);
+
 /// Validates a raw rig (parents in range, no cycles, finite transforms, non-zero scale) and
 /// builds the runtime rig, reordering joints parent-first. Errors (status_code::parse: the
 /// avatar's skeleton is malformed) name the node.

@@ -152,10 +152,10 @@ struct foot_measure {
 };
 
 /// Heel, toe tip and usability of both feet of `pose` ([0] left, [1] right), the floor being
-/// the lowest of the four points. `skeleton` gives the proportions; `fk` is scratch.
-/// Allocates nothing.
+/// the lowest of the four points (the legs' forward kinematics only, compute_proxy_feet).
+/// `skeleton` gives the proportions. Allocates nothing.
 void measure_feet(const proxy_skeleton& skeleton, const proxy_pose& pose, float min_confidence,
-                  proxy_fk& fk, std::array<foot_measure, 2>& out);
+                  std::array<foot_measure, 2>& out);
 
 class foot_contact_stage {
  public:
@@ -201,7 +201,6 @@ class foot_contact_stage {
   proxy_skeleton base_skeleton_;  // as given at construction
   proxy_skeleton skeleton_;       // base_skeleton_ scaled to the leg length in use
   float leg_length_ = 0.f;        // set_leg_length()'s value in use (0: none)
-  proxy_fk fk_;
   std::unique_ptr<slot[]> ring_;
   int capacity_ = 1;
   long pushed_ = 0;   // poses taken since the take began

@@ -44,10 +44,8 @@ status foot_contact_options::validate() const {
 }
 
 void measure_feet(const proxy_skeleton& skeleton, const proxy_pose& pose, float min_confidence,
-                  proxy_fk& fk, std::array<foot_measure, 2>& out) {
-  // The legs' bones only (compute_proxy_fk's heels and toe tips, bit for bit); `fk` is kept
-  // in the signature for callers that pass scratch.
-  (void)fk;
+                  std::array<foot_measure, 2>& out) {
+  // The legs' bones only (compute_proxy_fk's heels and toe tips, bit for bit).
   proxy_feet feet;
   compute_proxy_feet(skeleton, pose, feet);
   float floor = std::numeric_limits<float>::infinity();
@@ -131,7 +129,7 @@ bool foot_contact_stage::push(const proxy_pose& in, proxy_pose& out) noexcept {
   }
   slot& s = at(pushed_);
   s.pose = in;
-  measure_feet(skeleton_, in, options_.min_confidence, fk_, s.feet);
+  measure_feet(skeleton_, in, options_.min_confidence, s.feet);
   s.ok = std::isfinite(in.t) && finite3(in.hips_position) && finite3(s.feet[0].point) &&
          finite3(s.feet[1].point);
   ++pushed_;
@@ -242,12 +240,12 @@ void foot_contact_stage::emit(int k, proxy_pose& out) noexcept {
       const glm::vec3 moved = m.point - plant_point_[f];
       const glm::vec3 parted = (m.point - cur.feet[1 - f].point) - plant_apart_[f];
       const float own = std::sqrt(moved.x * moved.x + moved.z * moved.z);
-      const float apart = std::sqrt(parted.x * parted.x + parted.z * parted.z);
+      const float own_apart = std::sqrt(parted.x * parted.x + parted.z * parted.z);
       const float drift = k_drift_speed * static_cast<float>(t - plant_t_[f]);
       if (speed[f] > options_.release_speed || m.height > options_.release_height) {
         planted_[f] = false;
-      } else if (own > options_.release_distance &&
-                 (apart > options_.release_distance || own > options_.release_distance + drift)) {
+      } else if (own > options_.release_distance && (own_apart > options_.release_distance ||
+                                                     own > options_.release_distance + drift)) {
         planted_[f] = false;
         stepped_[f] = true;
       }
@@ -290,10 +288,10 @@ void foot_contact_stage::emit(int k, proxy_pose& out) noexcept {
     // planted) must not hold the body back.
     std::array<float, 2> hold;
     for (int f = 0; f < 2; ++f) {
-      const float v0 = 0.5f * options_.plant_speed, v1 = options_.plant_speed;
-      // Causal: one frame's speed is landmark noise more than motion; a planted foot holds.
+      // 1 - (speed - plant/2) / (plant/2), clamped (plant_speed > 0: validated). Causal: one
+      // frame's speed is landmark noise more than motion; a planted foot holds.
       const float h =
-          both_sided_ && v1 > v0 ? std::clamp((v1 - speed[f]) / (v1 - v0), 0.f, 1.f) : 1.f;
+          both_sided_ ? std::clamp(2.f - 2.f * speed[f] / options_.plant_speed, 0.f, 1.f) : 1.f;
       hold[f] = contact_[f] * h;
     }
     // The hips each anchored foot asks for (its offset from the hips is the FK's).

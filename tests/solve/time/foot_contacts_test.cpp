@@ -32,9 +32,8 @@ proxy_pose standing(double t, const proxy_skeleton& sk) {
 
 // World sole-middle points of both feet of `p` (what the stage anchors).
 std::array<foot_measure, 2> feet_of(const proxy_pose& p, const proxy_skeleton& sk) {
-  proxy_fk fk;
   std::array<foot_measure, 2> m;
-  measure_feet(sk, p, 0.f, fk, m);
+  measure_feet(sk, p, 0.f, m);
   return m;
 }
 
@@ -180,7 +179,6 @@ TEST(foot_contacts, a_foot_reported_outside_the_image_is_planted) {
 // leg is raised 40 degrees forward (high: never planted).
 std::vector<proxy_pose> swaying_over_the_left_foot(const proxy_skeleton& sk) {
   std::vector<proxy_pose> v;
-  proxy_fk fk;
   glm::vec3 sole0(0.f);
   for (int i = 0; i < 90; ++i) {
     proxy_pose p = standing(i / k_fps, sk);
@@ -188,7 +186,7 @@ std::vector<proxy_pose> swaying_over_the_left_foot(const proxy_skeleton& sk) {
     p[bone::left_upper_leg] = glm::angleAxis(a, glm::vec3(1.f, 0.f, 0.f));
     p[bone::right_upper_leg] = glm::angleAxis(glm::radians(-40.f), glm::vec3(1.f, 0.f, 0.f));
     std::array<foot_measure, 2> m;
-    measure_feet(sk, p, 0.f, fk, m);
+    measure_feet(sk, p, 0.f, m);
     if (i == 0) sole0 = m[0].point;
     p.hips_position.x -= m[0].point.x - sole0.x;
     p.hips_position.z -= m[0].point.z - sole0.z;
