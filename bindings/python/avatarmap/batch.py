@@ -546,6 +546,15 @@ def local_cluster(workers: int, host: str = LOOPBACK,
                         silence_logs=logging.ERROR)
 
 
+def _quiet_teardown() -> None:
+    """Runs in each worker of the local cluster (and in this process) once every result is
+    in: Dask's own log is raised to CRITICAL, so a heartbeat that races the scheduler's close
+    does not print a traceback after a batch that succeeded."""
+    for name in ["distributed"] + [n for n in list(logging.root.manager.loggerDict)
+                                   if n.startswith("distributed.")]:
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
 def _run_on_dask(todo: List[Task], options: dict, args: argparse.Namespace,
                  timing: dict) -> List[Result]:
     from distributed import Client, progress
@@ -596,6 +605,12 @@ def _run_on_dask(todo: List[Task], options: dict, args: argparse.Namespace,
         timing["wall"] = time.perf_counter() - t1
         return results
     finally:
+        if cluster is not None:  # only our own workers: a user's scheduler keeps its log
+            try:
+                client.run(_quiet_teardown)
+            except Exception:  # noqa: BLE001 - a worker already gone has nothing to say
+                pass
+            _quiet_teardown()
         client.close()
         if cluster is not None:
             cluster.close()
