@@ -20,6 +20,12 @@ packages+=(libwebsockets-dev chromium python3-pil)
 if [ "${AVATARMAP_SKIP_FUZZ:-0}" != 1 ] || [ "${AVATARMAP_SKIP_SANITIZE:-0}" != 1 ]; then
   packages+=(clang libclang-rt-14-dev)
 fi
+# Optional: Blender, for the add-on's test (docs/blender.md; CTest label `blender`) and
+# interop.blender. Large (about 480 MB with what it pulls in), so only when asked:
+# AVATARMAP_WITH_BLENDER=1.
+if [ "${AVATARMAP_WITH_BLENDER:-0}" = 1 ]; then
+  packages+=(blender)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -1,13 +1,19 @@
 // avatarmap's browser viewer (docs/viewer.md). Loads the avatar the server names in
 // /config.json, then either applies the proxy poses that arrive on the WebSocket (one
 // *.pose.jsonl line per message: VRM 1.0 normalised local rotations [x, y, z, w], the hips
-// position in metres, expression weights) or plays the server's .vrma clip in a loop. Poses
-// win over the clip: the first pose that arrives stops it.
+// position in metres, expression weights) or plays an animation itself: the server's .vrma clip,
+// its *.pose.jsonl (fetched whole, shown by time stamps), or the avatar .glb's own glTF
+// animation — or one opened or dropped on the page. The controls (play/pause, Space, timeline,
+// speed, loop) drive the animation's time; a video the server names is kept at that time.
+// Poses from the WebSocket win over the animation: the first that arrives stops it (except the
+// server's own stream of the pose file the page plays itself).
 //
-// For tests and tools: window.avatarmapViewer.state() says what the page shows; ?hud=0 hides
-// the text box; the page logs "avatarmap-viewer: first posed frame N ms" and sends
-// {"first_posed_ms": N} to the server once it has drawn its first posed frame (N counted from
-// the start of the page's navigation).
+// For tests and tools: window.avatarmapViewer.state() says what the page shows,
+// boneRotation(name) / rawBoneRotation(name) the avatar's normalised / raw local rotation of a
+// bone ([x, y, z, w]); ?hud=0 hides the text box and the control bar (a clean picture for
+// screenshots; the controls still work); the page logs "avatarmap-viewer: first posed frame N
+// ms" and sends {"first_posed_ms": N} to the server once it has drawn its first posed frame (N
+// counted from the start of the page's navigation).
 //
 // Render mode (?render=1; docs/world-benchmark-rendered.md): a fixed camera from the URL, a plain
 // background and floor, no WebSocket, no animation loop — a frame is drawn only when asked:
@@ -23,6 +29,8 @@ const params = new URLSearchParams(location.search);
 const hudElement = document.getElementById('hud');
 const renderMode = params.get('render') === '1';
 if (params.get('hud') === '0' || renderMode) hudElement.style.display = 'none';
+if (renderMode) document.body.classList.add('render');  // no controls, message or video
+if (params.get('hud') === '0') document.body.classList.add('bare');  // no control bar either
 
 // Render mode's URL parameters (all optional): w, h (canvas pixels, device pixel ratio 1),
 // cam=x,y,z (metres, the avatar's world: Y up, floor Y = 0, the avatar faces +Z), either
@@ -85,6 +93,14 @@ const state = {
   clipName: '',
   clipTime: null,        // seconds into the clip
   clipDuration: null,
+  clipKind: '',          // the animation the page plays: vrma | glb | poses ('' none)
+  playing: false,        // the controls: playing or paused, speed, loop
+  speed: 1,
+  loop: true,
+  videoName: '',         // the video beside the avatar ('' none), its state and time
+  video: 'none',         // none | loading | ready | failed
+  videoTime: null,
+  message: '',           // the newest message shown above the controls
   firstPosedMs: null,
   frames: 0,
   error: renderErrors.join('; '),
@@ -165,12 +181,16 @@ if (renderMode) {
   }
 }
 
-window.addEventListener('resize', () => {
+// The interactive page's canvas: the window, or its left part when a video is shown.
+function layout() {
   if (renderMode) return;
-  camera.aspect = window.innerWidth / window.innerHeight;
+  const width = videoElement.style.display === 'block' ? Math.round(window.innerWidth * 0.55)
+                                                       : window.innerWidth;
+  camera.aspect = width / window.innerHeight;
   camera.updateProjectionMatrix();
-  renderer.setSize(window.innerWidth, window.innerHeight);
-});
+  renderer.setSize(width, window.innerHeight);
+}
+window.addEventListener('resize', layout);
 
 // ---- avatar ---------------------------------------------------------------------------------
 let vrm = null;
@@ -218,17 +238,21 @@ function addMarkers() {
   }
 }
 
-async function loadAvatar(url, name) {
+// `animated`: the file is an avatar with its own glTF animation (`avatarmap convert -o x.glb`),
+// played by the controls on the raw bones.
+async function loadAvatar(url, name, animated = false) {
   state.avatar = 'loading';
   state.avatarName = name;
   try {
     const gltf = await gltfLoader().loadAsync(url);
     const loaded = gltf.userData.vrm;
     if (!loaded) throw new Error(`${name} is not a VRM avatar (no VRM extension)`);
+    if (animated && !gltf.animations.length) throw new Error(`${name} holds no glTF animation`);
     if (vrm) {
       scene.remove(vrm.scene);
       VRMUtils.deepDispose(vrm.scene);
     }
+    if (!renderMode && (player.kind === 'glb' || animated)) stopAnimation();
     VRMUtils.removeUnnecessaryVertices(gltf.scene);
     VRMUtils.rotateVRM0(loaded);  // VRM 0.x faces -Z: turn it to face +Z as VRM 1.0 does
     vrm = loaded;
@@ -242,11 +266,24 @@ async function loadAvatar(url, name) {
     else frameAvatar();
     state.avatar = 'ready';
     state.error = '';
-    if (config.clip) await loadClip(config.clip, config.clip_name || 'clip');
+    if (renderMode) {
+      if (config.clip) await loadClip(config.clip, config.clip_name || 'clip');
+    } else if (animated) {
+      vrm.humanoid.autoUpdateHumanBones = false;  // the animation drives the raw bones
+      mixer = new THREE.AnimationMixer(vrm.scene);
+      clipAction = mixer.clipAction(gltf.animations[0]);
+      clipAction.play();
+      startAnimation('glb', name, gltf.animations[0].duration, 0);
+    } else if (clipSource) {
+      await loadClip(clipSource.url, clipSource.name);  // the clip again, on this avatar
+    } else if (player.kind === 'poses') {
+      showAt(player.time);
+    }
   } catch (e) {
     state.avatar = 'failed';
     state.error = `could not load the avatar ${name}: ${e.message ?? e}`;
     console.error('avatarmap-viewer:', state.error);
+    if (!renderMode) showMessage(state.error);
   }
 }
 
@@ -256,6 +293,12 @@ async function loadClip(url, name) {
     const animation = gltf.userData.vrmAnimations?.[0];
     if (!animation) throw new Error(`${name} holds no VRM Animation`);
     const clip = createVRMAnimationClip(animation, vrm);
+    if (!renderMode) {
+      const keep = clipSource && clipSource.url === url ? player.time : 0;
+      stopAnimation();
+      clipSource = { url, name };
+      player.time = keep;
+    }
     mixer = new THREE.AnimationMixer(vrm.scene);
     clipAction = mixer.clipAction(clip);
     clipAction.setLoop(THREE.LoopRepeat, Infinity).play();
@@ -263,10 +306,277 @@ async function loadClip(url, name) {
     state.clipName = name;
     state.clipDuration = clip.duration;
     if (state.mode !== 'live') state.mode = 'clip';
+    if (!renderMode) startAnimation('vrma', name, clip.duration, 0, player.time);
   } catch (e) {
     state.error = `could not play ${name}: ${e.message ?? e}`;
     console.error('avatarmap-viewer:', state.error);
+    if (!renderMode) showMessage(state.error);
   }
+}
+
+// ---- the interactive page's animation and its controls -------------------------------------
+// One animation at a time: a .vrma clip or a .glb's animation (the mixer, stepped to the
+// player's time) or a pose file (the newest pose at or before the time). Time runs from 0 (the
+// first pose) to the duration; the video shows time + offset (a pose file's first t: its poses
+// carry the video's time stamps).
+const player = { kind: '', time: 0, duration: 0, offset: 0, playing: false, speed: 1, loop: true };
+let clipSource = null;  // the .vrma playing ({url, name}): loaded again onto a new avatar
+let poseTrack = null;   // the pose file playing: {poses, times}
+const controlsElement = document.getElementById('controls');
+const playButton = document.getElementById('play');
+const timeline = document.getElementById('timeline');
+const timeLabel = document.getElementById('time');
+const speedSelect = document.getElementById('speed');
+const loopBox = document.getElementById('loop');
+const fileInput = document.getElementById('open-file');
+const messageElement = document.getElementById('message');
+const videoElement = document.getElementById('video');
+let scrubbing = false;
+
+function showMessage(text) {
+  state.message = text;
+  messageElement.textContent = text;
+  messageElement.style.display = text ? 'block' : 'none';
+}
+
+function stopAnimation() {
+  if (mixer) mixer.stopAllAction();
+  mixer = null;
+  clipAction = null;
+  clipSource = null;
+  poseTrack = null;
+  if (vrm) vrm.humanoid.autoUpdateHumanBones = true;
+  player.kind = '';
+  state.clipKind = '';
+  timeline.disabled = true;
+  playButton.disabled = true;
+}
+
+function startAnimation(kind, name, duration, offset, time = 0) {
+  Object.assign(player, { kind, duration: Math.max(0, duration), offset, time: 0 });
+  player.playing = true;
+  state.clipKind = kind;
+  state.clipName = name;
+  state.clipDuration = player.duration;
+  state.mode = 'clip';
+  timeline.max = String(player.duration);
+  timeline.disabled = false;
+  playButton.disabled = false;
+  showMessage('');
+  seek(time);
+}
+
+// Shows the animation at time t (seconds from its start), without changing play/pause.
+function showAt(t) {
+  if (!vrm || !player.kind) return;
+  if (player.kind === 'poses') {
+    const times = poseTrack.times;
+    let lo = 0;
+    let hi = times.length - 1;
+    while (lo < hi) {  // the last pose whose time is <= t
+      const mid = (lo + hi + 1) >> 1;
+      if (times[mid] <= t) lo = mid;
+      else hi = mid - 1;
+    }
+    firstHips = poseTrack.firstHips;
+    standingHipsY = poseTrack.standing;
+    applyPose(poseTrack.poses[lo]);
+  } else if (clipAction) {
+    // LoopRepeat wraps a time of exactly the duration to 0: the end shows the last key.
+    clipAction.time = Math.min(t, Math.max(0, player.duration - 1e-6));
+    mixer.update(0);
+  }
+  state.clipTime = t;
+}
+
+function seek(t) {
+  player.time = Math.min(Math.max(0, Number(t) || 0), player.duration);
+  showAt(player.time);
+}
+
+function setPlaying(playing) {
+  if (!player.kind) return;
+  if (playing && !player.loop && player.time >= player.duration) player.time = 0;
+  player.playing = playing;
+}
+
+// Advances the player by a frame's wall-clock seconds.
+function advance(delta) {
+  if (!player.playing || !player.kind) return;
+  let t = player.time + delta * player.speed;
+  if (t >= player.duration) {
+    if (player.loop && player.duration > 0) t %= player.duration;
+    else {
+      t = player.duration;
+      player.playing = false;
+    }
+  }
+  player.time = t;
+  showAt(t);
+}
+
+// Parses a *.pose.jsonl text (the header line, if any, gives the rate that spaces poses whose
+// t does not increase, as `view`'s player does) and plays it.
+function loadPoses(text, name) {
+  const poses = [];
+  let fps = 30;
+  for (const line of text.split('\n')) {
+    if (!line.trim()) continue;
+    let value;
+    try {
+      value = JSON.parse(line);
+    } catch (e) {
+      throw new Error(`${name} line ${poses.length + 1}: not JSON (${e.message})`);
+    }
+    if (typeof value.format === 'string') {
+      if (value.fps > 0) fps = value.fps;
+    } else if (typeof value.t === 'number' && Number.isFinite(value.t)) {
+      poses.push(value);
+    }
+  }
+  if (!poses.length) throw new Error(`${name} holds no poses`);
+  const times = new Float64Array(poses.length);
+  const t0 = poses[0].t;
+  let standing = 0;
+  for (let i = 0; i < poses.length; i++) {
+    const t = poses[i].t - t0;
+    times[i] = i === 0 ? 0 : t > times[i - 1] ? t : times[i - 1] + 1 / fps;
+    const h = poses[i].hips_position;
+    if (Array.isArray(h) && Number.isFinite(h[1])) standing = Math.max(standing, h[1]);
+  }
+  stopAnimation();
+  // Hips: scaled by the whole file's standing height, relative to its first pose, so that any
+  // time shows the same pose however it is reached.
+  const h0 = poses[0].hips_position;
+  poseTrack = {
+    poses, times, firstHips: Array.isArray(h0) && h0.length === 3 ? h0 : null,
+    standing: Math.min(2.5, Math.max(standing, 0.3)),
+  };
+  startAnimation('poses', name, times[times.length - 1], t0);
+}
+
+async function loadPosesFrom(url, name) {
+  try {
+    const response = await fetch(url, { cache: 'no-store' });
+    if (!response.ok) throw new Error(`HTTP ${response.status}`);
+    loadPoses(await response.text(), name);
+  } catch (e) {
+    state.error = `could not play ${name}: ${e.message ?? e}`;
+    showMessage(state.error);
+  }
+}
+
+// The video beside the avatar: fetched whole into a blob (the server answers no Range
+// requests; a blob seeks anywhere).
+async function loadVideo(url, name) {
+  state.video = 'loading';
+  state.videoName = name;
+  try {
+    const response = await fetch(url);
+    if (!response.ok) throw new Error(`HTTP ${response.status}`);
+    videoElement.src = URL.createObjectURL(await response.blob());
+    videoElement.style.display = 'block';
+    layout();
+    await new Promise((resolve, reject) => {
+      videoElement.onloadeddata = resolve;
+      videoElement.onerror = () => reject(new Error('the browser cannot decode it'));
+    });
+    state.video = 'ready';
+  } catch (e) {
+    state.video = 'failed';
+    showMessage(`could not show the video ${name}: ${e.message ?? e}`);
+  }
+}
+
+// Keeps the video at the animation's time: played along at the same speed while playing,
+// sought while paused or when it drifts by more than 0.15 s.
+function syncVideo() {
+  if (state.video !== 'ready') return;
+  state.videoTime = videoElement.currentTime;
+  if (!player.kind) return;
+  const end = Number.isFinite(videoElement.duration) ? videoElement.duration : Infinity;
+  const target = Math.min(Math.max(0, player.time + player.offset), end);
+  const playing = player.playing && !scrubbing && target < end;
+  if (videoElement.playbackRate !== player.speed) videoElement.playbackRate = player.speed;
+  if (playing && videoElement.paused) videoElement.play().catch(() => {});
+  if (!playing && !videoElement.paused) videoElement.pause();
+  const drift = Math.abs(videoElement.currentTime - target);
+  if (!videoElement.seeking && drift > (playing ? 0.15 : 0.02)) videoElement.currentTime = target;
+}
+
+function updateControls() {
+  state.playing = player.playing;
+  state.speed = player.speed;
+  state.loop = player.loop;
+  playButton.textContent = player.playing ? 'Pause' : 'Play';
+  if (!player.kind) {
+    timeLabel.textContent = '–';
+    return;
+  }
+  if (!scrubbing) timeline.value = String(player.time);
+  timeLabel.textContent = `${player.time.toFixed(2)} / ${player.duration.toFixed(2)} s`;
+}
+
+// Opens a file the user chose or dropped, by its name.
+function openFile(file) {
+  const name = file.name;
+  const lower = name.toLowerCase();
+  const url = URL.createObjectURL(file);
+  if (lower.endsWith('.vrm')) return loadAvatar(url, name);
+  if (lower.endsWith('.glb')) return loadAvatar(url, name, true);
+  if (lower.endsWith('.vrma')) {
+    if (!vrm) return showMessage(`open an avatar (.vrm) before the clip ${name}`);
+    return loadClip(url, name);
+  }
+  if (lower.endsWith('.jsonl')) {
+    return file.text().then((text) => {
+      try {
+        loadPoses(text, name);
+      } catch (e) {
+        showMessage(`could not play ${name}: ${e.message ?? e}`);
+      }
+    });
+  }
+  showMessage(`cannot open ${name}: open a .vrm (avatar), .vrma (clip), .glb (avatar with its ` +
+              'animation) or .pose.jsonl (poses)');
+  return null;
+}
+
+if (!renderMode) {
+  const rotation = (node) => (node ? node.quaternion.toArray() : null);
+  Object.assign(window.avatarmapViewer, {
+    boneRotation: (name) => rotation(vrm?.humanoid.getNormalizedBoneNode(name)),
+    rawBoneRotation: (name) => rotation(vrm?.humanoid.getRawBoneNode(name)),
+  });
+  document.getElementById('open').addEventListener('click', (e) => {
+    e.currentTarget.blur();
+    fileInput.click();
+  });
+  fileInput.addEventListener('change', () => {
+    if (fileInput.files[0]) openFile(fileInput.files[0]);
+    fileInput.value = '';
+  });
+  playButton.addEventListener('click', () => {
+    playButton.blur();
+    setPlaying(!player.playing);
+  });
+  timeline.addEventListener('pointerdown', () => { scrubbing = true; });
+  timeline.addEventListener('pointerup', () => { scrubbing = false; });
+  timeline.addEventListener('input', () => seek(timeline.value));
+  timeline.addEventListener('change', () => { scrubbing = false; });
+  speedSelect.addEventListener('change', () => {
+    player.speed = Number(speedSelect.value) || 1;
+    speedSelect.blur();
+  });
+  loopBox.addEventListener('change', () => {
+    player.loop = loopBox.checked;
+    loopBox.blur();
+  });
+  window.addEventListener('keydown', (e) => {
+    if (e.code !== 'Space' && e.key !== ' ') return;
+    e.preventDefault();
+    setPlaying(!player.playing);
+  });
 }
 
 // ---- poses ----------------------------------------------------------------------------------
@@ -320,8 +630,9 @@ function connect(url) {
     if (state.firstPosedMs !== null) report();
   };
   socket.onmessage = (event) => {
-    newestMessage = event.data;
     state.posesReceived++;
+    // The server's stream of the pose file this page plays itself is not applied.
+    if (!(config.poses && !config.pose_socket)) newestMessage = event.data;
   };
   socket.onclose = () => {
     state.socket = 'closed';
@@ -334,7 +645,7 @@ function report() {
     socket.send(JSON.stringify({ first_posed_ms: state.firstPosedMs }));
 }
 
-// ---- drop a .vrm ----------------------------------------------------------------------------
+// ---- drop a file ----------------------------------------------------------------------------
 document.body.addEventListener('dragover', (e) => {
   e.preventDefault();
   document.body.classList.add('dragging');
@@ -344,7 +655,7 @@ document.body.addEventListener('drop', (e) => {
   e.preventDefault();
   document.body.classList.remove('dragging');
   const file = e.dataTransfer.files[0];
-  if (file) loadAvatar(URL.createObjectURL(file), file.name);
+  if (file && !renderMode) openFile(file);
 });
 
 // ---- loop -----------------------------------------------------------------------------------
@@ -354,11 +665,14 @@ let rate = { count: 0, since: performance.now(), perSecond: 0 };
 function hudText() {
   const lines = [];
   if (state.avatar === 'none')
-    lines.push('No avatar: drop a .vrm file on this page, or run\n' +
+    lines.push('No avatar: open or drop a .vrm file on this page, or run\n' +
                'avatarmap view --avatar FILE.vrm --connect PORT');
+  else if (state.avatarName === 'built-in avatar') lines.push(`built-in avatar (${state.avatar})`);
   else lines.push(`avatar ${state.avatarName} (${state.avatar})`);
   if (state.mode === 'clip' && state.clipTime !== null)
-    lines.push(`clip ${state.clipName}: ${state.clipTime.toFixed(1)} / ${state.clipDuration.toFixed(1)} s`);
+    lines.push(`${state.clipKind === 'poses' ? 'poses' : 'clip'} ${state.clipName}: ` +
+               `${state.clipTime.toFixed(1)} / ${state.clipDuration.toFixed(1)} s`);
+  if (state.videoName) lines.push(`video ${state.videoName} (${state.video})`);
   lines.push(`poses: ${state.socketUrl} ${state.socket}` +
              (state.mode === 'live' ? `, ${rate.perSecond.toFixed(0)}/s, t ${(state.lastPoseT ?? 0).toFixed(2)} s` : ''));
   return lines.join('\n');
@@ -374,10 +688,7 @@ function frame() {
       newestMessage = null;
       try {
         const pose = JSON.parse(text);
-        if (mixer) {
-          mixer.stopAllAction();
-          mixer = null;
-        }
+        stopAnimation();
         state.mode = 'live';
         applyPose(pose);
         posed = true;
@@ -385,13 +696,14 @@ function frame() {
       } catch (e) {
         state.badMessages++;
       }
-    } else if (mixer) {
-      mixer.update(delta);
-      state.clipTime = clipAction.time;
+    } else if (player.kind) {
+      advance(delta);
       posed = true;
     }
     vrm.update(delta);
   }
+  updateControls();
+  syncVideo();
   controls.update();
   renderer.render(scene, camera);
   state.frames++;
@@ -469,7 +781,64 @@ async function ready(timeoutMs = 30000) {
   return { ...state };
 }
 
-if (renderMode) Object.assign(window.avatarmapViewer, { renderAt, renderPose, ready });
+// For `avatarmap render` (docs/render.md): what framing the avatar needs (its rest hips height;
+// flip -1 for a VRM 0.x model, whose X and Z poses flip), the camera set after loading (any of
+// cam, look, yaw, pitch, roll, hfov, vfov as the URL gives them), and an avatar .glb's own glTF
+// animation (`convert -o x.glb`) stepped to time t: it drives the raw bones, so the normalised
+// ones are no longer copied onto them.
+function avatarInfo() {
+  if (!vrm) throw new Error(state.error || 'the avatar is not loaded');
+  return { restHips: [...restHips], restHipsY, flip: vrm.meta?.metaVersion === '0' ? -1 : 1 };
+}
+
+function setCamera(settings) {
+  Object.assign(render, settings);
+  placeRenderCamera();
+  return { ...state };
+}
+
+let glbMixer = null;
+let glbDuration = 0;
+// The clip loops: its end time would wrap to its start, so the last instant is held instead.
+function glbTime(t) {
+  return Math.min(Math.max(0, t), Math.max(0, glbDuration - 1e-6));
+}
+async function loadGlbAnimation(samples = 24) {
+  if (!vrm) throw new Error(state.error || 'the avatar is not loaded');
+  const gltf = await new GLTFLoader().loadAsync(config.avatar);
+  const clip = gltf.animations[0];
+  if (!clip) throw new Error(`${config.avatar_name || 'the avatar'} holds no glTF animation`);
+  vrm.humanoid.autoUpdateHumanBones = false;
+  glbMixer = new THREE.AnimationMixer(vrm.scene);
+  glbMixer.clipAction(clip).play();
+  glbDuration = clip.duration;
+  const hips = vrm.humanoid.getRawBoneNode('hips');
+  const where = new THREE.Vector3();
+  const positions = [];
+  for (let i = 0; i <= samples; i++) {
+    glbMixer.setTime(glbTime((clip.duration * i) / samples));
+    vrm.scene.updateMatrixWorld(true);
+    if (hips) positions.push(hips.getWorldPosition(where).toArray());
+  }
+  glbMixer.setTime(0);
+  state.mode = 'clip';
+  state.clipDuration = clip.duration;
+  return { duration: clip.duration, hips: positions };
+}
+
+function renderGlbAt(t) {
+  return drawRequested(t, () => {
+    if (!glbMixer) throw new Error('no glTF animation loaded: call loadGlbAnimation() first');
+    glbMixer.setTime(glbTime(t));
+    state.clipTime = t;
+  });
+}
+
+if (renderMode) {
+  Object.assign(window.avatarmapViewer, {
+    renderAt, renderPose, ready, avatarInfo, setCamera, loadGlbAnimation, renderGlbAt,
+  });
+}
 
 // ---- start ----------------------------------------------------------------------------------
 let config = {};
@@ -484,4 +853,10 @@ if (!renderMode) {
   connect(config.pose_socket || `${scheme}://${location.host}/pose`);
   requestAnimationFrame(frame);
 }
-if (config.avatar) loadAvatar(config.avatar, config.avatar_name || 'avatar.vrm');
+if (!renderMode && config.clip) clipSource = { url: config.clip, name: config.clip_name || 'clip' };
+if (!renderMode && config.poses) loadPosesFrom(config.poses, config.poses_name || 'poses');
+if (!renderMode && config.video) loadVideo(config.video, config.video_name || 'video');
+if (config.avatar) {
+  loadAvatar(config.avatar, config.avatar_name || 'avatar.vrm',
+             !renderMode && config.avatar_animated === true);
+}

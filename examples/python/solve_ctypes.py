@@ -93,7 +93,7 @@ class AvmSolverOptions(ctypes.Structure):
         ("max_extrapolation_seconds", _F),
         ("file_filter", _I), ("file_smoothing", _F), ("file_threads", _I),
         ("fit_hand_shape", _I), ("fit_body_to_image", _I),
-        ("foot_contacts", _I), ("root_follows_contacts", _I),
+        ("foot_contacts", _I), ("root_follows_contacts", _I), ("lower_body_rest", _I),
     ]
 
 

@@ -1,4 +1,4 @@
-// `avatarmap animate VIDEO --avatar A -o OUT`: capture and convert chained in one command.
+// `avatarmap animate VIDEO -o OUT [--avatar A]`: capture and convert chained in one command.
 // The landmarks go to a temporary file (or --keep-landmarks PATH), which `convert` then solves
 // and retargets; both stages keep their own options and messages. The flags each stage takes
 // are the ones it declares (its option tables and own flags: add_*_command_flag_specs), so
@@ -29,8 +29,8 @@ const char* k_animate_help =
     "Video in, animation out, in one command: `avatarmap capture` (body, hands and face by\n"
     "default) followed by `avatarmap convert` on its landmarks; each takes its own options\n"
     "(below, as each command declares them) and prints its own messages.\n"
-    "OUT: *.vrma (VRM Animation), *.glb (AVATAR with the motion), *.bvh (AVATAR's rig, or the\n"
-    "proxy skeleton without --avatar), *.pose.jsonl\n"
+    "OUT: *.vrma (VRM Animation), *.glb (AVATAR with the motion; the built-in avatar without\n"
+    "--avatar), *.bvh (AVATAR's rig, or the proxy skeleton without --avatar), *.pose.jsonl\n"
     "\n"
     "Options:\n";
 
@@ -78,7 +78,7 @@ int run_animate(int argc, char** argv) {
   std::vector<std::string> cap = {"avatarmap", "capture"};
   std::vector<std::string> conv = {"avatarmap", "convert"};
   std::string out_path, keep, input;
-  bool quiet = false, body_only = false, hands_given = false, face_given = false, avatar = false;
+  bool quiet = false, body_only = false, hands_given = false, face_given = false;
   for (int i = 2; i < argc; ++i) {
     const std::string s = argv[i];
     if (s == "--help" || s == "-h") {
@@ -132,7 +132,6 @@ int run_animate(int argc, char** argv) {
       continue;
     }
     if (const flag_spec* f = find_flag(flags.convert, s)) {
-      avatar |= f->name == "--avatar";
       if (!take(*f, &conv, nullptr)) return 2;
       continue;
     }
@@ -156,10 +155,6 @@ int run_animate(int argc, char** argv) {
   const clip_format_info* format = nullptr;
   if (status st = clip_format_for(out_path, format); !st.ok()) {
     std::fprintf(stderr, "avatarmap animate: %s\n", st.message().c_str());
-    return 2;
-  }
-  if (format->needs_avatar && !avatar) {
-    std::fprintf(stderr, "avatarmap animate: .glb output needs --avatar AVATAR\n");
     return 2;
   }
   if (body_only) {

@@ -66,13 +66,13 @@ status with_models_hint(const status& st, const std::string& source) {
     std::string tried;
     for (const std::string& t : r.tried) tried += (tried.empty() ? "" : ", ") + t;
     return st.with_message(st.message() + " (no models folder: looked in " +
-                           (tried.empty() ? "nothing" : tried) +
-                           "; scripts/prepare_capture.sh fetches and converts the models, "
-                           "--models DIR or $AVATARMAP_MODELS points elsewhere)");
+                           (tried.empty() ? "nothing" : tried) + "; " +
+                           script_command("scripts/prepare_capture.sh") +
+                           " fetches and converts the models, --models DIR or $AVATARMAP_MODELS "
+                           "points elsewhere)");
   }
-  return st.with_message(st.message() +
-                         " (scripts/prepare_capture.sh fetches and converts the "
-                         "models; --models DIR points elsewhere)");
+  return st.with_message(st.message() + " (" + script_command("scripts/prepare_capture.sh") +
+                         " fetches and converts the models; --models DIR points elsewhere)");
 }
 }  // namespace
 

@@ -22,6 +22,7 @@ int run_eval_pose(int argc, char** argv);
 int run_eval_world(int argc, char** argv);
 int run_avatar(int argc, char** argv);
 int run_view(int argc, char** argv);
+int run_render(int argc, char** argv);
 int run_options(int argc, char** argv);
 
 /// Every flag `capture` takes (its own and its option tables'), as `animate` hands them on;

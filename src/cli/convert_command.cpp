@@ -1,10 +1,18 @@
 // `avatarmap convert IN -o OUT [--avatar AVATAR] [--rig auto|NAME|FILE.json] [--fps N]`:
 // landmarks, proxy poses or VRM Animation in; VRMA, animated GLB, BVH or proxy poses out.
+#include <unistd.h>
+
 #include <array>
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "avatarmap/avatar/builtin_avatar.hpp"
 #include "avatarmap/core/limits.hpp"
 #include "avatarmap/jobs/clip_output.hpp"
 #include "avatarmap/jobs/convert_file.hpp"
@@ -27,7 +35,8 @@ const char* k_convert_help =
     "\n"
     "IN:  *.landmarks.jsonl (solved as by `avatarmap solve`), *.pose.jsonl, *.vrma or *.bvh\n"
     "     (mocap on its own skeleton, bound by the mapping tables)\n"
-    "OUT: *.vrma (VRM Animation), *.glb (the avatar with the motion; needs --avatar),\n"
+    "OUT: *.vrma (VRM Animation), *.glb (the avatar with the motion; the built-in avatar\n"
+    "     unless --avatar),\n"
     "     *.bvh (centimetres, ZXY: the avatar's own rig with --avatar, else the proxy\n"
     "     skeleton), *.pose.jsonl\n"
     "\n"
@@ -38,9 +47,9 @@ const char* k_convert_help =
 const cli_flag k_convert_flags[] = {
     {"--output", "-o", "PATH", "output file (required; written atomically)"},
     {"--avatar", nullptr, "FILE",
-     "the avatar (.vrm, .glb, .gltf, or a .bvh's skeleton) to drive (required for .glb; with "
-     ".bvh: write its rig "
-     "instead of the proxy skeleton)"},
+     "the avatar (.vrm, .glb, .gltf, or a .bvh's skeleton) to drive (.glb: the built-in avatar "
+     "when not given, as `avatarmap avatar` writes it; with .bvh: write its rig instead of "
+     "the proxy skeleton)"},
     {"--rig", nullptr, "auto|NAME|FILE.json",
      "how the avatar's joints map to the proxy: auto (default) uses a VRM's own humanoid map, "
      "else the best shipped table (mixamo, unity_humanoid, ue4_mannequin, ue5_mannequin, "
@@ -58,6 +67,7 @@ const cli_flag k_convert_flags[] = {
      "docs/foot-locking.md)"},
     {"--image-size", nullptr, "WxH", "landmark input: image size in pixels, as for solve"},
     {"--filter", nullptr, "offline|live|none", "landmark input: the filter, as for solve"},
+    {"--parts", nullptr, "LIST", k_parts_flag_help},
     {"--quiet", nullptr, nullptr, "no summary"},
 };
 // The solve-file table's flags convert takes for a landmark input (its --fps is the output's).
@@ -116,6 +126,42 @@ status dump_positions(const std::string& path, double fps, const std::vector<pro
   s += "]}\n";
   return io_detail::write_file_atomically(path, s);
 }
+
+// The built-in avatar (avatar/builtin_avatar.hpp) in a private temporary file
+// ($TMPDIR/avatarmap-builtin-XXXXXX.vrm) for as long as this object lives; registered for
+// removal on a signal.
+class builtin_avatar_file {
+ public:
+  builtin_avatar_file() = default;
+  builtin_avatar_file(const builtin_avatar_file&) = delete;
+  builtin_avatar_file& operator=(const builtin_avatar_file&) = delete;
+  ~builtin_avatar_file() {
+    if (!path_.empty()) std::remove(path_.c_str());
+  }
+  status write() {
+    std::string glb;
+    if (status st = builtin_avatar_glb(builtin_avatar_options{}, glb); !st.ok()) return st;
+    std::error_code ec;
+    std::filesystem::path dir = std::filesystem::temp_directory_path(ec);
+    if (ec) dir = ".";
+    std::string name = (dir / "avatarmap-builtin-XXXXXX.vrm").string();
+    const int fd = ::mkstemps(name.data(), 4);
+    if (fd < 0)
+      return status::error("cannot create a temporary file in " + dir.string() + ": " +
+                           std::strerror(errno));
+    path_ = name;
+    registration_ = std::make_unique<io_detail::temp_file_registration>(path_);
+    const int err = io_detail::write_all(fd, glb.data(), glb.size());
+    ::close(fd);
+    if (err != 0) return status::error("cannot write " + path_ + ": " + std::strerror(err));
+    return {};
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::unique_ptr<io_detail::temp_file_registration> registration_;
+};
 
 // What to do when the avatar's binding failed on its tables (parse: the table, or every
 // table, lacks bones the rig needs, or a table is malformed): the library says what did not
@@ -186,6 +232,10 @@ int run_convert(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap convert: %s\n", error.c_str());
     return 2;
   }
+  if (!parse_parts_flag(a, job.solve.options.parts, error)) {
+    std::fprintf(stderr, "avatarmap convert: landmark input: %s\n", error.c_str());
+    return 2;
+  }
   if (a.value("--image-size", value)) {
     int w = 0, h = 0;
     if (!parse_image_size(value, w, h)) {
@@ -213,6 +263,18 @@ int run_convert(int argc, char** argv) {
     return 2;
   }
   job.input = a.rest()[0];
+  // A .glb without --avatar carries the built-in avatar (as `view` shows it): written to a
+  // private temporary file that the binding and the writer read, removed at the end (or by
+  // the signal handlers, main.cpp).
+  const clip_format_info* glb = find_clip_format(job.output);
+  builtin_avatar_file builtin;
+  if (glb != nullptr && glb->needs_avatar && job.avatar.empty()) {
+    if (status st = builtin.write(); !st.ok()) {
+      std::fprintf(stderr, "avatarmap convert: the built-in avatar: %s\n", st.message().c_str());
+      return 1;
+    }
+    job.avatar = builtin.path();
+  }
   // Without --fps: 30 frames/s, except .pose.jsonl, which keeps the frames' own times.
   const clip_format_info* format = find_clip_format(job.output);
   job.fps = fps_given                                                        ? fps
@@ -252,7 +314,8 @@ int run_convert(int argc, char** argv) {
                  done.frames_read, seconds_text(done.t_last - done.t_first, 2).c_str(),
                  done.output.frames_written, done.output.fps > 0.0 ? fps_text : "", done.seconds);
     if (done.avatar)
-      std::fprintf(stderr, "avatar %s: %d joints; %s\n", job.avatar.c_str(),
+      std::fprintf(stderr, "avatar %s: %d joints; %s\n",
+                   builtin.path().empty() ? job.avatar.c_str() : "(built-in)",
                    done.avatar->rig.joint_count(), done.avatar->description.c_str());
     std::fprintf(stderr, "wrote %s\n", job.output.c_str());
   }

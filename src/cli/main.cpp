@@ -28,19 +28,24 @@ const char* k_usage =
     "      capture + convert in one command: video in, avatar animation out.\n"
     "  avatarmap live INPUT [-o OUT.pose.jsonl] [--fps 60] [--hands] [--face] [--serve PORT]\n"
     "      Latest-frame live loop (camera, or a file paced as one) with latency figures.\n"
-    "  avatarmap view [FILE.pose.jsonl|FILE.vrma] --avatar AVATAR.vrm [--port 8080]\n"
-    "      Browser viewer: the avatar posed live (live --serve) or playing FILE.\n"
+    "  avatarmap view [FILE.pose.jsonl|FILE.vrma] [--avatar AVATAR.vrm] [--port 8080]\n"
+    "      Browser viewer: the avatar (built-in unless --avatar) posed live or playing FILE.\n"
+    "  avatarmap render ANIMATION -o OUT.mp4 [--avatar AVATAR.vrm] [--video SOURCE.mp4]\n"
+    "      A .vrma, poses or an animated .glb rendered by the viewer (headless chromium).\n"
     "  avatarmap convert IN -o OUT [--avatar AVATAR] [--rig auto|NAME|FILE.json] [--fps N]\n"
-    "      Landmarks, poses, .vrma or .bvh in; .vrma, .glb (animated avatar), .bvh or poses out.\n"
-    "  avatarmap synth -o OUT.landmarks.jsonl [--truth OUT.pose.jsonl] [--scenario clean|noisy]\n"
-    "      Writes a synthetic recording (scripted or random motion) and its ground truth;\n"
-    "      with --mocap CLIP.bvh the landmarks of a motion capture take seen by a camera.\n"
+    "      Landmarks, poses, .vrma or .bvh in; .vrma, .glb (animated avatar: the built-in one\n"
+    "      unless --avatar), .bvh or poses out.\n"
+    "  avatarmap synth -o OUT.landmarks.jsonl [--truth T.pose.jsonl] [--scenario S]\n"
+    "      Writes a synthetic recording (S: demo, clean or noisy) and its ground truth; with\n"
+    "      --mocap CLIP.bvh the landmarks of a motion capture take seen by a camera.\n"
     "  avatarmap eval-pose TRUTH.pose.jsonl SOLVED.pose.jsonl [--json]\n"
     "      Bone-direction and head-orientation errors of solved poses against the truth.\n"
     "  avatarmap eval-world TRUTH.bvh SOLVED.pose.jsonl|SOLVED.bvh [--json] [--feet-only]\n"
     "      World errors (MPJPE, lean, root, foot skate) against motion capture (synth --mocap).\n"
-    "  avatarmap demo [--keep DIR]\n"
-    "      Synthesises a recording, solves it and prints the summary (no input needed).\n"
+    "  avatarmap demo [VIDEO] [--out DIR] [--keep] [--synthetic]\n"
+    "      The main job on a built-in default: the built-in avatar rendered performing a\n"
+    "      scripted motion, captured back and animated (the round trip's error printed), or\n"
+    "      VIDEO animated; writes DIR/demo.glb, demo.vrma and demo.mp4 (no input needed).\n"
     "  avatarmap import-tfjs IMAGE.json WORLD.json --size WxH --fps F -o OUT.landmarks.jsonl\n"
     "      Converts tfjs-models' reference pose landmarks (pixels + world) to our format.\n"
     "  avatarmap backends\n"
@@ -69,6 +74,7 @@ int dispatch(const std::string& cmd, int argc, char** argv) {
   if (cmd == "eval-world") return avatarmap::cli::run_eval_world(argc, argv);
   if (cmd == "avatar") return avatarmap::cli::run_avatar(argc, argv);
   if (cmd == "view") return avatarmap::cli::run_view(argc, argv);
+  if (cmd == "render") return avatarmap::cli::run_render(argc, argv);
   if (cmd == "options") return avatarmap::cli::run_options(argc, argv);
   return -1;
 }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "avatarmap/core/option_table.hpp"
+#include "avatarmap/solve/solver_options.hpp"
 #include "cli/cli_args.hpp"
 
 namespace avatarmap::cli {
@@ -23,6 +24,40 @@ struct cli_flag {
   const char* value_name;  // "PATH", or nullptr for a switch
   const char* help;
 };
+
+/// --parts LIST (solve, convert and so animate): which of the solver's parts to solve.
+inline constexpr const char* k_parts_flag_help =
+    "comma list of body,hands,face,root: the parts to solve (default: all); a part left out "
+    "stays at rest";
+
+/// Reads --parts LIST into `parts` (unchanged without the flag). False with `error` naming an
+/// unknown or empty part.
+inline bool parse_parts_flag(args& a, solve_parts& parts, std::string& error) {
+  std::string value;
+  if (!a.value("--parts", value)) return true;
+  solve_parts p{false, false, false, false};
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t end = value.find(',', start);
+    const std::string part = value.substr(start, end == std::string::npos ? end : end - start);
+    if (part == "body")
+      p.body = true;
+    else if (part == "hands")
+      p.hands = true;
+    else if (part == "face")
+      p.face = true;
+    else if (part == "root")
+      p.hips_translation = true;
+    else {
+      error = "unknown part '" + part + "' in --parts (body,hands,face,root)";
+      return false;
+    }
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  parts = p;
+  return true;
+}
 
 /// A flag as `animate` and the usage checks see it: its name and whether it takes a value.
 struct flag_spec {

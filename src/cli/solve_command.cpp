@@ -32,7 +32,7 @@ const cli_flag k_solve_flags[] = {
      "bones not seen for up to 1.5 s filled from both sides; live: the causal One Euro filter "
      "of a live stream; none. Older names: euro = live, landmarks = One Euro on the landmarks "
      "only, both = landmarks and live"},
-    {"--parts", nullptr, "LIST", "comma list of body,hands,face,root (default: all)"},
+    {"--parts", nullptr, "LIST", k_parts_flag_help},
     {"--progress", nullptr, nullptr,
      "force the progress line (default: when stderr is a terminal)"},
     {"--quiet", nullptr, nullptr, "no progress line"},
@@ -75,31 +75,9 @@ int run_solve(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap solve: %s\n", error.c_str());
     return 2;
   }
-  if (a.value("--parts", value)) {
-    solve_parts p{false, false, false, false};
-    size_t start = 0;
-    while (start <= value.size()) {
-      size_t end = value.find(',', start);
-      std::string part =
-          value.substr(start, end == std::string::npos ? std::string::npos : end - start);
-      if (part == "body")
-        p.body = true;
-      else if (part == "hands")
-        p.hands = true;
-      else if (part == "face")
-        p.face = true;
-      else if (part == "root")
-        p.hips_translation = true;
-      else {
-        std::fprintf(stderr,
-                     "avatarmap solve: unknown part '%s' in --parts (body,hands,face,root)\n",
-                     part.c_str());
-        return 2;
-      }
-      if (end == std::string::npos) break;
-      start = end + 1;
-    }
-    job.options.parts = p;
+  if (!parse_parts_flag(a, job.options.parts, error)) {
+    std::fprintf(stderr, "avatarmap solve: %s\n", error.c_str());
+    return 2;
   }
   if (!a.error().empty() || !a.check_no_options()) {
     std::fprintf(stderr, "avatarmap solve: %s\n", a.error().c_str());

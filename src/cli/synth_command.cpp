@@ -4,24 +4,18 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <string>
 
-#include "avatarmap/avatar/builtin_avatar.hpp"
 #include "avatarmap/core/limits.hpp"
-#include "avatarmap/export/vrma.hpp"
 #include "avatarmap/io/landmark_file.hpp"
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/io/tfjs_import.hpp"
-#include "avatarmap/jobs/clip_output.hpp"
 #include "avatarmap/jobs/mocap_synth.hpp"
-#include "avatarmap/rig/bound_avatar.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_pose.hpp"
 #include "avatarmap/synth/synth_recording.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
-#include "cli/solve_job.hpp"
 #include "common/atomic_file.hpp"
 
 namespace avatarmap::cli {
@@ -263,27 +257,6 @@ bool parse_synth(args& a, synth_settings& s, std::string& err) {
   return err.empty();
 }
 
-// Writes the built-in avatar (1.70 m, the demo's person) to `avatar_path`, then `poses` on it as
-// an animated .glb at `glb_path` through the library's clip writer; `out_frames` is the count
-// written.
-status write_on_builtin_avatar(const std::vector<proxy_pose>& poses, const std::string& avatar_path,
-                               const std::string& glb_path, std::size_t& out_frames) {
-  if (status st = write_builtin_avatar(avatar_path); !st) return st;
-  bound_avatar avatar;  // bound as `convert --avatar` binds it: the file's VRM humanoid
-  if (status st = bind_avatar(avatar_path, bind_avatar_options{}, avatar); !st) return st;
-  clip_output_job out;
-  out.path = glb_path;
-  out.frames = &poses;
-  out.avatar_path = avatar_path;
-  out.avatar_rig = &avatar.rig;
-  out.avatar_binding = avatar.binding;
-  out.avatar_table = avatar.table();
-  clip_output_summary summary;
-  if (status st = out.run(summary); !st) return st;
-  out_frames = summary.frames_written;
-  return {};
-}
-
 // `synth --mocap CLIP.bvh`: landmarks of a real take (jobs/mocap_synth.hpp).
 int run_mocap_synth(args& a, const std::string& bvh) {
   std::string output, camera_json, text;
@@ -413,117 +386,6 @@ int run_synth(int argc, char** argv) {
   return 0;
 }
 
-int run_demo(int argc, char** argv) {
-  args a(argc, argv, 2);
-  if (a.flag("--help") || a.flag("-h")) {
-    std::fputs(
-        "Usage: avatarmap demo [--out DIR] [--keep DIR]\n"
-        "\n"
-        "Synthesises a 10 s recording (avatarmap synth, 2 mm noise), solves it (avatarmap solve)\n"
-        "and prints the summary, then puts the motion on the built-in avatar (avatarmap avatar):\n"
-        "DIR/avatar.vrm (the avatar), DIR/demo.glb (the avatar moving: open it in a glTF\n"
-        "viewer) and DIR/demo.vrma (the motion as VRM Animation), where DIR is --out, else\n"
-        "--keep's folder, else ./avatarmap-demo (created if needed). --keep DIR also keeps\n"
-        "demo.landmarks.jsonl and demo.pose.jsonl there; otherwise they go to a temporary\n"
-        "folder that is removed.\n",
-        stdout);
-    return 0;
-  }
-  std::string keep, out_dir;
-  a.value("--keep", keep);
-  a.value("--out", out_dir);
-  if (!a.error().empty() || !a.check_no_options() || !a.rest().empty()) {
-    std::fprintf(stderr, "avatarmap demo: %s\n",
-                 a.error().empty() ? "unexpected argument (see --help)" : a.error().c_str());
-    return 2;
-  }
-  // The results' folder first, so that a bad one fails before any work.
-  if (out_dir.empty()) out_dir = keep.empty() ? "avatarmap-demo" : keep;
-  std::error_code ec;
-  std::filesystem::create_directories(out_dir, ec);
-  if (ec) {
-    std::fprintf(stderr, "avatarmap demo: cannot create %s: %s\n", out_dir.c_str(),
-                 ec.message().c_str());
-    return 1;
-  }
-  std::string dir = keep;
-  if (dir.empty()) {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/avatarmap-demo-XXXXXX";
-    if (!mkdtemp(pattern.data())) {
-      std::perror("avatarmap demo: cannot create a temporary folder");
-      return 1;
-    }
-    dir = pattern;
-  } else {
-    std::filesystem::create_directories(dir, ec);
-    if (ec) {
-      std::fprintf(stderr, "avatarmap demo: cannot create %s: %s\n", dir.c_str(),
-                   ec.message().c_str());
-      return 1;
-    }
-  }
-  synth_settings s;
-  s.output = dir + "/demo.landmarks.jsonl";
-  s.options.body_noise_sigma = s.options.hand_noise_sigma = s.options.face_noise_sigma = 0.002f;
-  long frames = 0;
-  status st = write_synth(s, frames);
-  if (!st.ok()) {
-    std::fprintf(stderr, "avatarmap demo: %s\n", st.message().c_str());
-    return 1;
-  }
-  std::printf(
-      "synthesised %ld frames of a scripted motion (squats, waving, finger curls, "
-      "blinks, talking): %s\n",
-      frames, s.output.c_str());
-  solve_file_job job = make_cli_solve_job();
-  job.input = s.output;
-  job.output = dir + "/demo.pose.jsonl";
-  solve_file_summary summary;
-  st = run_solve_job(job, progress_mode::off, summary);
-  if (!st.ok()) {
-    std::fprintf(stderr, "avatarmap demo: %s\n", st.message().c_str());
-    return 1;
-  }
-  print_summary(job, summary, stdout);
-  // The same motion as a VRM Animation clip any VRM viewer can play.
-  std::vector<proxy_pose> poses;
-  {
-    pose_reader reader;
-    st = reader.open(job.output);
-    proxy_pose p;
-    while (st.ok() && reader.next(p) == read_result::frame) poses.push_back(p);
-  }
-  if (keep.empty()) {
-    std::remove(s.output.c_str());
-    std::remove(job.output.c_str());
-    rmdir(dir.c_str());
-  }
-  const std::string vrma = out_dir + "/demo.vrma";
-  if (st.ok()) st = write_vrma(vrma, poses);
-  if (!st.ok()) {
-    std::fprintf(stderr, "avatarmap demo: %s\n", st.message().c_str());
-    return 1;
-  }
-  std::printf("wrote %zu frames of VRM Animation to %s\n", poses.size(), vrma.c_str());
-  // The motion on the built-in avatar, the way `avatarmap convert --avatar` would write it.
-  const std::string avatar = out_dir + "/avatar.vrm", glb = out_dir + "/demo.glb";
-  std::size_t written = 0;
-  st = write_on_builtin_avatar(poses, avatar, glb, written);
-  if (!st.ok()) {
-    std::fprintf(stderr, "avatarmap demo: %s\n", st.message().c_str());
-    return 1;
-  }
-  std::printf("wrote the built-in avatar to %s and the motion on it to %s (%zu frames)\n",
-              avatar.c_str(), glb.c_str(), written);
-  const std::filesystem::path shown = std::filesystem::absolute(glb, ec);
-  std::printf(
-      "watch it in the browser viewer: avatarmap view %s --avatar %s (then open the address it\n"
-      "  prints), or open %s in a glTF viewer (Blender: File > Import > glTF 2.0, then play)\n",
-      vrma.c_str(), avatar.c_str(), ec ? glb.c_str() : shown.c_str());
-  return 0;
-}
-
 int run_import_tfjs(int argc, char** argv) {
   args a(argc, argv, 2);
   if (a.flag("--help") || a.flag("-h")) {
@@ -535,6 +397,7 @@ int run_import_tfjs(int argc, char** argv) {
         "[x_px, y_px, z] image points, and one of 33 [x, y, z] world points in metres) into\n"
         "*.landmarks.jsonl. --size is the video's size in pixels, --fps its frame rate.\n"
         "\n"
+        "  -o, --output PATH   the landmarks file to write (required; written atomically)\n"
         "  --hand left|right   the files are a hand recording (21 points per frame, e.g.\n"
         "                      asl_hand.full.json + asl_hand_3d.full.json), written as that hand\n"
         "                      (the files do not say which)\n",

@@ -61,7 +61,7 @@ status use_builtin_avatar(pose_server_options& options) {
   if (status st = builtin_avatar_glb(builtin_avatar_options{}, glb); !st) return st;
   options.avatar_path.clear();
   options.avatar_data = std::move(glb);
-  options.avatar_name = "builtin.vrm";
+  options.avatar_name = "built-in avatar";
   return {};
 }
 

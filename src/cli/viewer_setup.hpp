@@ -24,7 +24,7 @@ bool parse_host_port(const std::string& text, std::string& out_host, int& out_po
                      std::string& error);
 
 /// Makes the server show the built-in avatar (`avatarmap avatar`): its bytes in
-/// options.avatar_data, served from memory as /avatar.vrm and named "builtin.vrm" on the page
+/// options.avatar_data, served from memory as /avatar.vrm and named "built-in avatar" on the page
 /// (no file is written). Fails only when the avatar cannot be made (out of memory).
 status use_builtin_avatar(pose_server_options& options);
 

@@ -141,4 +141,38 @@ resource_lookup find_resource(resource kind, const std::string& explicit_folder)
   return out;
 }
 
+std::string program_command() {
+  char buffer[4096];
+  const ssize_t n = ::readlink("/proc/self/exe", buffer, sizeof buffer - 1);
+  if (n <= 0) return "avatarmap";
+  const std::string self(buffer, static_cast<std::size_t>(n));
+  struct stat mine {};
+  if (::stat(self.c_str(), &mine) != 0) return self;
+  // The first `avatarmap` on the PATH, as a shell would pick it (an empty entry is ".").
+  const char* path = std::getenv("PATH");
+  const std::string dirs = path != nullptr ? path : "";
+  std::size_t begin = 0;
+  while (begin <= dirs.size()) {
+    std::size_t end = dirs.find(':', begin);
+    if (end == std::string::npos) end = dirs.size();
+    std::string dir = dirs.substr(begin, end - begin);
+    if (dir.empty()) dir = ".";
+    const std::string candidate = dir + "/avatarmap";
+    struct stat st {};
+    if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
+        ::access(candidate.c_str(), X_OK) == 0)
+      return st.st_dev == mine.st_dev && st.st_ino == mine.st_ino ? "avatarmap" : self;
+    begin = end + 1;
+  }
+  return self;
+}
+
+std::string script_command(const std::string& relative) {
+#ifdef AVATARMAP_SOURCE_DIR
+  const std::string in_tree = std::string(AVATARMAP_SOURCE_DIR) + "/" + relative;
+  if (::access(in_tree.c_str(), X_OK) == 0) return in_tree;
+#endif
+  return relative + " (in a checkout of avatarmap)";
+}
+
 }  // namespace avatarmap

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 
+#include "solve/body_hold.hpp"
 #include "solve/solve_body.hpp"
 #include "solve/solve_camera.hpp"
 #include "solve/solve_face.hpp"
@@ -68,6 +69,8 @@ void frame_solver::reset() {
   expressions_held_.fill(0.f);
   last_t_ = 0.0;
   started_ = false;
+  hold_.reset();
+  hold_stats_ = {};
   const bool estimate_fov = options_.horizontal_fov_degrees == 0.f;
   const float fov = estimate_fov ? k_prior_fov_degrees : options_.horizontal_fov_degrees;
   focal_per_width_ = 0.5f / std::tan(0.5f * fov * k_deg);
@@ -171,7 +174,7 @@ void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const
   prepare_frame(in, options_, focal_per_width_, f, fit_frame(in, false, fit));
   for (int side = 0; side < 2; ++side)  // the shapes learnt so far; nothing learnt
     if (fits_hand(f, side)) hand_shapes_[side].fit(f.hand[side].p, f.hand[side].c);
-  measure_prepared(in, f, m);
+  measure_prepared(in, f, hold_.state(), m);
 }
 
 bool frame_solver::fits_hand(const prepared_frame& f, int side) const {
@@ -180,7 +183,7 @@ bool frame_solver::fits_hand(const prepared_frame& f, int side) const {
 }
 
 void frame_solver::measure_prepared(const landmark_frame& in, const prepared_frame& f,
-                                    frame_measurement& m) const {
+                                    body_follow follow, frame_measurement& m) const {
   for (auto& b : m.bones) b.confidence = 0.f;  // the other fields are written with it
   m.hips_height_valid = m.hips_ground_valid = m.expressions_valid = false;
   m.expressions.fill(0.f);
@@ -189,6 +192,8 @@ void frame_solver::measure_prepared(const landmark_frame& in, const prepared_fra
                                  have_arm_reference_[1] ? &arm_reference_[1] : nullptr};
   measure_body(f, options_, arm_ref, m);
   measure_hips_position(in, f, options_, m);
+  // A body that is not a person's, or legs not seen: the lower body at rest (body_hold.hpp).
+  if (options_.parts.body) hold_body(follow, options_.lower_body_rest, f, options_, m);
   measure_hands(f, options_, m);  // after the body: replaces its coarse wrists
   // Coupling body -> face: the neck turns relative to the upper chest, this frame's when
   // measured, else the one shown last.
@@ -221,7 +226,21 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
   // Stage 1b: each hand fitted to the shape learnt so far, then learnt from (one alignment).
   for (int side = 0; side < 2; ++side)
     if (fits_hand(f, side)) hand_shapes_[side].fit_and_learn(f.hand[side].p, f.hand[side].c);
-  measure_prepared(in, f, m);
+  body_follow follow = body_follow::all;
+  if (options_.parts.body && options_.lower_body_rest != body_rest::off) {
+    const body_verdict v = judge_body(in, options_.image_width, options_.image_height);
+    follow = hold_.update(v, t);
+    if (v.has_body) {
+      ++hold_stats_.frames;
+      if (follow != body_follow::all) {
+        ++hold_stats_.held_frames;
+        if (follow == body_follow::limbs_off) ++hold_stats_.limbs_off_frames;
+        for (int i = 0; i < k_body_doubt_count; ++i)
+          if ((v.doubts >> i) & 1u) ++hold_stats_.doubt_frames[i];
+      }
+    }
+  }
+  measure_prepared(in, f, follow, m);
   for (int side = 0; side < 2; ++side) {  // the next frame's straight-arm twist reference
     const bone_measurement& ua =
         m.bones[idx(side == 0 ? bone::left_upper_arm : bone::right_upper_arm)];

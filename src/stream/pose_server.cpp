@@ -154,6 +154,12 @@ status pose_server_options::validate() const {
     return status::error("pose server: give the avatar as avatar_path or as avatar_data, not both");
   if (!clip_path.empty() && !is_file(clip_path))
     return status::error("pose server: clip '" + clip_path + "' is not a readable file");
+  if (!poses_path.empty() && !is_file(poses_path))
+    return status::error("pose server: poses '" + poses_path + "' is not a readable file");
+  if (!poses_path.empty() && !poses_data.empty())
+    return status::error("pose server: give the poses as poses_path or as poses_data, not both");
+  if (!video_path.empty() && !is_file(video_path))
+    return status::error("pose server: video '" + video_path + "' is not a readable file");
   return {};
 }
 
@@ -481,6 +487,11 @@ const char* mime_of(std::string_view path) {
   if (ends(".json")) return "application/json";
   if (ends(".vrm") || ends(".vrma") || ends(".glb")) return "model/gltf-binary";
   if (ends(".png")) return "image/png";
+  if (ends(".jsonl")) return "application/x-ndjson";
+  if (ends(".mp4") || ends(".m4v")) return "video/mp4";
+  if (ends(".webm")) return "video/webm";
+  if (ends(".ogv")) return "video/ogg";
+  if (ends(".mov")) return "video/quicktime";
   return nullptr;  // not served
 }
 
@@ -489,6 +500,8 @@ std::string route(const server_state& s, std::string_view path) {
   if (path == "/" || path == "/index.html") return s.options.page_dir + "/index.html";
   if (path == "/avatar.vrm") return s.options.avatar_path;
   if (path == "/clip.vrma") return s.options.clip_path;
+  if (path == "/poses.pose.jsonl") return s.options.poses_path;
+  if (path == "/video") return s.options.video_path;
   constexpr std::string_view modules = "/modules/";
   if (path.substr(0, modules.size()) == modules) {
     std::string_view rest = path.substr(modules.size());
@@ -562,10 +575,17 @@ int http_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, s
         return serve_memory(wsi, s, session, s.config_json, "application/json", true);
       if (path == "/avatar.vrm" && s.options.avatar_path.empty() && !s.options.avatar_data.empty())
         return serve_memory(wsi, s, session, s.options.avatar_data, "model/gltf-binary", false);
+      if (path == "/poses.pose.jsonl" && s.options.poses_path.empty() &&
+          !s.options.poses_data.empty())
+        return serve_memory(wsi, s, session, s.options.poses_data, "application/x-ndjson", true);
       const std::string file = route(s, path);
       // The avatar and the clip are glTF binaries whatever their names end with.
-      const char* mime =
-          path == "/avatar.vrm" || path == "/clip.vrma" ? "model/gltf-binary" : mime_of(file);
+      std::string lower_file = file;
+      for (char& c : lower_file) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      const char* mime = path == "/avatar.vrm" || path == "/clip.vrma" ? "model/gltf-binary"
+                         : path == "/poses.pose.jsonl"                 ? "application/x-ndjson"
+                         : path == "/video"                            ? mime_of(lower_file)
+                                                                       : mime_of(file);
       if (file.empty() || !mime || !is_file(file))
         return refuse(wsi, HTTP_STATUS_NOT_FOUND, "not found");
       const int n = lws_serve_http_file(wsi, file.c_str(), mime, s.file_headers.c_str(),
@@ -745,6 +765,13 @@ status pose_server::start(const pose_server_options& options) {
                           : has_avatar                   ? std::string("avatar.vrm")
                                                          : std::string();
   config["clip_name"] = base_name(options.clip_path);
+  config["avatar_animated"] = options.avatar_animated;
+  const bool has_poses = !options.poses_path.empty() || !options.poses_data.empty();
+  config["poses"] = has_poses ? nlohmann::json("/poses.pose.jsonl") : nlohmann::json();
+  config["poses_name"] =
+      !options.poses_name.empty() ? options.poses_name : base_name(options.poses_path);
+  config["video"] = options.video_path.empty() ? nlohmann::json() : nlohmann::json("/video");
+  config["video_name"] = base_name(options.video_path);
   s.config_json = config.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   s.file_headers.clear();
   for (const auto& h : k_file_headers) s.file_headers += std::string(h[0]) + " " + h[1] + "\r\n";

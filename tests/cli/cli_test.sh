@@ -78,6 +78,119 @@ synth_input() {
 }
 
 case $case_name in
+  glb_builtin)
+    # A .glb without --avatar carries the built-in avatar, as `avatarmap avatar` writes it:
+    # the same file as with --avatar set to that avatar, loaded by our own loader (inspect) as
+    # the VRM 1.0 avatar, and its animation (read here by an independent GLB reader) drives
+    # the avatar's humanoid bones and moves over time.
+    synth_input in.landmarks.jsonl 2 || exit 1
+    run 0 solve in.landmarks.jsonl -o in.pose.jsonl
+    run 0 avatar -o builtin.vrm
+    run 0 convert in.pose.jsonl -o default.glb
+    expect_in err.txt "avatar (built-in):"
+    expect_in err.txt "wrote default.glb"
+    run 0 convert in.pose.jsonl -o given.glb --avatar builtin.vrm
+    cmp -s default.glb given.glb || fail "default.glb differs from the same motion on builtin.vrm"
+    run 0 convert in.landmarks.jsonl -o landmarks.glb
+    ls "$dir" "${TMPDIR:-/tmp}" | grep -F "avatarmap-builtin-" | grep -q . &&
+      fail "the built-in avatar's temporary file was left: $(ls "${TMPDIR:-/tmp}" | grep builtin)"
+    run 0 inspect default.glb --json
+    python3 - out.txt builtin.vrm default.glb <<'PY' || fail "default.glb is not the built-in avatar animated"
+import json, struct, sys
+def glb_json(path):
+    b = open(path, "rb").read()
+    assert b[:4] == b"glTF", path
+    n, kind = struct.unpack_from("<II", b, 12)
+    assert kind == 0x4E4F534A, "first chunk is not JSON"
+    return json.loads(b[20:20 + n]), b[20 + n + 8:]
+info = json.load(open(sys.argv[1]))
+assert info["format"] == "vrm1", info["format"]
+avatar, _ = glb_json(sys.argv[2])
+out, binary = glb_json(sys.argv[3])
+human = avatar["extensions"]["VRMC_vrm"]["humanoid"]["humanBones"]
+names = {avatar["nodes"][v["node"]]["name"]: k for k, v in human.items()}
+assert [n["name"] for n in out["nodes"]] == [n["name"] for n in avatar["nodes"]], "nodes differ"
+anims = out.get("animations", [])
+assert len(anims) == 1, "%d animations" % len(anims)
+rotated = set()
+for ch in anims[0]["channels"]:
+    if ch["target"]["path"] != "rotation":
+        continue
+    node = out["nodes"][ch["target"]["node"]]["name"]
+    assert node in names, "a channel drives %s, no humanoid bone" % node
+    acc = out["accessors"][anims[0]["samplers"][ch["sampler"]]["output"]]
+    view = out["bufferViews"][acc["bufferView"]]
+    start = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
+    q = struct.unpack_from("<%df" % (4 * acc["count"]), binary, start)
+    frames = [q[i:i + 4] for i in range(0, len(q), 4)]
+    if max(abs(a - b) for f in frames for a, b in zip(f, frames[0])) > 0.05:
+        rotated.add(names[node])
+for bone in ("hips", "leftUpperArm", "rightLowerArm", "leftUpperLeg", "head"):
+    assert bone in rotated, "%s does not move (moving: %s)" % (bone, sorted(rotated))
+print("channels on", len(rotated), "moving bones")
+PY
+    if needs data models; then
+      run 0 animate "$AVATARMAP_TEST_DATA/motion/tfjs-models/pose_squats.mp4" -o squats.glb \
+        --models "$AVATARMAP_MODELS/onnx" --body-only --seconds 1
+      expect_in err.txt "avatar (built-in):"
+      run 0 inspect squats.glb
+      expect_in out.txt "declared: 55 of 55 bones"
+    fi
+    ;;
+  help_tables)
+    # --help against what each command takes. 1. The top-level usage: each flag it shows for a
+    # command is one that command lists in its own --help and accepts. 2. Each flag a command's
+    # source declares by hand (a "--name" literal in src/cli; the option tables' flags are
+    # listed from the tables themselves) and that the command accepts is in its --help.
+    # "Accepts": given with a dummy value and an input that does not exist, the command does
+    # not answer "unknown option" (case help_options checks each listed flag the same way).
+    src_cli="$(cd "$(dirname "$0")/../../src/cli" && pwd)"
+    accepts() {  # accepts CMD FLAG
+      timeout 20 "$exe" "$1" missing-input.nothing "$2" x >acc_out.txt 2>acc_err.txt </dev/null
+      ! grep -qE -- "unknown option $2( |\$)" acc_err.txt
+    }
+    listed() {  # listed CMD FLAG: FLAG in a usage line or the option column of CMD --help
+      [ -f "help.$1.txt" ] || "$exe" "$1" --help 2>/dev/null |
+        grep -E '^( {1,4}-|Usage: |  avatarmap )' | sed -E 's/^ +//; s/  .*//' >"help.$1.txt"
+      grep -qE -- "(^|[][ /,|])$2([][ ,=/|]|\$)" "help.$1.txt"
+    }
+    run 0 --help
+    grep -E '^  avatarmap [a-z]' out.txt >usage_lines.txt
+    [ -s usage_lines.txt ] || fail "avatarmap --help lists no commands"
+    while read -r _ cmd rest; do
+      for flag in $(printf '%s\n' "$rest" | grep -oE -- '(^| |\[)--?[a-zA-Z][a-zA-Z0-9-]*' |
+        grep -oE -- '--?[a-zA-Z][a-zA-Z0-9-]*' | sort -u); do
+        listed "$cmd" "$flag" ||
+          fail "avatarmap --help shows $cmd $flag, which \`avatarmap $cmd --help\` does not list"
+        accepts "$cmd" "$flag" || fail "avatarmap --help shows $cmd $flag, which $cmd refuses"
+      done
+    done <usage_lines.txt
+    # Hidden on purpose: convert --dump-positions (a diagnostic, see convert_command.cpp).
+    hidden=" --dump-positions "
+    declare -A files=(
+      [solve]="solve_command.cpp solve_job.cpp" [convert]="convert_command.cpp"
+      [capture]="capture_command.cpp capture_setup.cpp overlay_output.cpp"
+      [animate]="animate_command.cpp" [live]="live_command.cpp live_vmc.cpp"
+      [view]="view_command.cpp viewer_setup.cpp" [synth]="synth_command.cpp"
+      [demo]="demo_command.cpp" [import-tfjs]="synth_command.cpp"
+      [eval-pose]="eval_command.cpp" [eval-world]="eval_world_command.cpp"
+      [inspect]="inspect_command.cpp" [avatar]="avatar_command.cpp"
+      [backends]="other_commands.cpp" [options]="other_commands.cpp" [render]="render_command.cpp")
+    checked=0
+    for cmd in "${!files[@]}"; do
+      flags=$(cd "$src_cli" && cat ${files[$cmd]} 2>/dev/null |
+        grep -oE -- '"--[a-z][a-z0-9-]*"' | tr -d '"' | sort -u)
+      for flag in $flags; do
+        case "$hidden" in *" $flag "*) continue ;; esac
+        case "$flag" in --help) continue ;; esac
+        if accepts "$cmd" "$flag"; then
+          checked=$((checked + 1))
+          listed "$cmd" "$flag" || fail "$cmd accepts $flag, which its --help does not list"
+        fi
+      done
+    done
+    [ "$checked" -ge 60 ] || fail "only $checked accepted flags found in the sources"
+    ;;
   help)
     run 0 --help
     expect_in out.txt "Usage:"
@@ -200,8 +313,7 @@ assert [a["hips_position"] for a in on] != [a["hips_position"] for a in off]' ||
     expect_in out.bvh "HIERARCHY"
     expect_in out.bvh "Frame Time: 0.01666"
     run 0 convert in.landmarks.jsonl -o out.pose.jsonl
-    run 2 convert in.landmarks.jsonl -o out.glb
-    expect_in err.txt "--avatar"
+    # .glb without --avatar: the built-in avatar (case glb_builtin).
     run 2 convert in.landmarks.jsonl -o out.fbx
     expect_in err.txt ".vrma, .glb, .bvh or .pose.jsonl"
     run 1 convert missing.landmarks.jsonl -o x.vrma
@@ -329,8 +441,9 @@ open('black.png','wb').write(b'\\x89PNG\\r\\n\\x1a\\n'+chunk(b'IHDR',struct.pack
     run 2 animate in.mp4
     run 2 animate in.mp4 -o out.txt
     expect_in err.txt ".vrma, .glb, .bvh or .pose.jsonl"
-    run 2 animate in.mp4 -o out.glb
-    expect_in err.txt "--avatar"
+    run 1 animate missing.mp4 -o out.glb  # .glb needs no --avatar (the built-in avatar)
+    expect_in err.txt "missing.mp4"
+    [ -e out.glb ] && fail "a failed animate wrote its output"
     run 2 animate in.mp4 -o out.vrma --bogus
     expect_in err.txt "unknown option --bogus"
     # Every option `animate --help` lists is taken: case help_options (all commands).
@@ -470,6 +583,11 @@ for g in groups:
 if len(groups) != want or bad or "Hips" not in names:
     print("bundles at oscdump: %d (want %d), malformed: %d %s" % (len(groups), want, len(bad), bad[:2]))
     sys.exit(1)
+# /VMC/Ext/T strictly increasing, as oscdump prints it (six decimals).
+same = [(i, a) for i, (a, b) in enumerate(zip(times, times[1:])) if not b > a]
+if same:
+    print("/VMC/Ext/T not increasing at bundle(s) %s" % same[:5])
+    sys.exit(1)
 print("oscdump: %d bundles of %d bones" % (len(groups), bones))
 PY
         done
@@ -559,31 +677,101 @@ PY
     [ -e x.landmarks.jsonl ] && fail "a synth usage error wrote the output file"
     ;;
   demo)
+    # The synthetic path (no video): what the demo falls back to without models or Chromium.
     mkdir tmp
-    TMPDIR="$dir/tmp" run 0 demo
+    TMPDIR="$dir/tmp" run 0 demo --synthetic
     [ -z "$(ls -A tmp)" ] || fail "demo left files in TMPDIR: $(ls -A tmp)"
-    expect_in out.txt "solved 300 frames"
-    expect_in out.txt "wrote 300 poses"
+    expect_in out.txt "solved 240 frames"
+    expect_in out.txt "wrote 240 poses"
+    # The solve's error against the truth the synthesiser played (2 mm noise): small.
+    err_deg=$(sed -nE 's/.*error against the motion played \(240 frames\): bone directions ([0-9.]+) deg.*/\1/p' out.txt)
+    [ -n "$err_deg" ] || fail "demo printed no error against the motion played"
+    awk -v e="${err_deg:-99}" 'BEGIN { exit !(e < 5) }' || fail "demo's solve error $err_deg deg, expected < 5"
     # The motion on the built-in avatar, in ./avatarmap-demo by default.
     for f in avatar.vrm demo.glb demo.vrma; do
       [ "$(head -c 4 "avatarmap-demo/$f" 2>/dev/null)" = glTF ] || fail "demo did not write avatarmap-demo/$f"
     done
-    expect_in out.txt "the motion on it to avatarmap-demo/demo.glb (300 frames)"
-    expect_in out.txt "watch it in the browser viewer: avatarmap view avatarmap-demo/demo.vrma --avatar avatarmap-demo/avatar.vrm"
-    expect_in out.txt "open $dir/avatarmap-demo/demo.glb in a glTF viewer"
+    [ -e avatarmap-demo/demo.mp4 ] && fail "demo --synthetic wrote a video"
+    expect_in out.txt "avatarmap-demo/demo.glb (240 frames on it)"
+    # The command it prints runs: the binary's path while `avatarmap` on the PATH is another
+    # program (or none), `avatarmap` when it is this one.
+    expect_in out.txt "  $(realpath "$exe") view avatarmap-demo/demo.glb    (then open"
+    mkdir -p onpath && ln -sf "$exe" onpath/avatarmap
+    PATH="$dir/onpath:$PATH" run 0 demo --synthetic --seconds 2
+    expect_in out.txt "  avatarmap view avatarmap-demo/demo.glb    (then open"
+    expect_in out.txt "solved 60 frames"
     run 0 inspect avatarmap-demo/demo.glb
     expect_in out.txt "declared: 55 of 55 bones"
-    run 0 demo --keep "$dir/kept/new"
-    expect_in out.txt "solved 300 frames"
-    [ -s "$dir/kept/new/demo.landmarks.jsonl" ] || fail "demo --keep did not keep the landmarks"
-    [ -s "$dir/kept/new/demo.pose.jsonl" ] || fail "demo --keep did not keep the poses"
-    [ -s "$dir/kept/new/demo.glb" ] || fail "demo --keep did not put demo.glb there"
-    run 0 demo --out "$dir/elsewhere"
+    run 0 demo --synthetic --keep --out "$dir/kept/new" --seconds 2
+    for f in truth.pose.jsonl demo.landmarks.jsonl demo.pose.jsonl demo.glb; do
+      [ -s "$dir/kept/new/$f" ] || fail "demo --keep did not keep $f"
+    done
+    run 0 demo --synthetic --out "$dir/elsewhere" --seconds 2
     [ -s "$dir/elsewhere/demo.glb" ] && [ -s "$dir/elsewhere/avatar.vrm" ] ||
       fail "demo --out did not write there"
     : >blocker
-    run 1 demo --out blocker/x
+    run 1 demo --synthetic --out blocker/x
     expect_in err.txt "blocker/x"
+    run 2 demo --seconds 0
+    expect_in err.txt "--seconds"
+    run 2 demo a.mp4 b.mp4
+    expect_in err.txt "at most one VIDEO"
+    run 2 demo missing.mp4
+    expect_in err.txt "missing.mp4"
+    run 2 demo --frobnicate
+    ;;
+  demo_video)
+    # The README's first command's real path: the built-in avatar rendered (Chromium), captured
+    # back (the models), solved and rendered beside its source; a short, small clip.
+    if needs models && command -v chromium >/dev/null && command -v ffprobe >/dev/null; then
+      run 0 demo --seconds 3 --size 320x240 --out out
+      for f in source.mp4 demo.mp4 demo.glb demo.vrma avatar.vrm; do
+        [ -s "out/$f" ] || fail "demo did not write out/$f"
+      done
+      frames() { ffprobe -v error -count_frames -select_streams v:0 -show_entries \
+        stream=nb_read_frames,width -of csv=p=0 "$1"; }
+      [ "$(frames out/source.mp4)" = "320,90" ] || fail "source.mp4: $(frames out/source.mp4), expected 320 wide, 90 frames"
+      [ "$(frames out/demo.mp4)" = "640,90" ] || fail "demo.mp4: $(frames out/demo.mp4), expected 640 wide (side by side), 90 frames"
+      expect_in out.txt "round trip (render -> capture -> solve) error against the motion played (90 frames)"
+      # The body comes back (hands at 320x240 are a few pixels: not checked).
+      torso=$(sed -nE 's/.*round trip.*\(torso ([0-9.]+), arms ([0-9.]+), legs ([0-9.]+).*/\1 \2 \3/p' out.txt)
+      awk -v t="$torso" 'BEGIN { split(t, v, " "); exit !(v[1] != "" && v[1] < 20 && v[2] < 35 && v[3] < 30) }' ||
+        fail "round trip torso/arms/legs errors too large: $torso"
+      expect_in out.txt "view out/demo.glb --video out/source.mp4"
+    else
+      command -v chromium >/dev/null || skipped="${skipped:+$skipped; }no chromium"
+      command -v ffprobe >/dev/null || skipped="${skipped:+$skipped; }no ffprobe"
+    fi
+    ;;
+  closeup)
+    # A hand close-up (a forearm in the frame) animated with the defaults: the body's points
+    # are guesses, so the hips and legs stay at rest while the fingers move.
+    if needs data models; then
+      run 0 animate "$AVATARMAP_TEST_DATA/motion/tfjs-models/asl_hand.25fps.mp4" -o asl.pose.jsonl --quiet
+      /usr/bin/python3 - asl.pose.jsonl <<'PY' || fail "the close-up's body moved (see above)"
+import json, math, sys
+bones = ("hips", "leftUpperLeg", "rightUpperLeg", "leftLowerLeg", "rightLowerLeg")
+first, hy, worst, fingers = {}, [], 0.0, 0.0
+def angle(a, b):
+    d = abs(sum(x * y for x, y in zip(a, b)))
+    return math.degrees(2 * math.acos(min(1.0, d)))
+f0 = None
+for line in open(sys.argv[1]):
+    p = json.loads(line)
+    if "hips_position" not in p:
+        continue
+    hy.append(p["hips_position"][1])
+    r = p["bones"]
+    for b in bones:
+        first.setdefault(b, r[b])
+        worst = max(worst, angle(first[b], r[b]))
+    f0 = f0 or r["rightIndexProximal"]
+    fingers = max(fingers, angle(f0, r["rightIndexProximal"]), angle(f0, r.get("leftIndexProximal", f0)))
+print("frames %d, hips height range %.2f cm, largest hips/leg change %.2f deg, finger change %.1f deg"
+      % (len(hy), 100 * (max(hy) - min(hy)), worst, fingers))
+sys.exit(0 if len(hy) > 100 and max(hy) - min(hy) < 0.01 and worst < 1.0 and fingers > 20 else 1)
+PY
+    fi
     ;;
   avatar)
     run 0 avatar -o me.vrm

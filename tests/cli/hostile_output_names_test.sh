@@ -2,7 +2,7 @@
 # Output names and the clips behind them through the tool (issue 9, one writer table): every
 # command that writes a clip chooses the format from the output's extension in any case
 # (.VRMA is a .vrma), refuses an unknown one before any work with one message that lists the
-# formats, refuses .glb without an avatar, and refuses to scale root motion by a standing hips
+# formats, writes .glb without an avatar on the built-in one, and refuses to scale root motion by a standing hips
 # height that is not above the floor; a refused run writes nothing and keeps an existing file.
 # Usage: hostile_output_names_test.sh AVATARMAP_EXE WORK_DIR. Prints "N passed, N failed".
 source "$(dirname "$0")/hostile_lib.sh" "$@"
@@ -28,11 +28,13 @@ kept keep.fbx precious
 run 2 animate no-such-video.mp4 -o out.fbx
 expect_in err.txt "out.fbx: unknown output format; the name must end in .vrma, .glb, .bvh or .pose.jsonl"
 absent out.fbx
-run 2 convert clip.landmarks.jsonl -o out.GLB
-expect_in err.txt ".glb output needs --avatar"
-absent out.GLB
-run 2 animate no-such-video.mp4 -o out.Glb
-expect_in err.txt ".glb output needs --avatar"
+# --- .glb in any case without --avatar: the built-in avatar ------------------------------------
+run 0 convert clip.landmarks.jsonl -o out.GLB
+expect_in err.txt "avatar (built-in):"
+expect_in out.GLB "VRMC_vrm"
+run 1 animate no-such-video.mp4 -o out.Glb
+expect_in err.txt "no-such-video.mp4"
+absent out.Glb
 
 # --- root motion needs hips above the floor -------------------------------------------------------
 data=${AVATARMAP_TEST_DATA:-}

@@ -15,7 +15,7 @@ run ok view --help
 expect_in out.txt "--connect"
 expect_in out.txt "--allow-host"
 run 2 view take.mp4 --avatar me.vrm
-expect_in err.txt "FILE must be a .pose.jsonl or a .vrma"
+expect_in err.txt "FILE must be a .pose.jsonl, .vrma, .glb (an avatar with its animation) or .bvh"
 printf '{"t":0}\n' >one.pose.jsonl
 run 2 view one.pose.jsonl --avatar me.vrm --connect 9000
 expect_in err.txt "two sources of poses"
@@ -121,7 +121,7 @@ vport=$(sed -n 's|^http://127.0.0.1:\([0-9]*\)/$|\1|p' b.txt)
 [ -n "$vport" ] && pass || fail "view with a planted temporary name printed no URL: $(cat b.err)"
 planted=$(ls tmp)
 [ "$(http_get "$vport" /config.json "127.0.0.1:$vport" config.txt)" = 200 ] && pass || fail "no /config.json"
-expect_in config.txt '"avatar_name":"builtin.vrm"'
+expect_in config.txt '"avatar_name":"built-in avatar"'
 for load in 1 2 3; do
   [ "$(http_get "$vport" /avatar.vrm "localhost:$vport" "avatar$load.txt")" = 200 ] && pass ||
     fail "load $load of /avatar.vrm failed"

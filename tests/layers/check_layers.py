@@ -26,6 +26,7 @@ PUBLIC = {
     "capture": ["capture"],
     "live": ["live"],
     "stream": ["stream"],
+    "render": ["render"],
 }
 # Which layers each layer may use (its own included), from the targets' link lines.
 BELOW = {
@@ -38,6 +39,7 @@ BELOW = {
     "capture": {"media", "io", "solve"},
     "live": {"capture", "media", "io", "solve", "rig", "stream"},
     "stream": {"rig", "io", "solve"},
+    "render": {"stream", "capture", "media", "rig", "io", "solve"},
 }
 FRONT_ENDS = {"cli": os.path.join("src", "cli"), "c": os.path.join("bindings", "c", "src")}
 TEST_FRONT_ENDS = {"c", "cli", "python", "package", "interop", "viewer", "convert", "support",

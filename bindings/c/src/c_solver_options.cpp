@@ -70,6 +70,7 @@ constexpr c_field k_fields[] = {
     AVM_FIELD(fit_body_to_image),
     AVM_FIELD(foot_contacts),
     AVM_FIELD(root_follows_contacts),
+    AVM_FIELD(lower_body_rest),
 };
 #undef AVM_FIELD
 static_assert(sizeof(k_fields) / sizeof(k_fields[0]) * 4 + 4 == sizeof(avm_solver_options),

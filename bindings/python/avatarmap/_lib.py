@@ -108,12 +108,14 @@ class AvmSolverOptions(ctypes.Structure):
         ("file_filter", _I32), ("file_smoothing", _F32), ("file_threads", _I32),
         ("fit_hand_shape", _I32), ("fit_body_to_image", _I32),
         ("foot_contacts", _I32), ("root_follows_contacts", _I32),
+        ("lower_body_rest", _I32),
     ]
     _kinds_ = {name: BOOL for name in (
         "mirror", "solve_body", "solve_hands", "solve_face", "solve_hips_translation",
         "filter_rotations", "filter_position", "filter_expressions", "fit_hand_shape",
         "fit_body_to_image", "foot_contacts", "root_follows_contacts")}
     _ranges_ = {"file_filter": (0, 2),  # avm_file_filter
+                "lower_body_rest": (0, 2),  # standing, sitting, off
                 "file_threads": (1, 2)}
 
 

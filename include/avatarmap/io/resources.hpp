@@ -59,4 +59,16 @@ const char* resource_environment(resource kind);
 /// long as no other thread changes the environment. Never throws except std::bad_alloc.
 resource_lookup find_resource(resource kind, const std::string& explicit_folder = {});
 
+/// How a message should write a command of this program so that it runs when copied into a
+/// shell: "avatarmap" when the first `avatarmap` on $PATH is the running executable (the same
+/// file), else the running executable's absolute path (a build folder, an install whose bin/ is
+/// not on the PATH), else "avatarmap" when that path is unknown. For the CLI's messages (the C
+/// API's code runs in another program: it gives that program's path).
+std::string program_command();
+
+/// How a message should name the project script `relative` ("scripts/prepare_capture.sh") so
+/// that it runs from any folder: its absolute path in the source tree this was built from
+/// when it is there, else `relative` followed by " (in a checkout of avatarmap)".
+std::string script_command(const std::string& relative);
+
 }  // namespace avatarmap

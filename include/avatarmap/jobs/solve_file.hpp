@@ -19,6 +19,7 @@
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
+#include "avatarmap/solve/body_plausibility.hpp"
 #include "avatarmap/solve/solver_options.hpp"
 #include "avatarmap/time/filter_rules.hpp"  // pose_filter_mode, pose_filter_channels
 #include "avatarmap/time/offline_smoother.hpp"
@@ -68,6 +69,11 @@ struct solve_file_summary {
   float camera_roll_degrees = 0.f;
   long gravity_evidence_frames = 0;
   long floor_evidence_points = 0;  // the feet's resting points, when the floor decided
+  /// Frames whose lower body was held at rest (solver_options::lower_body_rest; the body's
+  /// points not a person's, or the legs not seen), among body_frames frames with a body; of
+  /// them, those whose spine and arms were not followed either, and how many had each doubt
+  /// (solve/body_plausibility.hpp, bit index order). A warning says it when any was held.
+  body_hold_stats body_hold{};
 };
 
 /// The job. Fill the inputs, call run(). Thread-safety: a job may be run from any thread; the

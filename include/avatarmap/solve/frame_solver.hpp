@@ -14,6 +14,7 @@
 
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
+#include "avatarmap/solve/body_plausibility.hpp"
 #include "avatarmap/solve/confidence_gate.hpp"
 #include "avatarmap/solve/hand_shape.hpp"
 #include "avatarmap/solve/solver_options.hpp"
@@ -110,6 +111,12 @@ class frame_solver {
   long floor_evidence_points() const;
   /// The shape learnt of the avatar's left (0) or right (1) hand (options().fit_hand_shape).
   const hand_shape& learnt_hand(int side) const { return hand_shapes_[side != 0 ? 1 : 0]; }
+  /// Frames of this take whose lower body was held at rest because the body was not
+  /// plausible or the legs not seen (options().lower_body_rest; body_plausibility.hpp), and
+  /// why. restart_take() and reset() start the count again.
+  const body_hold_stats& hold_stats() const { return hold_stats_; }
+  /// How much of the body the last solved frame followed.
+  body_follow body_follow_state() const { return hold_.state(); }
 
  private:
   // The gate stage (src/solve/solve_gate.cpp): this frame's measurement -> what is shown.
@@ -128,7 +135,7 @@ class frame_solver {
   bool fits_hand(const solve_detail::prepared_frame& f, int side) const;
   // The measuring stages on a prepared frame whose hands are fitted already.
   void measure_prepared(const landmark_frame& in, const solve_detail::prepared_frame& f,
-                        frame_measurement& m) const;
+                        body_follow follow, frame_measurement& m) const;
 
   solver_options options_;
   float focal_per_width_ = 1.f;  // focal length / image width, from the field of view
@@ -158,6 +165,8 @@ class frame_solver {
   bool started_ = false;
   mutable frame_measurement scratch_{};
   std::array<hand_shape, 2> hand_shapes_{};  // avatar's left, right (canonical space)
+  body_hold hold_{};  // whether the body is followed (hysteresis over frames)
+  body_hold_stats hold_stats_{};
   // The body fit's state (allocated once, at construction): segment lengths learnt over the
   // take, the camera's gravity, this frame's fit.
   std::unique_ptr<solve_detail::body_lengths> lengths_;

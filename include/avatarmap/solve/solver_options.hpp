@@ -35,6 +35,14 @@ struct confidence_options {
   float regain_seconds = 0.15f;
 };
 
+/// Where the lower body is held while the body's points are not a person's or the legs are not
+/// seen (solve/body_plausibility.hpp; docs/solver.md, "Bodies that are not followed").
+enum class body_rest : int {
+  standing = 0,  ///< hips upright at rest_hips_height, legs straight down
+  sitting = 1,   ///< thighs forward, shins down, hips at 0.52 rest_hips_height
+  off = 2,       ///< never held: every measured body is followed (before 0.1.0's rule)
+};
+
 struct solver_options {
   /// Mirror the performer: swap left and right and flip X (for mirrored webcam previews).
   bool mirror = false;
@@ -69,6 +77,11 @@ struct solver_options {
   /// roll learnt from the standing body. Needs image_width/height; false = BlazePose's world
   /// points as they are (they lean toward the camera) in the camera's axes.
   bool fit_body_to_image = true;
+  /// The rest the lower body (hips, legs, feet, root) is held at on frames whose body is not
+  /// plausible (legs above the hips, a torso larger than the image, bones no person has) or
+  /// whose lower body is not seen (a desk webcam's framing), decided with a few frames of
+  /// hysteresis; the arms (when the torso is plausible), hands and face keep driving.
+  body_rest lower_body_rest = body_rest::standing;
 
   /// Checks every field against k_solver_option_table (the message names the field and its
   /// range), then image_width and image_height both given or neither, and lost_below <=
@@ -158,6 +171,14 @@ inline constexpr option_row<solver_options> k_solver_option_table[] = {
               "(default: the body fitted to the image points through the camera, with the "
               "take's bone lengths, and turned upright by the camera's pitch and roll; "
               "docs/solver.md)"),
+    option_row<solver_options>("lower_body_rest",
+                               AVATARMAP_OPTION_FIELD(solver_options, lower_body_rest))
+        .choices("standing|sitting|off")
+        .cli("--lower-body-rest")
+        .help("where the hips and legs are held while the body's points are not a person's "
+              "(legs above the hips, a torso larger than the image, impossible bone lengths) "
+              "or the legs are not seen (upper-body framing): standing, sitting, or off "
+              "(always follow them); arms, hands and face still drive (docs/solver.md)"),
 };
 
 inline status solver_options::validate() const {

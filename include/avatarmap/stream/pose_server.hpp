@@ -60,6 +60,18 @@ struct pose_server_options {
   std::string avatar_name;
   /// VRM Animation (.vrma) the page plays in a loop, served as /clip.vrma; empty = none.
   std::string clip_path;
+  /// The avatar file holds its own animation (a .glb as `avatarmap convert -o x.glb` writes):
+  /// the page plays the first glTF animation on it with its controls.
+  bool avatar_animated = false;
+  /// Proxy poses (*.pose.jsonl text) the page fetches whole and plays itself by their time
+  /// stamps with its controls, served as /poses.pose.jsonl: the file poses_path, else the bytes
+  /// of poses_data from memory; empty = none. poses_name: the name the page shows.
+  std::string poses_path;
+  std::string poses_data;
+  std::string poses_name;
+  /// A video (.mp4, .webm, .ogv, .mov) the page shows beside the avatar in step with the
+  /// animation's time, served whole (no Range requests) as /video; empty = none.
+  std::string video_path;
   /// WebSocket URL the page takes its poses from; empty = this server's own k_pose_socket_path.
   /// (`avatarmap view --connect PORT` points the page at a `live --serve PORT`.)
   std::string pose_socket_url;

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 
 #include "avatarmap/core/status.hpp"
@@ -38,8 +39,11 @@ class vmc_stream {
   void close() { sender_.close(); }
   bool is_open() const { return sender_.is_open(); }
 
-  /// Sends `pose` as one bundle stamped `time` (seconds). True when the kernel took it; a
-  /// dropped or refused packet is counted (stats()) and the call returns at once.
+  /// Sends `pose` as one bundle stamped `time` (seconds, /VMC/Ext/T). The stamps sent are
+  /// strictly increasing, at least 1 us apart: a `time` less than 1 us after the previous
+  /// stamp (a repeated or earlier time) or not finite is sent as the previous stamp + 1 us
+  /// (the nearest float32, and at least the next float32 above it; 0 for the first). True when the
+  /// kernel took it; a dropped or refused packet is counted (stats()) and the call returns at once.
   bool send(const proxy_pose& pose, float time);
 
   const udp_send_stats& stats() const { return sender_.stats(); }
@@ -59,6 +63,7 @@ class vmc_stream {
   udp_sender sender_;
   vmc_skeleton skeleton_{};
   long encode_failures_ = 0;
+  float last_time_ = -std::numeric_limits<float>::infinity();  // the last /VMC/Ext/T sent
   proxy_foot_lock lock_;
   bool lock_on_ = false;
   proxy_pose locked_;  // scratch: the pose with its feet locked

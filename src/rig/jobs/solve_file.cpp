@@ -282,6 +282,24 @@ status solve_file_job::run(solve_file_summary& s) const {
   s.camera_roll_degrees = stream.solver().camera_roll_degrees();
   s.gravity_evidence_frames = stream.solver().gravity_evidence_frames();
   s.floor_evidence_points = stream.solver().floor_evidence_points();
+  s.body_hold = stream.solver().hold_stats();
+  if (s.body_hold.held_frames > 0 && warning) {
+    const body_hold_stats& h = s.body_hold;
+    std::string why;
+    for (int i = 0; i < k_body_doubt_count; ++i)
+      if (h.doubt_frames[i] > 0)
+        why += (why.empty() ? "" : ", ") + std::string(body_doubt_name(i)) + " " +
+               std::to_string(h.doubt_frames[i]);
+    const char* rest = solve_options.lower_body_rest == body_rest::sitting ? "sitting" : "standing";
+    warning("the lower body was held at rest (" + std::string(rest) + ") in " +
+            std::to_string(h.held_frames) + " of " + std::to_string(h.frames) +
+            " frames with a body (" + why + ")" +
+            (h.limbs_off_frames > 0
+                 ? "; the spine and arms were not followed either in " +
+                       std::to_string(h.limbs_off_frames) + " (not a person's points)"
+                 : std::string()) +
+            "; --lower-body-rest off follows every body");
+  }
   return {};
 }
 

@@ -333,6 +333,14 @@ typedef struct avm_solver_options {
   /* With foot_contacts: move the hips so that a planted foot stays where it landed (0: only
    * foot_contact is written); 1 */
   int32_t root_follows_contacts;
+  /* -- added in 0.1.0 after root_follows_contacts (a caller whose struct_size ends before it
+   *    gets the default) -- */
+  /* Where the lower body (hips, legs, feet, root) is held on frames whose body's points are
+   * not a person's (legs above the hips, a torso larger than the image, impossible bone
+   * lengths) or whose legs are not seen (upper-body framing), with a few frames of
+   * hysteresis; arms, hands and face still drive (docs/solver.md "Bodies that are not
+   * followed"): 0 standing (default), 1 sitting, 2 off (follow every body) */
+  int32_t lower_body_rest;
 } avm_solver_options;
 
 /* What avm_solve_file does after solving each frame. */
