@@ -404,10 +404,10 @@ status render_job(const render_options& o,
       if (status st = reply_value(reply, v); !st) return st;
       if (v.is_boolean() && v.get<bool>()) break;
       if (clock_type::now() > deadline)
-        return status::io_error("render: the viewer page did not start within " +
-                                number_text(o.step_timeout_s) + " s: are the viewer's modules in " +
-                                server_options.modules_dir +
-                                "? (scripts/fetch_viewer_modules.sh fetches them)");
+        return status::io_error(
+            "render: the viewer page did not start within " + number_text(o.step_timeout_s) +
+            " s: are the viewer's modules in " + server_options.modules_dir + "? (" +
+            script_command("scripts/fetch_viewer_modules.sh") + " fetches them)");
       if (o.cancel && o.cancel->load()) return status::error("render: interrupted");
       ::usleep(50000);
     }

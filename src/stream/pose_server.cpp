@@ -26,6 +26,7 @@
 #include <utility>
 #include <vector>
 
+#include "avatarmap/io/resources.hpp"
 #include "common/pose_text.hpp"
 
 #if defined(AVATARMAP_HAVE_WEBSOCKETS)
@@ -146,8 +147,9 @@ status pose_server_options::validate() const {
       !is_file(modules_dir + "/three-vrm/lib/three-vrm.module.js") ||
       !is_file(modules_dir + "/three-vrm-animation/lib/three-vrm-animation.module.js"))
     return status::error("pose server: three.js and three-vrm are missing from '" + modules_dir +
-                         "': run scripts/fetch_viewer_modules.sh (or scripts/setup.sh), or set "
-                         "AVATARMAP_VIEWER_MODULES to the folder it fills");
+                         "': run " + script_command("scripts/fetch_viewer_modules.sh") +
+                         " (or scripts/setup.sh), or set AVATARMAP_VIEWER_MODULES to the folder "
+                         "it fills");
   if (!avatar_path.empty() && !is_file(avatar_path))
     return status::error("pose server: avatar '" + avatar_path + "' is not a readable file");
   if (!avatar_path.empty() && !avatar_data.empty())

@@ -27,13 +27,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import cdp  # noqa: E402
 
-SKIP = 77
 
-
-def skip(why):
-    print(f"SKIPPED: {why}")
-    sys.exit(SKIP)
-
+from view_process import Checks, skip  # noqa: E402
+import view_process  # noqa: E402
 
 if len(sys.argv) != 3:
     sys.exit(__doc__)
@@ -48,40 +44,16 @@ if not cdp.find_chromium():
     skip("chromium is missing (Debian: chromium; scripts/setup.sh installs it)")
 os.makedirs(WORK, exist_ok=True)
 
-failures = []
-
-
-def check(ok, what):
-    print(("ok    " if ok else "FAIL  ") + what)
-    if not ok:
-        failures.append(what)
+check = Checks()
+failures = check.failures
 
 
 def run(*args):
     subprocess.run([EXE, *args], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
 
 
-class View:
-    """`avatarmap view ARGS --port 0`, its URL read from its standard output."""
-
-    def __init__(self, *args):
-        self.log_path = os.path.join(WORK, f"view{int(time.monotonic() * 1000)}.log")
-        self.log = open(self.log_path, "w")
-        self.process = subprocess.Popen([EXE, "view", *args, "--port", "0"],
-                                        stdout=subprocess.PIPE, stderr=self.log, text=True)
-        self.url = self.process.stdout.readline().strip()
-        if not self.url:
-            self.process.wait()
-            text = open(self.log_path).read()
-            if "fetch_viewer_modules" in text:
-                skip("the viewer's modules are missing: " + text.strip())
-            raise RuntimeError(f"view {args} printed no URL: {text}")
-
-    def stop(self):
-        self.process.send_signal(2)
-        code = self.process.wait(10)
-        self.log.close()
-        return code, open(self.log_path).read()
+def View(*args):
+    return view_process.View(EXE, WORK, *args)
 
 
 # ---- references read here -------------------------------------------------------------------
