@@ -199,6 +199,15 @@ let restHips = [0, 1, 0];
 let mixer = null;
 let clipAction = null;
 
+// A .glb's own animation drives its morph targets ("weights" channels: the face). three-vrm's
+// expression manager would set every morph target an expression binds on each vrm.update()
+// (to 0: nothing sets the expressions), after the mixer has written them, and the mixer does
+// not write a value again while it is unchanged: so the avatar's expressions are left out.
+function glbOwnsTheFace(v) {
+  v.expressionManager = undefined;
+  if (v.lookAt) v.lookAt.autoUpdate = false;
+}
+
 function gltfLoader() {
   const loader = new GLTFLoader();
   loader.register((parser) => new VRMLoaderPlugin(parser));
@@ -270,6 +279,7 @@ async function loadAvatar(url, name, animated = false) {
       if (config.clip) await loadClip(config.clip, config.clip_name || 'clip');
     } else if (animated) {
       vrm.humanoid.autoUpdateHumanBones = false;  // the animation drives the raw bones
+      glbOwnsTheFace(vrm);
       mixer = new THREE.AnimationMixer(vrm.scene);
       clipAction = mixer.clipAction(gltf.animations[0]);
       clipAction.play();
@@ -809,6 +819,7 @@ async function loadGlbAnimation(samples = 24) {
   const clip = gltf.animations[0];
   if (!clip) throw new Error(`${config.avatar_name || 'the avatar'} holds no glTF animation`);
   vrm.humanoid.autoUpdateHumanBones = false;
+  glbOwnsTheFace(vrm);
   glbMixer = new THREE.AnimationMixer(vrm.scene);
   glbMixer.clipAction(clip).play();
   glbDuration = clip.duration;

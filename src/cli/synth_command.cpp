@@ -44,7 +44,8 @@ const char* k_synth_help =
     "  --fps F               frames per second (default 30)\n"
     "  --size WxH            image size in pixels (default 1280x720)\n"
     "  --seed N              seed of the motion, camera, noise and bursts (default 1)\n"
-    "  --motion demo|random  the motion played\n"
+    "  --motion demo|random|head  the motion played; head = the torso upright, the head\n"
+    "                        swept over pitch -70..+40, yaw +-70, roll +-35 degrees\n"
     "  --max-wrist-speed R   top speed of arms and fingers in the random motion, rad/s (6)\n"
     "  --finger-bend DEG     sideways bend range of finger joints in the random motion (10)\n"
     "  --fov DEG             horizontal field of view (fixes the random camera's draw)\n"
@@ -181,8 +182,10 @@ bool parse_synth(args& a, synth_settings& s, std::string& err) {
       o.motion = synth_motion::demo;
     } else if (text == "random") {
       o.motion = synth_motion::random;
+    } else if (text == "head") {
+      o.motion = synth_motion::head;
     } else {
-      err = "--motion is demo or random, got '" + text + "'";
+      err = "--motion is demo, random or head, got '" + text + "'";
       return false;
     }
   }

@@ -38,7 +38,15 @@ void frame_solver::gate_bones(const frame_measurement& m, double t, proxy_pose& 
     split[2 * side + 1] = glm::conjugate(twist) * hand_local;
     split_mask |= (1ull << la) | (1ull << hd);
   }
+  // World rotations of this frame's output, filled in bone order (a parent comes before its
+  // children). The neck and head are measured in the camera's frame by the face mesh (or the
+  // pose's face points), not relative to the torso: their locals are taken relative to the
+  // parent's output, so the head shows the world rotation measured even when the torso shown
+  // differs from the torso measured (held, blended, eased, or a lower-body hold).
+  glm::quat out_world[k_bone_count];
   auto measured_local = [&](int b) -> glm::quat {
+    if (b == idx(bone::neck) || b == idx(bone::head))
+      return glm::conjugate(out_world[bone_parent(b)]) * m.bones[b].world;
     if (!((split_mask >> b) & 1u)) return local_of(b);
     if (b == idx(bone::left_lower_arm)) return split[0];
     if (b == idx(bone::left_hand)) return split[1];
@@ -52,6 +60,8 @@ void frame_solver::gate_bones(const frame_measurement& m, double t, proxy_pose& 
     const float c = m.bones[b].confidence;
     out.rotations[b] = g.update(c, t, co, [&] { return measured_local(b); });
     out.confidence[b] = g.gate.tracked ? c : 0.f;
+    const int p = bone_parent(b);
+    out_world[b] = p == k_no_parent ? out.rotations[b] : out_world[p] * out.rotations[b];
   }
   ++world_generation_;  // previous_world() now refers to this output
 }

@@ -112,8 +112,12 @@ void accumulate_pose_accuracy(const proxy_pose& truth, const proxy_pose& solved,
   const double head =
       bad[h] ? 180.0 : rotation_angle(glm::normalize(glm::inverse(ws[h]) * wt[h])) * k_rad_to_deg;
   acc.all.head.add(head);
+  acc.all.head_histogram.add(head);
   acc.bones[h].add(head);
-  if (low_frame) acc.low_visibility.head.add(head);
+  if (low_frame) {
+    acc.low_visibility.head.add(head);
+    acc.low_visibility.head_histogram.add(head);
+  }
 }
 
 status evaluate_pose_files(const std::string& truth_path, const std::string& solved_path,

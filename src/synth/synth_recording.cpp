@@ -4,6 +4,7 @@
 
 #include <random>
 
+#include "avatarmap/core/rotation.hpp"
 #include "avatarmap/synth/random_pose.hpp"
 
 namespace avatarmap {
@@ -70,13 +71,25 @@ synth_options synth_scenario_options(synth_scenario scenario, std::uint32_t seed
 
 synth_recording::synth_recording(const synth_options& options)
     : synth_(options),
-      motion_(synth_.skeleton(), synth_.options().seed, motion_options(synth_.options())) {}
+      motion_(synth_.skeleton(), synth_.options().seed, motion_options(synth_.options())),
+      head_(synth_.options().seed) {}
 
 void synth_recording::generate(double t, proxy_pose& out_truth, landmark_frame& out_frame) {
-  if (synth_.options().motion == synth_motion::random)
+  if (synth_.options().motion == synth_motion::random) {
     motion_.pose_at(t, out_truth);
-  else
+  } else if (synth_.options().motion == synth_motion::head) {
+    // The torso upright (so the head's world turn is the sweep's), the head swept, half of
+    // its turn in the neck.
+    motion_.pose_at(t, out_truth);
+    for (bone b : {bone::hips, bone::spine, bone::chest, bone::upper_chest})
+      out_truth.rotations[idx(b)] = identity_quat();
+    const glm::quat half = quat_fraction(head_turn(head_.at(t)), 0.5f);
+    out_truth.rotations[idx(bone::neck)] = half;
+    out_truth.rotations[idx(bone::head)] = half;
+    ground_pose(synth_.skeleton(), out_truth);
+  } else {
     out_truth = demo_motion_pose(t, synth_.skeleton());
+  }
   out_truth.t = t;
   synth_.generate(out_truth, out_frame);
   out_frame.t = t;

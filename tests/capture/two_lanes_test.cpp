@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <mutex>
 #include <set>
 #include <thread>
 
@@ -17,24 +18,34 @@ TEST(two_lanes, every_task_once_and_done_when_the_batch_returns) {
   two_lanes lanes;
   constexpr int k_batches = 2000;
   std::atomic<int> runs[two_lanes::k_max_tasks];
-  std::set<std::thread::id> threads;
-  std::thread::id ran_on[two_lanes::k_max_tasks];
   for (int b = 0; b < k_batches; ++b) {
     const int count = b % (two_lanes::k_max_tasks + 1);  // 0..4 tasks
     for (auto& r : runs) r.store(0);
     auto task = [&](int i) {
       if (b % 50 == 0) std::this_thread::sleep_for(std::chrono::microseconds(200));
-      ran_on[i] = std::this_thread::get_id();
       runs[i].fetch_add(1);
     };
     lanes.run_batch(count, task);
     for (int i = 0; i < two_lanes::k_max_tasks; ++i) {
       ASSERT_EQ(runs[i].load(), i < count ? 1 : 0) << "batch " << b << " task " << i;
-      if (i < count) threads.insert(ran_on[i]);
     }
   }
-  // Sleeping tasks leave the other lane time to take one: both threads have worked.
-  EXPECT_EQ(threads.size(), 2u);
+  // Both lanes work: in a batch of two, each task waits (up to 10 s, however loaded the
+  // machine) for the other to have started, which only a second thread can do.
+  std::atomic<int> started{0};
+  std::set<std::thread::id> pair;
+  std::mutex pair_mutex;
+  auto side_by_side = [&](int) {
+    started.fetch_add(1);
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (started.load() < 2 && std::chrono::steady_clock::now() < give_up)
+      std::this_thread::yield();
+    std::lock_guard<std::mutex> lock(pair_mutex);
+    pair.insert(std::this_thread::get_id());
+  };
+  lanes.run_batch(2, side_by_side);
+  EXPECT_EQ(started.load(), 2);
+  EXPECT_EQ(pair.size(), 2u) << "the two tasks of a batch did not run side by side";
 }
 
 TEST(two_lanes, two_long_tasks_overlap) {

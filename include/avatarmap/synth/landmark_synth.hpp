@@ -54,8 +54,10 @@ enum class synth_face : std::uint8_t { none, mesh_468, mesh_478 };
 
 /// Which motion a synthetic recording plays (synth_recording.hpp; landmark_synth itself takes
 /// any pose): demo = demo_motion_pose()'s scripted 10 s loop; random = random_motion
-/// (random_motion.hpp), fast, seeded by synth_options::seed.
-enum class synth_motion : std::uint8_t { demo, random };
+/// (random_motion.hpp), fast, seeded by synth_options::seed; head = the random motion's arms,
+/// legs, eyes and expressions with the torso upright and the head swept over its whole range
+/// relative to it (head_sweep.hpp: pitch -70..+40, yaw +-70, roll +-35 degrees).
+enum class synth_motion : std::uint8_t { demo, random, head };
 
 /// The limbs that low-visibility bursts affect (the person's sides, also when mirrored).
 enum class synth_limb : std::uint8_t { left_arm, right_arm, left_leg, right_leg };

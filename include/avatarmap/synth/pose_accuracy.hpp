@@ -50,11 +50,39 @@ struct angle_stats {
   double mean() const { return count > 0 ? sum / static_cast<double>(count) : 0.0; }
 };
 
+/// Histogram of angles for percentiles: bins of 0.05 degrees over [0, 180] (the last bin
+/// takes everything above). quantile() returns the upper edge of the bin where the share q of
+/// the samples is reached, so it is at most 0.05 degrees above the exact percentile.
+struct angle_histogram {
+  static constexpr double k_bin_degrees = 0.05;
+  static constexpr int k_bins = 3600;
+  std::array<std::uint32_t, k_bins> bins{};
+  long count = 0;
+  void add(double degrees) {
+    int b = degrees >= 0.0 ? static_cast<int>(degrees / k_bin_degrees) : 0;
+    if (!(degrees < 180.0)) b = k_bins - 1;  // NaN too
+    ++bins[b < k_bins ? b : k_bins - 1];
+    ++count;
+  }
+  /// q in [0, 1]; 0 when empty.
+  double quantile(double q) const {
+    if (count == 0) return 0.0;
+    const double need = q * static_cast<double>(count);
+    long seen = 0;
+    for (int b = 0; b < k_bins; ++b) {
+      seen += bins[b];
+      if (static_cast<double>(seen) >= need && seen > 0) return (b + 1) * k_bin_degrees;
+    }
+    return k_bins * k_bin_degrees;
+  }
+};
+
 /// Figures over one set of samples.
 struct accuracy_figures {
   angle_stats direction;                                    // every measured bone
   std::array<angle_stats, k_direction_group_count> groups;  // torso, arms, legs, fingers
   angle_stats head;                                         // head orientation
+  angle_histogram head_histogram;                           // its percentiles
 };
 
 struct pose_accuracy {

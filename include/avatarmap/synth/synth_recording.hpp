@@ -14,6 +14,7 @@
 
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
+#include "avatarmap/synth/head_sweep.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
 #include "avatarmap/synth/random_motion.hpp"
 
@@ -55,6 +56,7 @@ class synth_recording {
  private:
   landmark_synth synth_;
   random_motion motion_;
+  head_sweep head_;
 };
 
 }  // namespace avatarmap

@@ -4,16 +4,21 @@
 // byte for byte, whatever their format). Written atomically (io_detail::write_file_atomically).
 #include "avatarmap/export/animated_glb.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <exception>
 #include <new>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "avatarmap/core/limits.hpp"
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/skeleton/expression.hpp"
 #include "common/atomic_file.hpp"
 #include "rig/export/glb_builder.hpp"
 #include "rig/gltf_document.hpp"
@@ -139,6 +144,204 @@ status gather_images(const gltf_detail::gltf_document& doc, json& j, glb_builder
   return {};
 }
 
+// ---- The face: the avatar's expression definitions as morph-target binds ----
+
+// One bind of a proxy expression to a morph target of a node's mesh.
+struct morph_bind {
+  int expression = 0;  // skeleton/expression.hpp index
+  int node = 0;
+  int target = 0;
+  float weight = 1.f;
+};
+
+struct face_binds {
+  std::vector<morph_bind> binds;
+  std::array<bool, k_expression_count> binary{};   // isBinary of the definition used
+  std::array<bool, k_expression_count> defined{};  // the first definition of a name wins
+};
+
+bool equal_nocase(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? char(c - 'A' + 'a') : c; };
+    if (lower(a[i]) != lower(b[i])) return false;
+  }
+  return true;
+}
+
+int expression_nocase(std::string_view name) {
+  for (int e = 0; e < k_expression_count; ++e)
+    if (equal_nocase(name, expression_name(static_cast<expression>(e)))) return e;
+  return -1;
+}
+
+const json* member(const json& v, const char* key) {
+  if (!v.is_object()) return nullptr;
+  auto it = v.find(key);
+  return it == v.end() ? nullptr : &*it;
+}
+
+// Morph targets of a node's mesh (its first primitive's; glTF requires every primitive of a
+// mesh to have the same count), 0 when the node has no mesh or the mesh none.
+int node_target_count(const json& j, int node) {
+  const json* nodes = member(j, "nodes");
+  const json* meshes = member(j, "meshes");
+  if (!nodes || !meshes || !nodes->is_array() || !meshes->is_array() || node < 0 ||
+      static_cast<std::size_t>(node) >= nodes->size())
+    return 0;
+  const json* mesh = member((*nodes)[static_cast<std::size_t>(node)], "mesh");
+  if (!mesh || !mesh->is_number_integer()) return 0;
+  const std::int64_t m = mesh->get<std::int64_t>();
+  if (m < 0 || static_cast<std::size_t>(m) >= meshes->size()) return 0;
+  const json* prims = member((*meshes)[static_cast<std::size_t>(m)], "primitives");
+  if (!prims || !prims->is_array() || prims->empty()) return 0;
+  const json* targets = member((*prims)[0], "targets");
+  return targets && targets->is_array() ? static_cast<int>(targets->size()) : 0;
+}
+
+// Adds a bind when its node's mesh has the target and the weight is a number; else ignores it.
+void add_bind(const json& j, face_binds& out, int e, const json* node, const json* index,
+              const json* weight, float weight_scale) {
+  if (!node || !index || !node->is_number_integer() || !index->is_number_integer()) return;
+  const std::int64_t n = node->get<std::int64_t>(), t = index->get<std::int64_t>();
+  if (n < 0 || n > 0x7fffffff || t < 0 || t >= node_target_count(j, static_cast<int>(n))) return;
+  float w = 1.f;
+  if (weight) {
+    if (!weight->is_number()) return;
+    w = weight->get<float>() * weight_scale;
+    if (!std::isfinite(w)) return;
+  }
+  out.binds.push_back({e, static_cast<int>(n), static_cast<int>(t), w});
+}
+
+bool is_binary(const json& def) {
+  const json* b = member(def, "isBinary");
+  return b && b->is_boolean() && b->get<bool>();
+}
+
+// VRM 1.0: VRMC_vrm.expressions.{preset,custom}.NAME.morphTargetBinds[{node, index, weight}].
+void read_vrm1_binds(const json& j, const json& expressions, face_binds& out) {
+  for (const char* group : {"preset", "custom"}) {
+    const json* g = member(expressions, group);
+    if (!g || !g->is_object()) continue;
+    for (auto it = g->begin(); it != g->end(); ++it) {
+      const std::optional<expression> e = expression_from_name(it.key());
+      if (!e || out.defined[idx(*e)]) continue;
+      out.defined[idx(*e)] = true;
+      out.binary[idx(*e)] = is_binary(it.value());
+      const json* binds = member(it.value(), "morphTargetBinds");
+      if (!binds || !binds->is_array()) continue;
+      for (const json& b : *binds)
+        add_bind(j, out, idx(*e), member(b, "node"), member(b, "index"), member(b, "weight"), 1.f);
+    }
+  }
+}
+
+// VRM 0.x: VRM.blendShapeMaster.blendShapeGroups[{presetName, name, binds[{mesh, index,
+// weight 0-100}], isBinary}]; a bind reaches every node that shows its mesh.
+void read_vrm0_binds(const json& j, const json& groups, face_binds& out) {
+  static constexpr std::array<std::pair<std::string_view, expression>, 12> k_presets = {{
+      {"a", expression::aa},
+      {"i", expression::ih},
+      {"u", expression::ou},
+      {"e", expression::ee},
+      {"o", expression::oh},
+      {"blink", expression::blink},
+      {"blink_l", expression::blink_left},
+      {"blink_r", expression::blink_right},
+      {"lookup", expression::look_up},
+      {"lookdown", expression::look_down},
+      {"lookleft", expression::look_left},
+      {"lookright", expression::look_right},
+  }};
+  const json* nodes = member(j, "nodes");
+  for (const json& g : groups) {
+    int e = -1;
+    const json* preset = member(g, "presetName");
+    if (preset && preset->is_string()) {
+      for (const auto& [name, ex] : k_presets)
+        if (equal_nocase(preset->get_ref<const std::string&>(), name)) e = idx(ex);
+    }
+    const json* name = member(g, "name");
+    if (e < 0 && name && name->is_string())
+      e = expression_nocase(name->get_ref<const std::string&>());
+    if (e < 0 || out.defined[static_cast<std::size_t>(e)]) continue;
+    out.defined[static_cast<std::size_t>(e)] = true;
+    out.binary[static_cast<std::size_t>(e)] = is_binary(g);
+    const json* binds = member(g, "binds");
+    if (!binds || !binds->is_array() || !nodes || !nodes->is_array()) continue;
+    for (const json& b : *binds) {
+      const json* mesh = member(b, "mesh");
+      if (!mesh || !mesh->is_number_integer()) continue;
+      for (std::size_t n = 0; n < nodes->size(); ++n) {
+        const json* m = member((*nodes)[n], "mesh");
+        if (!m || !m->is_number_integer() || m->get<std::int64_t>() != mesh->get<std::int64_t>())
+          continue;
+        const json node = static_cast<std::int64_t>(n);
+        add_bind(j, out, e, &node, member(b, "index"), member(b, "weight"), 0.01f);
+      }
+    }
+  }
+}
+
+// Plain glTF: morph targets named (mesh.extras.targetNames) after an expression, any case.
+void read_named_targets(const json& j, face_binds& out) {
+  const json* nodes = member(j, "nodes");
+  const json* meshes = member(j, "meshes");
+  if (!nodes || !meshes || !nodes->is_array() || !meshes->is_array()) return;
+  for (std::size_t n = 0; n < nodes->size(); ++n) {
+    const json* m = member((*nodes)[n], "mesh");
+    if (!m || !m->is_number_integer() || m->get<std::int64_t>() < 0 ||
+        static_cast<std::size_t>(m->get<std::int64_t>()) >= meshes->size())
+      continue;
+    const json* extras =
+        member((*meshes)[static_cast<std::size_t>(m->get<std::int64_t>())], "extras");
+    const json* names = extras ? member(*extras, "targetNames") : nullptr;
+    if (!names || !names->is_array()) continue;
+    for (std::size_t t = 0; t < names->size(); ++t) {
+      if (!(*names)[t].is_string()) continue;
+      const int e = expression_nocase((*names)[t].get_ref<const std::string&>());
+      if (e < 0) continue;
+      const json node = static_cast<std::int64_t>(n), index = static_cast<std::int64_t>(t);
+      add_bind(j, out, e, &node, &index, nullptr, 1.f);
+    }
+  }
+}
+
+// The avatar's definitions, the first kind the file has (VRM 1.0, VRM 0.x, target names).
+face_binds read_face_binds(const json& j) {
+  face_binds out;
+  const json* ext = member(j, "extensions");
+  const json* vrm1 = ext ? member(*ext, "VRMC_vrm") : nullptr;
+  const json* expressions = vrm1 ? member(*vrm1, "expressions") : nullptr;
+  const json* vrm0 = ext ? member(*ext, "VRM") : nullptr;
+  const json* master = vrm0 ? member(*vrm0, "blendShapeMaster") : nullptr;
+  const json* groups = master ? member(*master, "blendShapeGroups") : nullptr;
+  if (expressions && expressions->is_object())
+    read_vrm1_binds(j, *expressions, out);
+  else if (groups && groups->is_array())
+    read_vrm0_binds(j, *groups, out);
+  else
+    read_named_targets(j, out);
+  return out;
+}
+
+// A node's default morph weights: node.weights, else its mesh's weights, else zeros (glTF 2.0).
+std::vector<float> default_weights(const json& j, int node, int count) {
+  std::vector<float> w(static_cast<std::size_t>(count), 0.f);
+  const json& n = j["nodes"][static_cast<std::size_t>(node)];
+  const json* weights = member(n, "weights");
+  if (!weights || !weights->is_array())
+    weights = member(j["meshes"][n["mesh"].get<std::size_t>()], "weights");
+  if (weights && weights->is_array() && weights->size() == w.size())
+    for (std::size_t t = 0; t < w.size(); ++t)
+      if ((*weights)[t].is_number()) {
+        const float v = (*weights)[t].get<float>();
+        w[t] = std::isfinite(v) ? std::clamp(v, 0.f, 1.f) : 0.f;
+      }
+  return w;
+}
+
 // Appends the animation (time accessor, one rotation channel per joint that moves, the hips'
 // translation). Refuses non-finite values: no writer emits nan.
 status add_animation(const rig& r, const std::vector<rig_pose>& frames,
@@ -157,6 +360,19 @@ status add_animation(const rig& r, const std::vector<rig_pose>& frames,
     if (pose.hips_joint >= 0 && !is_finite(pose.hips_translation))
       return status::error(out_path + ": frame " + std::to_string(f) +
                            " has a non-finite hips translation; nothing written");
+  }
+  const std::vector<proxy_pose>* faces = options.expressions;
+  if (faces != nullptr) {
+    if (faces->size() != n)
+      return status::invalid_argument(out_path + ": " + std::to_string(faces->size()) +
+                                      " expression frames for " + std::to_string(n) +
+                                      " rig poses; give one per frame");
+    for (std::size_t f = 0; f < n; ++f)
+      for (int e = 0; e < k_expression_count; ++e)
+        if (!std::isfinite((*faces)[f].expressions[static_cast<std::size_t>(e)]))
+          return status::error(out_path + ": frame " + std::to_string(f) + " expression '" +
+                               std::string(expression_name(static_cast<expression>(e))) +
+                               "' is not finite; nothing written");
   }
   std::vector<float> times(n);
   for (std::size_t i = 0; i < n; ++i) times[i] = static_cast<float>(double(i) / options.fps);
@@ -199,6 +415,33 @@ status add_animation(const rig& r, const std::vector<rig_pose>& frames,
       values.insert(values.end(),
                     {f.hips_translation.x, f.hips_translation.y, f.hips_translation.z});
     add_channel(r.source_index[hips], "translation", values, "VEC3", 3);
+  }
+  if (faces != nullptr) {
+    face_binds face = read_face_binds(j);
+    std::stable_sort(face.binds.begin(), face.binds.end(),
+                     [](const morph_bind& a, const morph_bind& b) { return a.node < b.node; });
+    for (std::size_t i = 0; i < face.binds.size();) {
+      const int node = face.binds[i].node;
+      std::size_t end = i;
+      while (end < face.binds.size() && face.binds[end].node == node) ++end;
+      const int count = node_target_count(j, node);
+      const std::vector<float> base = default_weights(j, node, count);
+      values.assign(n * static_cast<std::size_t>(count), 0.f);
+      for (std::size_t f = 0; f < n; ++f) {
+        float* w = values.data() + f * static_cast<std::size_t>(count);
+        std::copy(base.begin(), base.end(), w);
+        for (std::size_t b = i; b < end; ++b) {
+          const morph_bind& m = face.binds[b];
+          float v =
+              std::clamp((*faces)[f].expressions[static_cast<std::size_t>(m.expression)], 0.f, 1.f);
+          if (face.binary[static_cast<std::size_t>(m.expression)]) v = v > 0.5f ? 1.f : 0.f;
+          w[m.target] += v * m.weight;
+        }
+        for (int t = 0; t < count; ++t) w[t] = std::clamp(w[t], 0.f, 1.f);
+      }
+      add_channel(node, "weights", values, "SCALAR", 1);
+      i = end;
+    }
   }
   if (!j.contains("animations") || !j["animations"].is_array()) j["animations"] = json::array();
   j["animations"].push_back(std::move(anim));

@@ -172,6 +172,7 @@ status clip_output_job::run(clip_output_summary& s) const {
     case clip_format::glb: {
       animated_glb_options o;
       o.fps = rate;
+      o.expressions = &written;  // the face: one proxy pose per rig pose (retarget_clip_job)
       st = write_animated_glb(avatar_path, *avatar_rig, rig_poses, o, path);
       break;
     }

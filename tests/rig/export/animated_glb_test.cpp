@@ -10,11 +10,13 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "avatarmap/avatar/builtin_avatar.hpp"
 #include "avatarmap/export/bvh.hpp"
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "rig/gltf_document.hpp"
@@ -284,6 +286,74 @@ TEST_F(animated_glb_writer, refuses_non_finite_poses_and_foreign_rigs) {
   s = write_animated_glb(avatar, bigger, bending_frames(r, 3), {}, out);
   ASSERT_FALSE(s.ok());
   EXPECT_TRUE(contains(s.message(), "does not belong")) << s.message();
+}
+
+// The face (docs/export.md): the weights written for known expressions (the independent
+// read-back over three definition kinds is tests/convert/face_glb_test.py); frames whose count
+// or values are wrong refused; hostile or absent definitions give joints only, never a crash.
+TEST_F(animated_glb_writer, the_face_drives_morph_weights_and_bad_faces_are_refused) {
+  const std::string avatar = dir.file("builtin.vrm");
+  ASSERT_TRUE(write_builtin_avatar(avatar).ok());
+  const rig r = rig_of(avatar);
+  const std::vector<rig_pose> frames = bending_frames(r, 3);
+  std::vector<proxy_pose> faces(3);
+  faces[1][expression::aa] = 0.5f;
+  animated_glb_options o;
+  o.expressions = &faces;
+  ASSERT_TRUE(write_animated_glb(avatar, r, frames, o, out).ok());
+  const parsed_glb g = parse_glb(test::read_text(out));
+  ASSERT_TRUE(g.error.empty()) << g.error;
+  // The built-in avatar binds aa to its face's target named "aa", weight 1.
+  int channels = 0;
+  for (const json& c : g.j["animations"][0]["channels"]) {
+    if (c["target"]["path"] != "weights") continue;
+    ++channels;
+    const json& node = g.j["nodes"][c["target"]["node"].get<std::size_t>()];
+    const json& names = g.j["meshes"][node["mesh"].get<std::size_t>()]["extras"]["targetNames"];
+    const json& acc =
+        g.j["accessors"][g.j["animations"][0]["samplers"][c["sampler"].get<std::size_t>()]["output"]
+                             .get<std::size_t>()];
+    ASSERT_EQ(acc["count"].get<std::size_t>(), 3 * names.size());
+    const std::string bytes = view_bytes(g, acc["bufferView"].get<std::size_t>());
+    for (std::size_t f = 0; f < 3; ++f)
+      for (std::size_t t = 0; t < names.size(); ++t) {
+        float v = 0.f;
+        std::memcpy(
+            &v, bytes.data() + acc.value("byteOffset", std::size_t{0}) + 4 * (f * names.size() + t),
+            4);
+        EXPECT_FLOAT_EQ(v, f == 1 && names[t] == "aa" ? 0.5f : 0.f) << names[t] << " frame " << f;
+      }
+  }
+  EXPECT_EQ(channels, 1);
+
+  faces.pop_back();
+  status s = write_animated_glb(avatar, r, frames, o, dir.file("short.glb"));
+  EXPECT_EQ(s.code(), status_code::invalid_argument);
+  EXPECT_TRUE(contains(s.message(), "2 expression frames for 3")) << s.message();
+  faces.resize(3);
+  faces[2][expression::blink] = NAN;
+  s = write_animated_glb(avatar, r, frames, o, dir.file("nan.glb"));
+  EXPECT_TRUE(contains(s.message(), "frame 2 expression 'blink'")) << s.message();
+  EXPECT_FALSE(std::filesystem::exists(dir.file("nan.glb")));
+
+  // Hostile definitions: binds to a node without a mesh, out-of-range indices, wrong types.
+  json j = test::minimal_vrm1();
+  j["extensions"]["VRMC_vrm"]["expressions"] = {
+      {"preset",
+       {{"blink",
+         {{"morphTargetBinds",
+           {{{"node", 1}, {"index", 0}, {"weight", 1.0}},
+            {{"node", 99}, {"index", -1}, {"weight", "x"}},
+            {{"node", "a"}, {"index", 1e30}}}}}},
+        {"aa", {{"morphTargetBinds", 7}}}}},
+      {"custom", "not an object"}};
+  const std::string hostile = write_json("hostile.gltf", j);
+  const rig hr = rig_of(hostile);
+  faces[2][expression::blink] = 1.f;
+  const std::vector<rig_pose> hframes = bending_frames(hr, 3);
+  ASSERT_TRUE(write_animated_glb(hostile, hr, hframes, o, out).ok());
+  for (const json& c : parse_glb(test::read_text(out)).j["animations"][0]["channels"])
+    EXPECT_NE(c["target"]["path"], "weights");
 }
 
 TEST_F(animated_glb_writer, keeps_the_mode_of_the_replaced_file_and_follows_no_symlink) {
