@@ -352,7 +352,8 @@ TEST_F(animated_glb_writer, the_face_drives_morph_weights_and_bad_faces_are_refu
   faces[2][expression::blink] = 1.f;
   const std::vector<rig_pose> hframes = bending_frames(hr, 3);
   ASSERT_TRUE(write_animated_glb(hostile, hr, hframes, o, out).ok());
-  for (const json& c : parse_glb(test::read_text(out)).j["animations"][0]["channels"])
+  const json written = parse_glb(test::read_text(out)).j;  // kept: the loop reads into it
+  for (const json& c : written["animations"][0]["channels"])
     EXPECT_NE(c["target"]["path"], "weights");
 }
 
