@@ -192,14 +192,8 @@ int run_animate(int argc, char** argv) {
     cap.push_back("--quiet");
     conv.push_back("--quiet");
   }
-  auto run = [](std::vector<std::string>& v, int (*fn)(int, char**)) {
-    std::vector<char*> p;
-    for (std::string& s : v) p.push_back(s.data());
-    p.push_back(nullptr);
-    return fn(static_cast<int>(v.size()), p.data());
-  };
-  int rc = run(cap, run_capture);
-  if (rc == 0) rc = run(conv, run_convert);
+  int rc = run_with_args(cap, run_capture);
+  if (rc == 0) rc = run_with_args(conv, run_convert);
   if (temporary) std::remove(landmarks.c_str());
   return rc;
 }

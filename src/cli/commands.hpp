@@ -2,11 +2,21 @@
 // 1 failure while working (I/O, bad data), 2 wrong usage.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "cli/option_flags.hpp"
 
 namespace avatarmap::cli {
+
+/// Runs one command with `args` as its argv ({"avatarmap", "capture", ...}), for the commands
+/// that chain others (animate, demo): each stage keeps its own options, checks and messages.
+inline int run_with_args(std::vector<std::string> args, int (*command)(int, char**)) {
+  std::vector<char*> argv;
+  for (std::string& s : args) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  return command(static_cast<int>(args.size()), argv.data());
+}
 
 int run_solve(int argc, char** argv);
 int run_convert(int argc, char** argv);

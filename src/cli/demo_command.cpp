@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "avatarmap/avatar/builtin_avatar.hpp"
@@ -55,14 +56,10 @@ const char* k_demo_help =
     "                with a source video)\n"
     "  --synthetic   no video: solve synthesised landmarks of the scripted motion\n";
 
-// Runs one of the CLI's commands with these arguments (as `animate` chains capture and
-// convert: each stage keeps its own options, checks and messages).
+// One of the CLI's commands (commands.hpp's run_with_args), `v[0]` its name.
 int run_command(std::vector<std::string> v, int (*fn)(int, char**)) {
-  v.insert(v.begin(), "avatarmap");  // argv[0]; v[0] is the command's name
-  std::vector<char*> p;
-  for (std::string& s : v) p.push_back(s.data());
-  p.push_back(nullptr);
-  return fn(static_cast<int>(v.size()), p.data());
+  v.insert(v.begin(), "avatarmap");
+  return run_with_args(std::move(v), fn);
 }
 
 // Writes the built-in avatar (1.70 m, the demo's person) to `avatar_path`, then `poses` on it as

@@ -9,7 +9,6 @@
 #include <unistd.h>
 
 #include <atomic>
-#include <cctype>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -28,6 +27,7 @@
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
 #include "cli/viewer_setup.hpp"
+#include "common/file_extension.hpp"
 #include "common/pose_text.hpp"
 
 extern char** environ;
@@ -92,12 +92,8 @@ bool open_in_browser(const std::string& url) {
 
 // True when `path` names a video the page can be given: its extension, any case.
 bool video_file_name(const std::string& path) {
-  std::string lower = path;
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  for (const char* e : {".mp4", ".m4v", ".webm", ".ogv", ".mov"}) {
-    const std::size_t n = std::strlen(e);
-    if (lower.size() > n && lower.compare(lower.size() - n, n, e) == 0) return true;
-  }
+  for (const char* e : {".mp4", ".m4v", ".webm", ".ogv", ".mov"})
+    if (path.size() > std::strlen(e) && jobs_detail::ends_with_nocase(path, e)) return true;
   return false;
 }
 

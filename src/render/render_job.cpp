@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -29,6 +28,7 @@
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "avatarmap/stream/pose_server.hpp"
 #include "avatarmap/time/resample_clip.hpp"
+#include "common/file_extension.hpp"
 #include "common/pose_text.hpp"
 #include "render/devtools_pipe.hpp"
 #include "render/png_decode.hpp"
@@ -38,16 +38,6 @@ namespace {
 
 using clock_type = std::chrono::steady_clock;
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-bool ends_with(const std::string& s, const char* tail) {
-  const std::size_t n = std::strlen(tail);
-  return s.size() >= n && s.compare(s.size() - n, n, tail) == 0;
-}
-
 bool is_file(const std::string& path) {
   struct stat st {};
   return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
@@ -56,11 +46,11 @@ bool is_file(const std::string& path) {
 enum class animation_kind { poses, vrma, bvh, glb, unknown };
 
 animation_kind kind_of(const std::string& path) {
-  const std::string l = lower(path);
-  if (ends_with(l, ".pose.jsonl")) return animation_kind::poses;
-  if (ends_with(l, ".vrma")) return animation_kind::vrma;
-  if (ends_with(l, ".bvh")) return animation_kind::bvh;
-  if (ends_with(l, ".glb")) return animation_kind::glb;
+  using jobs_detail::ends_with_nocase;
+  if (ends_with_nocase(path, ".pose.jsonl")) return animation_kind::poses;
+  if (ends_with_nocase(path, ".vrma")) return animation_kind::vrma;
+  if (ends_with_nocase(path, ".bvh")) return animation_kind::bvh;
+  if (ends_with_nocase(path, ".glb")) return animation_kind::glb;
   return animation_kind::unknown;
 }
 
@@ -205,8 +195,9 @@ status reply_value(const std::string& reply, nlohmann::json& out) {
 status render_options::validate() const {
   if (animation.empty()) return status::error("render: no animation given");
   if (output.empty()) return status::error("render: no output given (-o OUT.mp4)");
-  const std::string out = lower(output);
-  if (!ends_with(out, ".mp4") && !ends_with(out, ".mov") && !ends_with(out, ".mkv"))
+  using jobs_detail::ends_with_nocase;
+  if (!ends_with_nocase(output, ".mp4") && !ends_with_nocase(output, ".mov") &&
+      !ends_with_nocase(output, ".mkv"))
     return status::error("render: " + output + ": the output must be a .mp4, .mov or .mkv video");
   if (width < 16 || width > 4096 || height < 16 || height > 4096)
     return status::error("render: the size must be 16..4096 pixels a side, got " +

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "avatarmap/rig/bvh_rig.hpp"
+#include "common/file_extension.hpp"
 #include "rig/gltf_document.hpp"
-#include "rig/jobs/file_extension.hpp"
 
 namespace avatarmap {
 

@@ -18,52 +18,14 @@
 #include "avatarmap/skeleton/proxy_skeleton.hpp"
 #include "avatarmap/stream/vmc_stream.hpp"
 #include "osc_test_reader.hpp"
+#include "udp_test_receiver.hpp"
 
 namespace avatarmap {
 namespace {
 
-// A UDP socket bound to an ephemeral loopback port; receive() waits up to 2 s.
-class loopback_receiver {
- public:
-  loopback_receiver() {
-    fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    if (fd_ < 0) return;
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    int size = 4 << 20;  // every bundle of the test queued without loss
-    ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &size, sizeof size);
-    if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-      ::close(fd_);
-      fd_ = -1;
-      return;
-    }
-    socklen_t n = sizeof a;
-    ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &n);
-    port_ = ntohs(a.sin_port);
-    timeval tv{2, 0};
-    ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-  }
-  ~loopback_receiver() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  bool ok() const { return fd_ >= 0; }
-  int port() const { return port_; }
-  std::vector<std::uint8_t> receive() {
-    std::vector<std::uint8_t> buf(65536);
-    const ssize_t n = ::recv(fd_, buf.data(), buf.size(), 0);
-    buf.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
-    return buf;
-  }
-
- private:
-  int fd_ = -1;
-  int port_ = 0;
-};
-
 // Sends one bundle per time and returns the /VMC/Ext/T value of each, as received.
 std::vector<float> sent_times(const std::vector<float>& times) {
-  loopback_receiver rx;
+  test::udp_receiver rx(AF_INET, 4 << 20);  // every bundle of the test queued without loss
   EXPECT_TRUE(rx.ok());
   vmc_stream stream;
   EXPECT_TRUE(stream.open({"127.0.0.1", rx.port()}, make_vmc_skeleton(make_proxy_skeleton())).ok());

@@ -12,7 +12,7 @@
 #include "avatarmap/rig/bvh_rig.hpp"
 #include "avatarmap/time/resample_clip.hpp"
 #include "avatarmap/time/seconds_text.hpp"
-#include "rig/jobs/file_extension.hpp"
+#include "common/file_extension.hpp"
 
 namespace avatarmap {
 

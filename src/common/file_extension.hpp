@@ -1,5 +1,5 @@
-// File extensions compared as the jobs compare them (clip_output's formats, convert_file's
-// inputs): without regard to ASCII case.
+// File extensions compared as the jobs, `render` and `view` compare them (clip_output's
+// formats, convert_file's inputs, videos): without regard to ASCII case.
 #pragma once
 
 #include <cstddef>
