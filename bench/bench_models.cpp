@@ -169,10 +169,10 @@ void BM_model(benchmark::State& state, const std::string& name) {
 }
 
 const char* const k_models[] = {
-    "pose_detection",      "pose_landmark_lite",  "pose_landmark_full",
-    "pose_landmark_heavy", "palm_detection_lite", "palm_detection_full",
-    "hand_landmark_lite",  "hand_landmark_full",  "face_detection_short_range",
-    "face_landmark"};
+    "pose_detection",      "pose_landmark_lite",          "pose_landmark_full",
+    "pose_landmark_heavy", "palm_detection_lite",         "palm_detection_full",
+    "hand_landmark_lite",  "hand_landmark_full",          "face_detection_short_range",
+    "face_landmark",       "face_landmark_with_attention"};
 
 // Each model in float and, next to it, its int8 version (<name>.int8.onnx, docs/capture.md
 // "int8 models"; no FLOP counters: the peak above is a float one).

@@ -14,6 +14,8 @@ mkdir -p "$models/onnx"
 # name [outputs to drop]: pose_landmark's 256x256 segmentation output is not used and costs
 # much of its time (REFERENCE §4); its heatmap is kept: the pipeline refines the landmarks from
 # it as MediaPipe does (max error on pose.jpg 9.1 px with it, 15.2 px without).
+# face_landmark_with_attention (the 478-point mesh with irises) holds three MediaPipe custom
+# operators that the converter rewrites as standard ONNX (docs/convert.md "Custom operators").
 while read -r name drop; do
   src="$models/$name.tflite"
   dst="$models/onnx/$name.onnx"
@@ -37,6 +39,7 @@ hand_landmark_lite
 hand_landmark_full
 face_detection_short_range
 face_landmark
+face_landmark_with_attention
 LIST
 # int8 versions (<name>.int8.onnx) from the float ones and the activation ranges calibrated on
 # real frames (tools/models/int8_ranges/<name>.json, made by scripts/calibrate_int8.sh; docs/

@@ -88,6 +88,8 @@ const state = {
   socketUrl: '',
   posesReceived: 0,
   posesApplied: 0,
+  arkitTargets: 0,       // morph targets named after ARKit's shapes that poses drive directly
+  arkitExpressions: 0,   // expressions named after ARKit's shapes (Perfect Sync clips)
   badMessages: 0,
   lastPoseT: null,       // t of the newest applied pose (seconds)
   clipName: '',
@@ -266,6 +268,7 @@ async function loadAvatar(url, name, animated = false) {
     VRMUtils.rotateVRM0(loaded);  // VRM 0.x faces -Z: turn it to face +Z as VRM 1.0 does
     vrm = loaded;
     scene.add(vrm.scene);
+    findArkitTargets(vrm);
     const rest = vrm.humanoid.normalizedRestPose.hips?.position ?? [0, 1, 0];
     restHips = rest;
     restHipsY = Math.max(0.1, rest[1]);
@@ -589,6 +592,91 @@ if (!renderMode) {
   });
 }
 
+// ---- ARKit's blendshapes (Perfect Sync) -----------------------------------------------------
+// ARKit's 52 names (Apple's; the proxy pose's "blendshapes"), in ARKit's order.
+const ARKIT_SHAPES = [
+  'browDownLeft', 'browDownRight', 'browInnerUp', 'browOuterUpLeft', 'browOuterUpRight',
+  'cheekPuff', 'cheekSquintLeft', 'cheekSquintRight', 'eyeBlinkLeft', 'eyeBlinkRight',
+  'eyeLookDownLeft', 'eyeLookDownRight', 'eyeLookInLeft', 'eyeLookInRight', 'eyeLookOutLeft',
+  'eyeLookOutRight', 'eyeLookUpLeft', 'eyeLookUpRight', 'eyeSquintLeft', 'eyeSquintRight',
+  'eyeWideLeft', 'eyeWideRight', 'jawForward', 'jawLeft', 'jawOpen', 'jawRight', 'mouthClose',
+  'mouthDimpleLeft', 'mouthDimpleRight', 'mouthFrownLeft', 'mouthFrownRight', 'mouthFunnel',
+  'mouthLeft', 'mouthLowerDownLeft', 'mouthLowerDownRight', 'mouthPressLeft', 'mouthPressRight',
+  'mouthPucker', 'mouthRight', 'mouthRollLower', 'mouthRollUpper', 'mouthShrugLower',
+  'mouthShrugUpper', 'mouthSmileLeft', 'mouthSmileRight', 'mouthStretchLeft',
+  'mouthStretchRight', 'mouthUpperUpLeft', 'mouthUpperUpRight', 'noseSneerLeft',
+  'noseSneerRight', 'tongueOut'];
+const ARKIT_BY_LOWER = new Map(ARKIT_SHAPES.map((n) => [n.toLowerCase(), n]));
+
+// ARKit's shape a clip or morph target name stands for, as the .glb writer reads names
+// (docs/export.md): any case, after a prefix up to the last '.' and then "ARKit_".
+function arkitShapeOf(name) {
+  let n = String(name).split('.').pop();
+  if (n.length > 6 && n.toLowerCase().startsWith('arkit_')) n = n.slice(6);
+  return ARKIT_BY_LOWER.get(n.toLowerCase()) ?? null;
+}
+
+// The avatar's ARKit shapes: its expressions named after one (Perfect Sync clips, set through
+// three-vrm) and, for the shapes no expression claims, its morph targets named after one (the
+// built-in avatar's 52; set directly after vrm.update(), so that they win over the expressions
+// bound to the same targets, as in the .glb writer).
+let arkitExpressions = new Map();  // shape -> expression name
+let arkitTargets = [];             // {mesh, index, shape}
+let shapeWeights = null;           // the last pose's blendshapes, while any is non-zero
+
+function findArkitTargets(v) {
+  arkitExpressions = new Map();
+  arkitTargets = [];
+  shapeWeights = null;
+  for (const e of v.expressionManager?.expressions ?? []) {
+    const shape = arkitShapeOf(e.expressionName);
+    if (shape && !arkitExpressions.has(shape)) arkitExpressions.set(shape, e.expressionName);
+  }
+  v.scene.traverse((o) => {
+    if (!o.morphTargetDictionary || !o.morphTargetInfluences) return;
+    for (const [name, index] of Object.entries(o.morphTargetDictionary)) {
+      const shape = arkitShapeOf(name);
+      if (shape && !arkitExpressions.has(shape)) arkitTargets.push({ mesh: o, index, shape });
+    }
+  });
+  state.arkitTargets = arkitTargets.length;
+  state.arkitExpressions = arkitExpressions.size;
+}
+
+// Takes a pose's blendshapes: Perfect Sync expressions get their values now (before
+// vrm.update()); the named targets in applyShapeTargets() after it. A pose without blendshapes,
+// or with all of them 0, leaves the face to the expressions (and clears the targets once).
+function takeBlendshapes(pose) {
+  const b = pose.blendshapes;
+  const active = b && typeof b === 'object' && Object.values(b).some((x) => Number(x) > 0);
+  const expressions = vrm.expressionManager;
+  if (!active) {
+    if (shapeWeights) {
+      for (const t of arkitTargets) t.mesh.morphTargetInfluences[t.index] = 0;
+      // An ARKit-named expression that is also the proxy's (browDownLeft) keeps the pose's value.
+      if (expressions)
+        for (const name of arkitExpressions.values())
+          expressions.setValue(name, clamp01(pose.expressions?.[name]));
+    }
+    shapeWeights = null;
+    return;
+  }
+  shapeWeights = b;
+  if (expressions)
+    for (const [shape, name] of arkitExpressions) expressions.setValue(name, clamp01(b[shape]));
+}
+
+function clamp01(x) {
+  const v = Number(x);
+  return Number.isFinite(v) ? Math.min(1, Math.max(0, v)) : 0;
+}
+
+function applyShapeTargets() {
+  // A .vrma or .glb animation drives the face itself.
+  if (!shapeWeights || player.kind === 'glb' || player.kind === 'vrma') return;
+  for (const t of arkitTargets) t.mesh.morphTargetInfluences[t.index] = clamp01(shapeWeights[t.shape]);
+}
+
 // ---- poses ----------------------------------------------------------------------------------
 let newestMessage = null;  // only the newest pose is parsed, once per drawn frame
 let standingHipsY = 0;     // the highest hips height seen: the performer standing
@@ -626,6 +714,7 @@ function applyPose(pose) {
       if (expressions.getExpression(name)) expressions.setValue(name, Number(weights[name]) || 0);
     }
   }
+  takeBlendshapes(pose);
   state.lastPoseT = typeof pose.t === 'number' ? pose.t : null;
   state.posesApplied++;
 }
@@ -711,6 +800,7 @@ function frame() {
       posed = true;
     }
     vrm.update(delta);
+    applyShapeTargets();
   }
   updateControls();
   syncVideo();
@@ -751,6 +841,7 @@ function drawRequested(t, pose) {
     lastRenderT = t;
     pose();
     vrm.update(dt);
+    applyShapeTargets();
     renderer.render(scene, camera);
     state.frames++;
     await new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve)));

@@ -27,7 +27,8 @@ import os
 import sys
 
 AVM_BONE_COUNT = 55
-AVM_EXPRESSION_COUNT = 16
+AVM_EXPRESSION_COUNT = 21
+AVM_BLENDSHAPE_COUNT = 52
 AVM_POSE_LANDMARK_COUNT = 33
 AVM_HAND_LANDMARK_COUNT = 21
 AVM_FACE_COUNTS = (468, 478)
@@ -66,6 +67,7 @@ class AvmPose(ctypes.Structure):
         ("confidence", ctypes.c_float * AVM_BONE_COUNT),
         ("expressions", ctypes.c_float * AVM_EXPRESSION_COUNT),
         ("foot_contact", ctypes.c_float * 2),  # [left, right]: 0 = free .. 1 = planted
+        ("blendshapes", ctypes.c_float * AVM_BLENDSHAPE_COUNT),  # ARKit's 52 (0.2.0)
     ]
 
 

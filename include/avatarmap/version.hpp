@@ -2,9 +2,9 @@
 #pragma once
 
 #define AVATARMAP_VERSION_MAJOR 0
-#define AVATARMAP_VERSION_MINOR 1
+#define AVATARMAP_VERSION_MINOR 2
 #define AVATARMAP_VERSION_PATCH 0
-#define AVATARMAP_VERSION_STRING "0.1.0"
+#define AVATARMAP_VERSION_STRING "0.2.0"
 
 namespace avatarmap {
 inline constexpr int k_version_major = AVATARMAP_VERSION_MAJOR;

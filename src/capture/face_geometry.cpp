@@ -18,7 +18,57 @@ constexpr int k_pose_face_points = 11;
 constexpr int k_pose_right_eye = 5;
 constexpr int k_pose_left_eye = 2;
 
+// Mesh points that face_landmark_with_attention's refined regions replace, in the order of the
+// model's outputs (MediaPipe's tensors_to_face_landmarks_with_attention.pbtxt; the same lists
+// are the subsets its Landmarks2TransformMatrix operators crop).
+constexpr int k_refined_lips[k_face_refined_lips] = {
+    61, 146, 91, 181, 84, 17, 314, 405, 321, 375, 291, 185, 40, 39, 37, 0,  267, 269, 270, 409,
+    78, 95,  88, 178, 87, 14, 317, 402, 318, 324, 308, 191, 80, 81, 82, 13, 312, 311, 310, 415,
+    76, 77,  90, 180, 85, 16, 315, 404, 320, 307, 306, 184, 74, 73, 72, 11, 302, 303, 304, 408,
+    62, 96,  89, 179, 86, 15, 316, 403, 319, 325, 292, 183, 42, 41, 38, 12, 268, 271, 272, 407};
+constexpr int k_refined_left_eye[k_face_refined_eye] = {
+    33,  7,   163, 144, 145, 153, 154, 155, 133, 246, 161, 160, 159, 158, 157, 173, 130, 25,
+    110, 24,  23,  22,  26,  112, 243, 247, 30,  29,  27,  28,  56,  190, 226, 31,  228, 229,
+    230, 231, 232, 233, 244, 113, 225, 224, 223, 222, 221, 189, 35,  124, 46,  53,  52,  65,
+    143, 111, 117, 118, 119, 120, 121, 128, 245, 156, 70,  63,  105, 66,  107, 55,  193};
+constexpr int k_refined_right_eye[k_face_refined_eye] = {
+    263, 249, 390, 373, 374, 380, 381, 382, 362, 466, 388, 387, 386, 385, 384, 398, 359, 255,
+    339, 254, 253, 252, 256, 341, 463, 467, 260, 259, 257, 258, 286, 414, 446, 261, 448, 449,
+    450, 451, 452, 453, 464, 342, 445, 444, 443, 442, 441, 413, 265, 353, 276, 283, 282, 295,
+    372, 340, 346, 347, 348, 349, 350, 357, 465, 383, 300, 293, 334, 296, 336, 285, 417};
+// An iris's depth is the mean depth of its eye's contour: the first 16 points of each eye list.
+constexpr int k_eye_contour_points = 16;
+
+void overwrite_xy(const int* indices, int count, const float* xy, float* out) {
+  for (int k = 0; k < count; ++k) {
+    out[indices[k] * 3] = xy[k * 2];
+    out[indices[k] * 3 + 1] = xy[k * 2 + 1];
+  }
+}
+
+void place_iris(const float* iris, const int* eye, int first, float* out) {
+  float z = 0.f;
+  for (int k = 0; k < k_eye_contour_points; ++k) z += out[eye[k] * 3 + 2];
+  z /= static_cast<float>(k_eye_contour_points);
+  for (int k = 0; k < k_face_refined_iris; ++k) {
+    out[(first + k) * 3] = iris[k * 2];
+    out[(first + k) * 3 + 1] = iris[k * 2 + 1];
+    out[(first + k) * 3 + 2] = z;
+  }
+}
+
 }  // namespace
+
+void refine_face_mesh(const float* mesh, const float* lips, const float* left_eye,
+                      const float* right_eye, const float* left_iris, const float* right_iris,
+                      float* out) {
+  std::copy(mesh, mesh + k_face_mesh_count * 3, out);
+  overwrite_xy(k_refined_lips, k_face_refined_lips, lips, out);
+  overwrite_xy(k_refined_left_eye, k_face_refined_eye, left_eye, out);
+  overwrite_xy(k_refined_right_eye, k_face_refined_eye, right_eye, out);
+  place_iris(left_iris, k_refined_left_eye, k_face_mesh_count, out);
+  place_iris(right_iris, k_refined_right_eye, k_face_mesh_count + k_face_refined_iris, out);
+}
 
 ssd_anchor_options face_detection_anchor_options() {
   // face_detection_short_range.pbtxt + face_detection.pbtxt (SsdAnchorsCalculator).

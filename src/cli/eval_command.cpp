@@ -20,6 +20,9 @@ const char* k_eval_help =
     "orientation error (mean, and its 95th percentile in the \"head p95\" row and\n"
     "\"head_p95\" in JSON), and the same over the low-visibility frames (truth confidence 0 marks\n"
     "a bone in a burst; 'marked' is over those bones only). Angles in degrees.\n"
+    "The face: mean absolute error of each eye's blink, of jawOpen and of the visemes (weights\n"
+    "0..1), and the gaze's angle per eye relative to the head (mean and 95th percentile;\n"
+    "\"face\" in JSON). jawOpen is read from the files' blendshapes.\n"
     "\n"
     "Options:\n"
     "  --jitter SOLVED  no truth: the RMS of the second time derivative of the bones' world\n"
@@ -47,6 +50,22 @@ void print_figures_row(const char* name, const accuracy_figures& f) {
   std::printf("%-22s %8.2f", name, f.direction.mean());
   for (int g = 0; g < k_direction_group_count; ++g) std::printf(" %8.2f", f.groups[g].mean());
   std::printf(" %8.2f\n", f.head.mean());
+}
+
+void print_weight_json(const char* name, const weight_stats& s, bool comma) {
+  std::printf("\"%s\":{\"mean\":%.4f,\"max\":%.4f,\"count\":%ld}%s", name, s.mean(), s.max, s.count,
+              comma ? "," : "");
+}
+
+const char* const k_viseme_names[5] = {"aa", "ih", "ou", "ee", "oh"};
+
+void print_face_json(const face_accuracy& f) {
+  std::printf("\"face\":{");
+  print_weight_json("blink", f.blink, true);
+  print_weight_json("jawOpen", f.jaw_open, true);
+  for (int v = 0; v < 5; ++v) print_weight_json(k_viseme_names[v], f.visemes[v], true);
+  print_stats_json("gaze", f.gaze, false);
+  std::printf(",\"gaze_p95\":%.4f},", f.gaze_histogram.quantile(0.95));
 }
 
 }  // namespace
@@ -121,6 +140,7 @@ int run_eval_pose(int argc, char** argv) {
     print_figures_json("low_visibility", acc.low_visibility);
     std::printf(",");
     print_stats_json("marked", acc.marked, true);
+    print_face_json(acc.face);
     std::printf("\"bones\":{");
     bool first = true;
     for (int b = 0; b < k_bone_count; ++b) {
@@ -140,6 +160,15 @@ int run_eval_pose(int argc, char** argv) {
   if (acc.all.head.count > 0)
     std::printf("%-22s %8.2f  (head orientation, 95th percentile; max %.1f)\n", "head p95",
                 acc.all.head_histogram.quantile(0.95), acc.all.head.max);
+  const face_accuracy& fa = acc.face;
+  if (fa.blink.count > 0) {
+    std::printf("%-22s %8s %8s %8s %8s %8s %8s %8s %8s\n", "face", "blink", "jawOpen", "aa", "ih",
+                "ou", "ee", "oh", "gaze");
+    std::printf("%-22s %8.3f %8.3f", "mean abs error", fa.blink.mean(), fa.jaw_open.mean());
+    for (int v = 0; v < 5; ++v) std::printf(" %8.3f", fa.visemes[v].mean());
+    std::printf(" %8.2f  (gaze degrees; p95 %.2f)\n", fa.gaze.mean(),
+                fa.gaze_histogram.quantile(0.95));
+  }
   if (acc.low_visibility_frames > 0) {
     print_figures_row("low-visibility frames", acc.low_visibility);
     std::printf("%-22s %8.2f  (bones in a burst only; max %.1f)\n", "marked bones",

@@ -1,6 +1,8 @@
 #include "cli/live_vmc.hpp"
 
 #include <algorithm>
+#include <optional>
+#include <string>
 
 #include "avatarmap/rig/bound_avatar.hpp"
 #include "avatarmap/skeleton/proxy_skeleton.hpp"
@@ -18,12 +20,34 @@ const char* const k_live_vmc_help =
     "                        a frame's arrival to the packet: median ~23 ms, p95 ~50 ms at\n"
     "                        --fps 60 on a 2-core machine (body only)\n"
     "  --avatar FILE         the receiver's model (.vrm, .glb): its bones and rest positions\n"
-    "                        are sent (default: every bone of a 1.70 m proxy skeleton)\n";
+    "                        are sent (default: every bone of a 1.70 m proxy skeleton)\n"
+    "  --vmc-blendshapes SET the face's /VMC/Ext/Blend/Val names: vrm0 (default: the VRM 0.x\n"
+    "                        presets A I U E O, Blink, Blink_L/R, LookUp..., Joy Angry Sorrow\n"
+    "                        Fun, which every VRM model has), arkit (ARKit's 52 by Apple's\n"
+    "                        names, for Perfect Sync avatars) or both\n";
 
 int live_vmc::read_options(args& a) {
   given_ = a.value("--vmc", destination_);
   const bool avatar = a.value("--avatar", avatar_path_);
+  std::string blends;
+  const bool blends_given = a.value("--vmc-blendshapes", blends);
   if (!a.error().empty()) return 0;  // the caller reports the scanner's error
+  if (blends_given) {
+    const std::optional<vmc_blend_set> set = vmc_blend_set_from_name(blends);
+    if (!set) {
+      std::fprintf(stderr,
+                   "avatarmap live: --vmc-blendshapes takes vrm0, arkit or both, got '%s'\n",
+                   blends.c_str());
+      return 2;
+    }
+    if (!given_) {
+      std::fprintf(stderr,
+                   "avatarmap live: --vmc-blendshapes chooses what --vmc sends: use it with --vmc "
+                   "HOST[:PORT]\n");
+      return 2;
+    }
+    blends_ = *set;
+  }
   if (avatar && !given_) {
     std::fprintf(stderr,
                  "avatarmap live: --avatar gives the VMC receiver's model: use it with --vmc "
@@ -66,7 +90,7 @@ int live_vmc::open() {
     rest_source_ = avatar_path_;
   }
   stream_ = std::make_unique<vmc_stream>();
-  st = stream_->open(to, skeleton);
+  st = stream_->open(to, skeleton, {}, blends_);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap live: --vmc: %s\n", st.message().c_str());
     stream_.reset();
@@ -89,10 +113,11 @@ void live_vmc::print_summary(std::FILE* out) const {
   if (!stream_) return;
   const udp_send_stats& s = stream_->stats();
   std::fprintf(out,
-               "vmc: %ld bundles sent to %s (%d bones, %d blend values, %.1f KB each; rest "
+               "vmc: %ld bundles sent to %s (%d bones, %d blend values (%s), %.1f KB each; rest "
                "positions from %s), %ld dropped, %ld refused (no receiver), %ld errors\n",
                s.sent, stream_->address().c_str(), stream_->bone_messages(),
                stream_->blend_messages(),
+               std::string(vmc_blend_set_name(stream_->blend_set())).c_str(),
                static_cast<double>(stream_->last_bundle_bytes()) / 1024.0, rest_source_.c_str(),
                s.dropped, s.refused, s.errors + stream_->encode_failures());
   if (latencies_.count() == 0) return;

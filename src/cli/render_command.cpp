@@ -42,6 +42,9 @@ const char* k_render_help =
     "                    time\n"
     "  --landmarks L.landmarks.jsonl\n"
     "                    draw these landmarks on the source video (needs --video)\n"
+    "  --framing body|face\n"
+    "                    what the camera frames: the whole motion (default), or the head\n"
+    "                    in close-up, as a webcam sees a face\n"
     "  --chromium PATH   the browser to run (default: chromium on the PATH)\n"
     "  --quiet           no progress line\n"
     "\n"
@@ -92,7 +95,7 @@ int run_render(int argc, char** argv) {
     return 0;
   }
   render_options o;
-  std::string size, stills;
+  std::string size, stills, framing;
   a.value("--output", o.output, "-o");
   a.value("--avatar", o.avatar);
   a.value("--size", size);
@@ -101,6 +104,7 @@ int run_render(int argc, char** argv) {
   a.value("--video", o.video);
   a.value("--landmarks", o.landmarks);
   a.value("--chromium", o.chromium);
+  a.value("--framing", framing);
   const bool quiet = a.flag("--quiet");
   if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 1) {
     std::fprintf(
@@ -112,6 +116,13 @@ int run_render(int argc, char** argv) {
   if (!size.empty() && !parse_size(size, o.width, o.height)) {
     std::fprintf(stderr, "avatarmap render: --size: '%s' is not WxH (e.g. 1280x720)\n",
                  size.c_str());
+    return 2;
+  }
+  if (framing == "face") {
+    o.framing = render_options::framing_kind::face;
+  } else if (!framing.empty() && framing != "body") {
+    std::fprintf(stderr, "avatarmap render: --framing takes body or face, got '%s'\n",
+                 framing.c_str());
     return 2;
   }
   if (!stills.empty() && !parse_times(stills, o.stills)) {

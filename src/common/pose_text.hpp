@@ -18,9 +18,10 @@ namespace avatarmap::io_detail {
 /// Appends `pose` as one line ("{...}" and, when `newline`, "\n"): t, hips_position,
 /// foot_contact ([left, right]), every
 /// bone (VRM 1.0 names, enum order, [x, y, z, w]; identity ones left out with
-/// options.skip_identity), every expression, and confidence with options.write_confidence.
-/// Non-finite numbers are written as null. False when out.reserve() fails (the output says
-/// why); the line is then incomplete.
+/// options.skip_identity), every expression, ARKit's 52 blendshapes (all of them, by ARKit
+/// name, when any weight is non-zero; left out when all are 0, which readers take as 0), and
+/// confidence with options.write_confidence. Non-finite numbers are written as null. False when
+/// out.reserve() fails (the output says why); the line is then incomplete.
 template <class Out>
 bool put_pose_line(Out& o, const proxy_pose& pose, const pose_write_options& options,
                    bool newline = true) {
@@ -70,6 +71,22 @@ bool put_pose_line(Out& o, const proxy_pose& pose, const pose_write_options& opt
     o.put_number(pose.expressions[e]);
   }
   o.put('}');
+  bool any_blendshape = false;
+  // `!= 0` is also true for NaN, so a non-finite weight is written (as null), not hidden.
+  for (float w : pose.blendshapes) any_blendshape = any_blendshape || w != 0.f;
+  if (any_blendshape) {
+    if (!o.reserve(32)) return false;
+    o.put(",\"blendshapes\":{");
+    for (int s = 0; s < k_blendshape_count; ++s) {
+      if (!o.reserve(64)) return false;
+      if (s) o.put(',');
+      o.put('"');
+      o.put(blendshape_name(static_cast<blendshape>(s)));
+      o.put("\":");
+      o.put_number(pose.blendshapes[s]);
+    }
+    o.put('}');
+  }
   if (options.write_confidence) {
     if (!o.reserve(32)) return false;
     o.put(",\"confidence\":{");
@@ -119,9 +136,10 @@ class memory_text {
   std::size_t pos_ = 0;
 };
 
-/// Bytes a pose line can take with every bone and confidence written (the bound the pose
-/// server's buffers are sized by; reserve()'s per-entry room is what makes it a bound).
-inline constexpr std::size_t k_pose_line_max =
-    128 + 64 + k_bone_count * 128 + 32 + k_expression_count * 64 + 32 + k_bone_count * 64 + 2;
+/// Bytes a pose line can take with every bone, blendshape and confidence written (the bound the
+/// pose server's buffers are sized by; reserve()'s per-entry room is what makes it a bound).
+inline constexpr std::size_t k_pose_line_max = 128 + 64 + k_bone_count * 128 + 32 +
+                                               k_expression_count * 64 + 32 +
+                                               k_blendshape_count * 64 + 32 + k_bone_count * 64 + 2;
 
 }  // namespace avatarmap::io_detail

@@ -157,6 +157,19 @@ struct pose_reader::impl {
     });
   }
 
+  bool parse_blendshapes(json_cursor& c, proxy_pose& out) {
+    return io_detail::for_each_member(c, scratch2, [&](std::string_view name) {
+      auto s = blendshape_from_name(name);
+      if (!s)
+        return c.fail("unknown blendshape " + quoted(name) +
+                      " in \"blendshapes\" (expected one of ARKit's 52 names such as "
+                      "\"eyeBlinkLeft\" or \"jawOpen\"; see docs/file-formats.md)");
+      return parse_finite(c, out.blendshapes[idx(*s)],
+                          "blendshape \"" + std::string(blendshape_name(*s)) + "\"",
+                          "a weight in [0, 1]");
+    });
+  }
+
   bool parse_weights(json_cursor& c, proxy_pose& out, bool confidence) {
     return io_detail::for_each_member(c, scratch2, [&](std::string_view name) {
       if (confidence) {
@@ -172,9 +185,9 @@ struct pose_reader::impl {
       auto e = expression_from_name(name);
       if (!e)
         return c.fail("unknown expression " + quoted(name) +
-                      " (expected a VRM 1.0 expression name such as \"blink\" or \"aa\", or "
-                      "one of avatarmap's browUpLeft/browUpRight/browDownLeft/browDownRight; "
-                      "see docs/file-formats.md)");
+                      " (expected a VRM 1.0 expression name such as \"blink\", \"aa\" or "
+                      "\"happy\", or one of avatarmap's browUpLeft/browUpRight/browDownLeft/"
+                      "browDownRight; see docs/file-formats.md)");
       return parse_finite(c, out.expressions[idx(*e)],
                           "expression \"" + std::string(expression_name(*e)) + "\"",
                           "a weight in [0, 1]");
@@ -216,6 +229,8 @@ struct pose_reader::impl {
           if (!parse_bones(c, out)) return false;
         } else if (key == "expressions") {
           if (!parse_weights(c, out, false)) return false;
+        } else if (key == "blendshapes") {
+          if (!parse_blendshapes(c, out)) return false;
         } else if (key == "confidence") {
           if (!parse_weights(c, out, true)) return false;
         } else if (key == "format" || key == "version") {

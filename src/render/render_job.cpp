@@ -139,6 +139,35 @@ framing frame_motion(const std::vector<std::array<double, 3>>& hips, double rest
   return f;
 }
 
+// The head in close-up: the head's rest height above the hips (0.83 of the hips' rest height:
+// the built-in avatar's eyes, 0.79 m above 0.95 m hips) over the middle of the hips' range,
+// k_face_view_height metres of height in view plus the range the hips move up and down, the
+// camera level with the face.
+constexpr double k_face_view_height = 0.5;
+constexpr double k_head_over_hips = 0.83;
+
+framing frame_face(const std::vector<std::array<double, 3>>& hips, double rest_hips_y, int width,
+                   int height) {
+  double lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30};
+  for (const auto& p : hips)
+    for (int i = 0; i < 3; ++i) {
+      if (!std::isfinite(p[i])) continue;
+      lo[i] = std::min(lo[i], p[i]);
+      hi[i] = std::max(hi[i], p[i]);
+    }
+  for (int i = 0; i < 3; ++i)
+    if (lo[i] > hi[i]) lo[i] = hi[i] = (i == 1 ? rest_hips_y : 0.0);
+  framing f;
+  const double aspect = static_cast<double>(width) / height;
+  const double tan_v = std::tan(f.hfov * M_PI / 180 / 2) / aspect;
+  const double d = (k_face_view_height + (hi[1] - lo[1])) / 2 / tan_v + (hi[2] - lo[2]) / 2;
+  f.look[0] = f.cam[0] = (lo[0] + hi[0]) / 2;
+  f.look[1] = f.cam[1] = (lo[1] + hi[1]) / 2 + k_head_over_hips * std::max(0.2, rest_hips_y);
+  f.look[2] = (lo[2] + hi[2]) / 2;
+  f.cam[2] = f.look[2] + d;
+  return f;
+}
+
 // Nearest-neighbour scale of `src` (RGB8) to fit inside the w x h panel at `dst`, centred.
 struct panel_scaler {
   std::vector<int> xs, ys;
@@ -431,7 +460,9 @@ status render_job(const render_options& o,
       hips.push_back(
           {flip * p.hips_position.x * s, p.hips_position.y * s, flip * p.hips_position.z * s});
   }
-  const framing f = frame_motion(hips, rest_hips_y, panel_w, panel_h);
+  const framing f = o.framing == render_options::framing_kind::face
+                        ? frame_face(hips, rest_hips_y, panel_w, panel_h)
+                        : frame_motion(hips, rest_hips_y, panel_w, panel_h);
   auto triple = [](const double* v) {
     char buf[96];
     std::snprintf(buf, sizeof buf, "%.4f,%.4f,%.4f", v[0], v[1], v[2]);

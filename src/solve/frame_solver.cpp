@@ -44,7 +44,9 @@ frame_solver::frame_solver(const solver_options& options)
     : options_(options.validate().ok() ? options : solver_options{}),
       lengths_(std::make_unique<body_lengths>()),
       gravity_(std::make_unique<camera_gravity>()),
-      fit_(std::make_unique<body_fit>()) {
+      fit_(std::make_unique<body_fit>()),
+      face_calibration_(std::make_unique<face_calibration>()),
+      face_features_(std::make_unique<face_features>()) {
   reset();
 }
 
@@ -67,6 +69,8 @@ void frame_solver::reset() {
   ground_ = ground_origin_ = glm::vec2(0.f);
   have_origin_ = false;
   expressions_held_.fill(0.f);
+  blendshapes_held_.fill(0.f);
+  face_calibration_->reset();
   last_t_ = 0.0;
   started_ = false;
   hold_.reset();
@@ -92,7 +96,9 @@ void frame_solver::restart_take(bool keep_view) {
   const body_lengths lengths = *lengths_;
   camera_gravity gravity = *gravity_;
   const std::array<hand_shape, 2> hands = hand_shapes_;
+  const face_calibration face = *face_calibration_;
   reset();
+  *face_calibration_ = face;
   focal_per_width_ = focal;
   focal_information_ = information;
   focal_weighted_sum_ = weighted;
@@ -103,6 +109,40 @@ void frame_solver::restart_take(bool keep_view) {
   gravity.has_floor = false;  // the floor's height is found again from the start
   if (keep_view) *gravity_ = gravity;
   hand_shapes_ = hands;
+}
+
+bool frame_solver::face_calibrated() const { return face_calibration_->calibrated(); }
+long frame_solver::face_calibration_frames() const { return face_calibration_->frames; }
+
+void frame_solver::begin_face_take() {
+  if (!face_take_) face_take_ = std::make_unique<face_take>();
+  face_take_->frames.clear();
+}
+
+void frame_solver::add_face_take(const landmark_frame& in) {
+  if (!face_take_) begin_face_take();
+  // The field of view given, else the prior's (never the estimate so far): the calibration
+  // reads a take alike whenever it runs (a file's before its warm-up, a source's after).
+  const float fov = options_.horizontal_fov_degrees != 0.f ? options_.horizontal_fov_degrees
+                                                           : k_prior_fov_degrees;
+  prepared_frame f;
+  prepare_frame(in, options_, 0.5f / std::tan(0.5f * fov * k_deg), f);
+  face_features& ff = face_take_->frames.emplace_back();
+  read_face_features(f, options_, ff);
+}
+
+bool frame_solver::end_face_take() {
+  if (!face_take_) return false;
+  const bool done = calibrate_take(*face_take_, *face_calibration_);
+  face_take_.reset();
+  return done;
+}
+
+bool frame_solver::calibrate_face(const landmark_frame* frames, std::size_t count) {
+  begin_face_take();
+  face_take_->frames.reserve(count);
+  for (std::size_t i = 0; frames != nullptr && i < count; ++i) add_face_take(frames[i]);
+  return end_face_take();
 }
 
 float frame_solver::performer_leg_length() const {
@@ -174,7 +214,8 @@ void frame_solver::measure(const landmark_frame& in, frame_measurement& m) const
   prepare_frame(in, options_, focal_per_width_, f, fit_frame(in, false, fit));
   for (int side = 0; side < 2; ++side)  // the shapes learnt so far; nothing learnt
     if (fits_hand(f, side)) hand_shapes_[side].fit(f.hand[side].p, f.hand[side].c);
-  measure_prepared(in, f, hold_.state(), m);
+  face_features features;
+  measure_prepared(in, f, hold_.state(), m, features);
 }
 
 bool frame_solver::fits_hand(const prepared_frame& f, int side) const {
@@ -183,10 +224,12 @@ bool frame_solver::fits_hand(const prepared_frame& f, int side) const {
 }
 
 void frame_solver::measure_prepared(const landmark_frame& in, const prepared_frame& f,
-                                    body_follow follow, frame_measurement& m) const {
+                                    body_follow follow, frame_measurement& m,
+                                    face_features& features) const {
   for (auto& b : m.bones) b.confidence = 0.f;  // the other fields are written with it
   m.hips_height_valid = m.hips_ground_valid = m.expressions_valid = false;
   m.expressions.fill(0.f);
+  m.blendshapes.fill(0.f);
   // Coupling to the previous frame: a straight arm keeps the twist it had.
   const glm::quat* arm_ref[2] = {have_arm_reference_[0] ? &arm_reference_[0] : nullptr,
                                  have_arm_reference_[1] ? &arm_reference_[1] : nullptr};
@@ -200,7 +243,7 @@ void frame_solver::measure_prepared(const landmark_frame& in, const prepared_fra
   const bone_measurement& uc = m.bones[idx(bone::upper_chest)];
   const bool have_uc = uc.confidence > 0.f;
   measure_face(f, options_, have_uc ? uc.world : previous_world(idx(bone::upper_chest)), have_uc,
-               m);
+               *face_calibration_, features, m);
 }
 
 const glm::quat& frame_solver::previous_world(int b) const {
@@ -240,7 +283,9 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
       }
     }
   }
-  measure_prepared(in, f, follow, m);
+  measure_prepared(in, f, follow, m, *face_features_);
+  // The face's neutral learns from this frame (used from the next one on).
+  face_calibration_->update(*face_features_);
   for (int side = 0; side < 2; ++side) {  // the next frame's straight-arm twist reference
     const bone_measurement& ua =
         m.bones[idx(side == 0 ? bone::left_upper_arm : bone::right_upper_arm)];
@@ -251,7 +296,7 @@ void frame_solver::solve(const landmark_frame& in, proxy_pose& out) {
   }
   gate_bones(m, t, out);
   out.hips_position = gate_hips_position(m, t);
-  gate_expressions(m, t, out.expressions);
+  gate_expressions(m, t, out);
   out.t = t;
 }
 

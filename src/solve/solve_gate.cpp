@@ -89,19 +89,21 @@ glm::vec3 frame_solver::gate_hips_position(const frame_measurement& m, double t)
   return glm::vec3(ground_.x, hips_height_, ground_.y);
 }
 
-void frame_solver::gate_expressions(const frame_measurement& m, double t,
-                                    std::array<float, k_expression_count>& out) {
-  // Held, then eased to 0 (neutral).
+void frame_solver::gate_expressions(const frame_measurement& m, double t, proxy_pose& out) {
+  // Expressions and blendshapes: held, then eased to 0 (neutral).
   update_gate(face_state_, m.expressions_valid ? 1.f : 0.f, t, options_.confidence);
   if (face_state_.tracked) {
     expressions_held_ = m.expressions;
-    out = m.expressions;
+    blendshapes_held_ = m.blendshapes;
+    out.expressions = m.expressions;
+    out.blendshapes = m.blendshapes;
     return;
   }
   const float k = face_state_.ever_tracked
                       ? 1.f - hold_and_ease(t - face_state_.lost_at, options_.confidence).weight
                       : 0.f;
-  for (int i = 0; i < k_expression_count; ++i) out[i] = expressions_held_[i] * k;
+  for (int i = 0; i < k_expression_count; ++i) out.expressions[i] = expressions_held_[i] * k;
+  for (int i = 0; i < k_blendshape_count; ++i) out.blendshapes[i] = blendshapes_held_[i] * k;
 }
 
 }  // namespace avatarmap

@@ -45,13 +45,18 @@ struct hand_points {
 
 /// The face mesh points the solver reads, in VRM pixels with the perspective shear of the
 /// face's viewing ray removed, sides after mirroring (index 0 = avatar's left).
+/// Per eye: corners, three upper- and lower-lid points, the iris centre (478 points), the
+/// brow's inner and outer ends (107/336, 70/300) and the point below the lower lid (230/450).
 struct eye_points {
-  glm::vec3 outer, inner, upper[3], lower[3], iris, brow;
+  glm::vec3 outer, inner, upper[3], lower[3], iris, brow_inner, brow_outer, under;
   bool has_iris = false;
 };
+/// lip_upper/lip_lower: the inner lips (13, 14); lip_top/lip_bottom: the outer lips' middle
+/// (0, 17); nose_base: below the nose (2). docs/expressions.md lists every index.
 struct face_points {
   bool valid = false;
-  glm::vec3 forehead, chin, cheek[2], mouth[2], lip_upper, lip_lower;
+  glm::vec3 forehead, chin, cheek[2], mouth[2], lip_upper, lip_lower, lip_top, lip_bottom,
+      nose_base;
   eye_points eye[2];
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 
+#include "avatarmap/skeleton/blendshape.hpp"
 #include "avatarmap/stream/unity_space.hpp"
 #include "avatarmap/stream/vmc_names.hpp"
 
@@ -24,17 +25,44 @@ void write_transform(osc_writer& out, std::string_view address, std::string_view
   out.end_message();
 }
 
+void write_blend(osc_writer& out, std::string_view name, float w) {
+  out.begin_message("/VMC/Ext/Blend/Val", "sf");
+  out.add_string(name);
+  out.add_float32(w >= 0.f ? std::min(w, 1.f) : 0.f);  // NaN -> 0
+  out.end_message();
+}
+
 }  // namespace
 
-int vmc_blend_count() {
+std::string_view vmc_blend_set_name(vmc_blend_set set) {
+  switch (set) {
+    case vmc_blend_set::arkit:
+      return "arkit";
+    case vmc_blend_set::both:
+      return "both";
+    case vmc_blend_set::vrm0:
+      break;
+  }
+  return "vrm0";
+}
+
+std::optional<vmc_blend_set> vmc_blend_set_from_name(std::string_view name) {
+  for (vmc_blend_set s : {vmc_blend_set::vrm0, vmc_blend_set::arkit, vmc_blend_set::both})
+    if (vmc_blend_set_name(s) == name) return s;
+  return std::nullopt;
+}
+
+int vmc_blend_count(vmc_blend_set set) {
   int n = 0;
-  for (int e = 0; e < k_expression_count; ++e)
-    n += !vrm0_blend_name(static_cast<expression>(e)).empty();
+  if (set != vmc_blend_set::arkit)
+    for (int e = 0; e < k_expression_count; ++e)
+      n += !vrm0_blend_name(static_cast<expression>(e)).empty();
+  if (set != vmc_blend_set::vrm0) n += k_blendshape_count;
   return n;
 }
 
 bool write_vmc_bundle(const vmc_skeleton& skeleton, const proxy_pose& pose, float time,
-                      osc_writer& out) {
+                      osc_writer& out, vmc_blend_set blends) {
   out.clear();
   out.begin_bundle(k_osc_immediately);
   write_transform(out, "/VMC/Ext/Root/Pos", "root", glm::vec3(0.f), glm::quat(1.f, 0.f, 0.f, 0.f));
@@ -57,15 +85,14 @@ bool write_vmc_bundle(const vmc_skeleton& skeleton, const proxy_pose& pose, floa
                     vrm_to_unity_position(position), vrm_to_unity_rotation(local));
   }
 
-  for (int e = 0; e < k_expression_count; ++e) {
-    const std::string_view name = vrm0_blend_name(static_cast<expression>(e));
-    if (name.empty()) continue;
-    const float w = pose.expressions[e];
-    out.begin_message("/VMC/Ext/Blend/Val", "sf");
-    out.add_string(name);
-    out.add_float32(w >= 0.f ? std::min(w, 1.f) : 0.f);  // NaN -> 0
-    out.end_message();
-  }
+  if (blends != vmc_blend_set::arkit)
+    for (int e = 0; e < k_expression_count; ++e) {
+      const std::string_view name = vrm0_blend_name(static_cast<expression>(e));
+      if (!name.empty()) write_blend(out, name, pose.expressions[e]);
+    }
+  if (blends != vmc_blend_set::vrm0)
+    for (int b = 0; b < k_blendshape_count; ++b)
+      write_blend(out, blendshape_name(static_cast<blendshape>(b)), pose.blendshapes[b]);
   out.begin_message("/VMC/Ext/Blend/Apply", "");
   out.end_message();
   out.begin_message("/VMC/Ext/OK", "i");

@@ -10,8 +10,9 @@ constexpr double k_min_step = 1e-6;  // seconds between two /VMC/Ext/T stamps, a
 }  // namespace
 
 status vmc_stream::open(const host_port& to, const vmc_skeleton& skeleton,
-                        const foot_lock_options& foot_lock) {
+                        const foot_lock_options& foot_lock, vmc_blend_set blends) {
   skeleton_ = skeleton;
+  blends_ = blends;
   encode_failures_ = 0;
   last_time_ = -std::numeric_limits<float>::infinity();
   lock_on_ = foot_lock.enabled;
@@ -45,7 +46,7 @@ bool vmc_stream::send(const proxy_pose& pose, float time) {
     }
   }
   last_time_ = time;
-  if (!write_vmc_bundle(skeleton_, *sent, time, writer_)) {
+  if (!write_vmc_bundle(skeleton_, *sent, time, writer_, blends_)) {
     ++encode_failures_;
     return false;
   }

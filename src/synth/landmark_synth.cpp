@@ -3,25 +3,24 @@
 //
 // Face rules (head frame: VRM axes at rest, metres from the head joint, s = skeleton scale):
 // - eye width w = 0.03 s (outer - inner corner); the corner lines are parallel to X.
-// - lids: closure c = min(1, blink + blinkLeft/Right); each upper-lid point and its lower-lid
-//   partner sit (0.22 (1 - c) + 0.02 c) w apart along the head's up axis, symmetric about
-//   the corner line.
-// - mouth: neutral width 0.05 s; blend_visemes() gives (open, width_scale); width =
-//   0.05 s width_scale, inner-lip gap (13 - 14) = open * width; the upper lip takes a quarter
-//   of the opening, the lower lip three quarters.
-// - brows (105/334 and their neighbours): 0.012 s above the open upper lid's middle point,
-//   + 0.008 s browUp, - 0.005 s browDown (weights clamped to [0, 1]).
-// - irises (478 only): rest centre at inner + 0.55 (outer - inner) + 0.06 w up; gaze moves
-//   it by 0.012 s (sin yaw, -sin pitch) along the head's X / Y axes, where
-//   (pitch, yaw) = euler_from_quat(eye bone local rotation, YXZ): positive yaw turns the gaze
-//   toward +X, positive pitch (right-handed about +X) turns it down, so the iris moves down.
-//   Ring points 469-472 / 474-477 = centre + 0.0058 s * (+X, +Y, -X, -Y).
+// - the face's own proportions and the reach of each shape: synth_face_shape (the population
+//   face by default, drawn per seed with synth_options::face_variation).
+// - build_face() deforms the template for each ARKit shape the solver measures (lids, brows,
+//   cheeks, mouth corners and lips, irises); docs/expressions.md ("The generator") writes the
+//   rules out. They are the generator's own, written apart from the solver's measurements.
+// - irises (478 only): rest centre at inner + 0.5 (outer - inner) + 0.02 w up (+ the face's
+//   own offset); gaze moves it by the eyeball radius (0.012 s) times (sin yaw, -sin pitch)
+//   along the head's X / Y axes, where (pitch, yaw) = euler_from_quat(eye bone local
+//   rotation, YXZ): positive yaw turns the gaze toward +X, positive pitch (right-handed about
+//   +X) turns it down, so the iris moves down. Ring points 469-472 / 474-477 = centre +
+//   0.0058 s * (+X, +Y, -X, -Y).
 // - every other index: a deterministic point on the front half of an ellipsoid on the head.
 #include "avatarmap/synth/landmark_synth.hpp"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <random>
 
 #include "avatarmap/core/euler.hpp"
 #include "avatarmap/core/rotation.hpp"
@@ -36,18 +35,14 @@ constexpr float k_eye_z = 0.088f;
 constexpr float k_eye_inner_x = 0.016f;
 constexpr float k_eye_width = 0.03f;
 constexpr float k_lid_open = 0.22f;                        // lid gap / eye width, open
-constexpr float k_lid_closed = 0.02f;                      // closed
 constexpr float k_lid_z = 0.003f;                          // lids bulge forward over the eyeball
 constexpr float k_lid_fraction[3] = {0.25f, 0.5f, 0.75f};  // from outer to inner corner
 constexpr float k_mouth_y = 0.045f;
 constexpr float k_mouth_z = k_eye_z;  // mouth corners at the eye corners' depth
 constexpr float k_mouth_width = 0.05f;
 constexpr float k_brow_above_lid = 0.012f;
-constexpr float k_brow_up = 0.008f;
-constexpr float k_brow_down = 0.005f;
-constexpr float k_iris_along = 0.55f;
-constexpr float k_iris_above = 0.06f;  // * eye width
-constexpr float k_iris_gaze = 0.012f;
+constexpr float k_iris_along = 0.5f;
+constexpr float k_iris_above = 0.02f;  // * eye width
 constexpr float k_iris_radius = 0.0058f;
 
 // Per eye, right side listed; the left side is its mirror image.
@@ -66,6 +61,11 @@ constexpr eye_indices k_left_eye{
     362, 263, 359, {387, 386, 385}, {373, 374, 380}, {300, 293, 334, 296, 336}, {449, 450, 451},
     265, 464, 473};
 constexpr float k_brow_fraction[5] = {-0.15f, 0.15f, 0.5f, 0.85f, 1.1f};
+// Shares of a brow's moves along it (outer -> inner) and of the lid gap along the lid.
+constexpr float k_brow_inner_share[5] = {0.f, 0.2f, 0.5f, 0.85f, 1.f};
+constexpr float k_brow_outer_share[5] = {1.f, 0.85f, 0.5f, 0.2f, 0.f};
+constexpr float k_brow_down_share[5] = {0.6f, 0.8f, 1.f, 1.f, 1.f};
+constexpr float k_lid_arc[3] = {0.85f, 1.f, 0.9f};
 constexpr float k_brow_shape[5] = {0.007f, 0.010f, 0.012f, 0.011f, 0.009f};
 
 // Fixed points: right side (x < 0) or the midline; mirrored pairs below.
@@ -192,6 +192,68 @@ synth_viseme_shape blend_visemes(const proxy_pose& pose) {
   return out;
 }
 
+synth_face_shape draw_face_shape(std::uint32_t seed) {
+  // Its own generator: the face must not shift the camera, noise or burst sequences.
+  std::mt19937 g(seed ^ 0xface5u);
+  auto u = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(g); };
+  synth_face_shape f;
+  const float open = u(0.17f, 0.28f);
+  f.eye_open[0] = open * u(0.95f, 1.05f);
+  f.eye_open[1] = open * u(0.95f, 1.05f);
+  f.shut_fraction = u(0.05f, 0.14f);
+  f.wide_gain = u(0.34f, 0.46f);
+  const float brow = u(-0.002f, 0.002f);
+  f.brow_offset[0] = brow + u(-0.0005f, 0.0005f);
+  f.brow_offset[1] = brow + u(-0.0005f, 0.0005f);
+  f.brow_raise = u(0.0068f, 0.0082f);
+  f.brow_lower = u(0.0045f, 0.0055f);
+  f.cheek_raise = u(0.003f, 0.004f);
+  f.mouth_width = u(0.045f, 0.056f);
+  f.jaw_drop = u(0.027f, 0.031f);
+  f.corner_follow = u(0.46f, 0.54f);
+  f.narrow = u(0.27f, 0.33f);
+  f.funnel_open = u(0.005f, 0.007f);
+  f.smile_rise = u(0.0082f, 0.0098f);
+  f.smile_out = u(0.5f, 0.7f);
+  f.stretch_out = u(0.0065f, 0.0075f);
+  f.frown_drop = u(0.0045f, 0.0055f);
+  f.shift = u(0.0065f, 0.0075f);
+  f.eyeball_radius = u(0.0112f, 0.0128f);
+  f.iris_u = u(-0.03f, 0.03f);
+  f.iris_v = u(-0.03f, 0.03f);
+  return f;
+}
+
+void set_truth_expressions(proxy_pose& pose) {
+  for (int side = 0; side < 2; ++side) {
+    const glm::quat q = glm::normalize(pose[side == 0 ? bone::left_eye : bone::right_eye]);
+    const glm::vec3 pyr = euler_from_quat(q, euler_order::yxz);  // x = pitch (+ = down), y = yaw
+    eye_look_blendshapes(side == 0, std::sin(pyr.y), -std::sin(pyr.x), pose.blendshapes);
+  }
+  expressions_from_blendshapes(pose.blendshapes, pose.expressions);
+}
+
+void blendshapes_from_expressions(const proxy_pose& pose, blendshape_weights& out) {
+  out.fill(0.f);
+  auto e = [&](expression x) { return clamp01(pose[x]); };
+  const float blink = e(expression::blink);
+  out[idx(blendshape::eye_blink_left)] = clamp01(blink + e(expression::blink_left));
+  out[idx(blendshape::eye_blink_right)] = clamp01(blink + e(expression::blink_right));
+  out[idx(blendshape::jaw_open)] =
+      clamp01(e(expression::aa) + e(expression::ih) + e(expression::oh));
+  const float stretch = clamp01(e(expression::ih) + e(expression::ee));
+  out[idx(blendshape::mouth_stretch_left)] = stretch;
+  out[idx(blendshape::mouth_stretch_right)] = stretch;
+  out[idx(blendshape::mouth_funnel)] = e(expression::oh);
+  out[idx(blendshape::mouth_pucker)] = e(expression::ou);
+  const float up_l = e(expression::brow_up_left), up_r = e(expression::brow_up_right);
+  out[idx(blendshape::brow_outer_up_left)] = up_l;
+  out[idx(blendshape::brow_outer_up_right)] = up_r;
+  out[idx(blendshape::brow_inner_up)] = std::min(up_l, up_r);
+  out[idx(blendshape::brow_down_left)] = e(expression::brow_down_left);
+  out[idx(blendshape::brow_down_right)] = e(expression::brow_down_right);
+}
+
 status synth_options::validate() const {
   if (!(image_width > 0) || !(image_height > 0))
     return status::error("synth_options.image_width/image_height must be > 0");
@@ -307,6 +369,7 @@ void landmark_synth::init() {
   const float half_fov = 0.5f * fov_degrees_ * k_pi / 180.f;
   focal_ = 0.5f * static_cast<float>(options_.image_width) / std::tan(half_fov);
   build_template(face_template_, skeleton_.scale);
+  face_shape_ = options_.face_variation ? draw_face_shape(options_.seed) : synth_face_shape{};
   reseed(options_.seed);
 }
 
@@ -406,40 +469,86 @@ void landmark_synth::add_noise(glm::vec3* points, int count, float sigma) {
 }
 
 void landmark_synth::build_face(const proxy_pose& pose) {
-  // Deformed head-frame template into points_.face, then to VRM space.
+  // Deformed head-frame template into points_.face, then to VRM space. The shapes are drawn
+  // from the pose's blendshapes (those of its expressions when it carries none).
   std::array<glm::vec3, k_face_mesh_iris_count>& f = points_.face;
   f = face_template_;
   const float s = skeleton_.scale;
   const float w = k_eye_width * s;
+  const synth_face_shape& fs = face_shape_;
+  blendshape_weights bw = pose.blendshapes;
+  bool any = false;
+  for (float v : bw) any = any || v > 0.f;
+  if (!any) blendshapes_from_expressions(pose, bw);
+  auto B = [&](blendshape x, int side = 0) { return clamp01(bw[idx(x) + side]); };
 
-  const float blink = pose[expression::blink];
-  const float closure[2] = {clamp01(blink + pose[expression::blink_right]),
-                            clamp01(blink + pose[expression::blink_left])};
-  const float brow[2] = {k_brow_up * s * clamp01(pose[expression::brow_up_right]) -
-                             k_brow_down * s * clamp01(pose[expression::brow_down_right]),
-                         k_brow_up * s * clamp01(pose[expression::brow_up_left]) -
-                             k_brow_down * s * clamp01(pose[expression::brow_down_left])};
-  const bone eye_bones[2] = {bone::right_eye, bone::left_eye};
-  const eye_indices* eyes[2] = {&k_right_eye, &k_left_eye};
+  // Eyes. side 0 = the person's left (+X).
   for (int side = 0; side < 2; ++side) {
-    const eye_indices& e = *eyes[side];
-    const float c = closure[side];
-    const float half_gap = 0.5f * (k_lid_open * (1.f - c) + k_lid_closed * c) * w;
+    const eye_indices& e = side == 0 ? k_left_eye : k_right_eye;
+    const float sx = side == 0 ? 1.f : -1.f;
+    const float open = fs.eye_open[side] * w;
+    const float blink = B(blendshape::eye_blink_left, side);
+    const float wide = B(blendshape::eye_wide_left, side);
+    // The lid gap closes to shut_fraction of it and opens by wide_gain; the upper lid makes
+    // 80 % of the change. The three lid pairs stand apart on an arc (0.85, 1, 0.9 of the gap).
+    const float gap = open * (1.f - (1.f - fs.shut_fraction) * blink) +
+                      fs.wide_gain * open * wide * (1.f - blink);
+    const float change = open - gap;
     const float line_y = face_template_[e.inner].y;
     for (int i = 0; i < 3; ++i) {
-      f[e.upper[i]].y = line_y + half_gap;
-      f[e.lower[i]].y = line_y - half_gap;
+      f[e.upper[i]].y = line_y + k_lid_arc[i] * (0.5f * open - 0.8f * change);
+      f[e.lower[i]].y = line_y - k_lid_arc[i] * (0.5f * open - 0.2f * change);
     }
-    for (int i = 0; i < 5; ++i) f[e.brow[i]].y += brow[side];
-    glm::quat q = glm::normalize(pose[eye_bones[side]]);
+    // Brows (outer -> inner): the inner raise lifts the inner end, the outer raise the outer
+    // end, each fading along the brow; browDown lowers it, the inner end most, and draws the
+    // inner end toward the nose.
+    const float inner_up = B(blendshape::brow_inner_up);
+    const float outer_up = B(blendshape::brow_outer_up_left, side);
+    const float down = B(blendshape::brow_down_left, side);
+    for (int i = 0; i < 5; ++i) {
+      glm::vec3& p = f[e.brow[i]];
+      p.y += fs.brow_offset[side] * s +
+             fs.brow_raise * s *
+                 (inner_up * k_brow_inner_share[i] + outer_up * k_brow_outer_share[i]) -
+             fs.brow_lower * s * down * k_brow_down_share[i];
+      p.x -= sx * 0.001f * s * down * k_brow_inner_share[i];
+    }
+    const float cheek = B(blendshape::cheek_squint_left, side);
+    for (int i = 0; i < 3; ++i)
+      f[e.under[i]].y += fs.cheek_raise * s * cheek * (i == 1 ? 1.f : 0.8f);
+    // Iris: its own rest place, moved by the eyeball's radius times the sines of the turn.
+    glm::quat q = glm::normalize(pose[side == 0 ? bone::left_eye : bone::right_eye]);
     glm::vec3 pyr = euler_from_quat(q, euler_order::yxz);  // x = pitch, y = yaw
-    glm::vec3 gaze(k_iris_gaze * s * std::sin(pyr.y), -k_iris_gaze * s * std::sin(pyr.x), 0.f);
-    if (!is_finite(gaze)) gaze = glm::vec3(0.f);
-    for (int i = 0; i < 5; ++i) f[e.iris + i] += gaze;
+    glm::vec3 move(sx * fs.iris_u * w + fs.eyeball_radius * s * std::sin(pyr.y),
+                   fs.iris_v * w - fs.eyeball_radius * s * std::sin(pyr.x), 0.f);
+    if (!is_finite(move)) move = glm::vec3(0.f);
+    for (int i = 0; i < 5; ++i) f[e.iris + i] += move;
   }
-  const synth_viseme_shape m = blend_visemes(pose);
-  const float width = k_mouth_width * s * m.width_scale;
-  set_mouth(f, width, m.open * width, s);
+
+  // Mouth: the corners (291 left, 61 right) from the width, smile, stretch, frown and the
+  // jaw; the lips' middles (13/14 inner, 0/17 outer) from the jaw and the funnel.
+  const float round = std::max(B(blendshape::mouth_funnel), B(blendshape::mouth_pucker));
+  const float half_w = 0.5f * fs.mouth_width * s * (1.f - fs.narrow * round);
+  const float drop = fs.jaw_drop * s * B(blendshape::jaw_open);
+  const float part = fs.funnel_open * s * B(blendshape::mouth_funnel);
+  const float shift = fs.shift * s * (B(blendshape::mouth_left) - B(blendshape::mouth_right));
+  const float y = k_mouth_y * s, z = k_mouth_z * s;
+  for (int side = 0; side < 2; ++side) {
+    const float sx = side == 0 ? 1.f : -1.f;
+    const float smile = B(blendshape::mouth_smile_left, side);
+    const float out = half_w + fs.smile_out * fs.smile_rise * s * smile +
+                      fs.stretch_out * s * B(blendshape::mouth_stretch_left, side);
+    const float up = fs.smile_rise * s * smile -
+                     fs.frown_drop * s * B(blendshape::mouth_frown_left, side) -
+                     fs.corner_follow * drop;
+    f[side == 0 ? 291 : 61] = glm::vec3(shift + sx * out, y + up, z);
+    f[side == 0 ? 308 : 78] = glm::vec3(shift + sx * 0.9f * out, y + up, z + 0.003f * s);
+  }
+  const float forward = 0.006f * s * round;
+  f[13] = glm::vec3(shift, y + 0.5f * part, 0.095f * s + forward);
+  f[14] = glm::vec3(shift, y - 0.5f * part - drop, 0.095f * s + forward);
+  f[0] = glm::vec3(shift, y + 0.008f * s + 0.5f * part, 0.099f * s + forward);
+  f[17] = glm::vec3(shift, y - 0.010f * s - 0.5f * part - drop, 0.097f * s + forward);
 
   const glm::quat& head = fk_.world[idx(bone::head)];
   const glm::vec3& origin = fk_.joints[idx(bone::head)];
@@ -459,6 +568,8 @@ void landmark_synth::generate(const proxy_pose& pose, landmark_frame& out) {
     mirrored_.t = pose.t;
     mirrored_.hips_position = mirror_x(pose.hips_position);
     mirrored_.expressions = pose.expressions;
+    mirrored_.blendshapes = pose.blendshapes;
+    mirror_blendshapes(mirrored_.blendshapes);
     swap_expressions(mirrored_, expression::blink_left, expression::blink_right);
     swap_expressions(mirrored_, expression::look_left, expression::look_right);
     swap_expressions(mirrored_, expression::brow_up_left, expression::brow_up_right);

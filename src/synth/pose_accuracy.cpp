@@ -118,6 +118,27 @@ void accumulate_pose_accuracy(const proxy_pose& truth, const proxy_pose& solved,
     acc.low_visibility.head.add(head);
     acc.low_visibility.head_histogram.add(head);
   }
+
+  face_accuracy& fa = acc.face;
+  for (int side = 0; side < 2; ++side) {
+    const expression one = side == 0 ? expression::blink_left : expression::blink_right;
+    fa.blink.add((solved[expression::blink] + solved[one]) -
+                 (truth[expression::blink] + truth[one]));
+    const bone eye = side == 0 ? bone::left_eye : bone::right_eye;
+    const glm::quat qs = solved[eye], qt = truth[eye];
+    const bool eye_bad = !(glm::dot(qs, qs) > 1e-12f) || !std::isfinite(glm::dot(qs, qs));
+    const glm::vec3 fwd(0.f, 0.f, 1.f);
+    const double g =
+        eye_bad ? 180.0 : angle_degrees(glm::normalize(qt) * fwd, glm::normalize(qs) * fwd);
+    fa.gaze.add(g);
+    fa.gaze_histogram.add(g);
+  }
+  fa.jaw_open.add(solved[blendshape::jaw_open] - truth[blendshape::jaw_open]);
+  for (int v = 0; v < 5; ++v)
+    fa.visemes[v].add(solved.expressions[idx(expression::aa) + v] -
+                      truth.expressions[idx(expression::aa) + v]);
+  for (int i = 0; i < k_blendshape_count; ++i)
+    fa.shapes[i].add(solved.blendshapes[i] - truth.blendshapes[i]);
 }
 
 status evaluate_pose_files(const std::string& truth_path, const std::string& solved_path,

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/synth/landmark_synth.hpp"
 
 namespace avatarmap {
 
@@ -163,10 +164,14 @@ void random_motion::pose_at(double t, proxy_pose& out) {
   for (int i = 0; i < k_expression_count; ++i)
     out.expressions[i] = channels_[e].a.expressions[i] +
                          w[e] * (channels_[e].b.expressions[i] - channels_[e].a.expressions[i]);
+  for (int i = 0; i < k_blendshape_count; ++i)
+    out.blendshapes[i] = channels_[e].a.blendshapes[i] +
+                         w[e] * (channels_[e].b.blendshapes[i] - channels_[e].a.blendshapes[i]);
   const channel_state& torso = channels_[static_cast<int>(motion_channel::torso)];
   const float wt = w[static_cast<int>(motion_channel::torso)];
   out.hips_position = torso.a.hips_position + wt * (torso.b.hips_position - torso.a.hips_position);
   ground_pose(skeleton_, out);
+  set_truth_expressions(out);  // from the blendshapes and the eyes as they are now
 }
 
 }  // namespace avatarmap

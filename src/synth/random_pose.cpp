@@ -1,9 +1,11 @@
 // Random poses and the scripted demo motion. See include/avatarmap/synth/random_pose.hpp.
 #include "avatarmap/synth/random_pose.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/synth/landmark_synth.hpp"
 
 namespace avatarmap {
 
@@ -144,28 +146,83 @@ proxy_pose random_pose(std::mt19937& rng, const random_pose_limits& L) {
     }
   }
   // Conjugate gaze: both eyes turn together.
-  glm::quat eye = axis_angle(k_y, sym(rng, L.eye_yaw)) * axis_angle(k_x, sym(rng, L.eye_pitch));
+  // Half the time at the camera (within 3 degrees), as a person at a screen or camera looks;
+  // else anywhere in the limits.
+  const bool at_camera = L.expressions && uniform(rng, 0.f, 1.f) < 0.5f;
+  const float eye_yaw = at_camera ? std::min(3.f, L.eye_yaw) : L.eye_yaw;
+  const float eye_pitch = at_camera ? std::min(3.f, L.eye_pitch) : L.eye_pitch;
+  glm::quat eye = axis_angle(k_y, sym(rng, eye_yaw)) * axis_angle(k_x, sym(rng, eye_pitch));
   p[bone::left_eye] = eye;
   p[bone::right_eye] = eye;
 
   if (L.expressions) {
-    if (uniform(rng, 0.f, 1.f) < 0.5f) p[expression::blink] = uniform(rng, 0.f, 1.f);
-    if (uniform(rng, 0.f, 1.f) < 0.25f) {
-      expression e =
-          uniform(rng, 0.f, 1.f) < 0.5f ? expression::blink_left : expression::blink_right;
-      p[e] = uniform(rng, 0.f, 1.f - p[expression::blink]);
+    // ARKit shapes (left/right the person's), in the combinations a face makes; the 21
+    // expressions are derived from them and from the eyes (set_truth_expressions).
+    auto& bs = p.blendshapes;
+    auto set = [&](blendshape x, float v) { bs[idx(x)] = v; };
+    auto pair = [&](blendshape left, float v, float asym) {
+      const float other = std::min(1.f, std::max(0.f, v * uniform(rng, 1.f - asym, 1.f + asym)));
+      const bool first = uniform(rng, 0.f, 1.f) < 0.5f;
+      bs[idx(left)] = first ? v : other;
+      bs[idx(left) + 1] = first ? other : v;
+    };
+    // Mostly open eyes and a face at rest, as in real takes: a blink in 15 % of the poses, a
+    // wink in 5 %, wide eyes in 10 %; a mouth shape in 6 of 8; a brow move in 1 of 2.
+    if (uniform(rng, 0.f, 1.f) < 0.15f)
+      pair(blendshape::eye_blink_left, uniform(rng, 0.f, 1.f), 0.1f);
+    if (uniform(rng, 0.f, 1.f) < 0.05f) {  // a wink
+      const int side = uniform(rng, 0.f, 1.f) < 0.5f ? 0 : 1;
+      bs[idx(blendshape::eye_blink_left) + side] = uniform(rng, 0.7f, 1.f);
     }
-    int viseme = static_cast<int>(uniform(rng, 0.f, 6.f));
-    if (viseme >= 1 && viseme <= 5)
-      p.expressions[idx(expression::aa) + viseme - 1] = uniform(rng, 0.f, 1.f);
-    const expression ups[2] = {expression::brow_up_left, expression::brow_up_right};
-    const expression downs[2] = {expression::brow_down_left, expression::brow_down_right};
-    for (int side = 0; side < 2; ++side) {
-      int kind = static_cast<int>(uniform(rng, 0.f, 3.f));
-      if (kind == 1) p[ups[side]] = uniform(rng, 0.f, 1.f);
-      if (kind == 2) p[downs[side]] = uniform(rng, 0.f, 1.f);
+    if (uniform(rng, 0.f, 1.f) < 0.1f && bs[idx(blendshape::eye_blink_left)] == 0.f)
+      pair(blendshape::eye_wide_left, uniform(rng, 0.f, 1.f), 0.15f);
+    switch (static_cast<int>(uniform(rng, 0.f, 8.f))) {
+      case 1:  // talking / jaw
+        set(blendshape::jaw_open, uniform(rng, 0.f, 1.f));
+        break;
+      case 2:  // a smile, maybe with the cheeks and an open mouth
+        pair(blendshape::mouth_smile_left, uniform(rng, 0.f, 1.f), 0.3f);
+        pair(blendshape::cheek_squint_left,
+             uniform(rng, 0.f, 1.f) * bs[idx(blendshape::mouth_smile_left)], 0.2f);
+        set(blendshape::jaw_open, uniform(rng, 0.f, 0.5f));
+        break;
+      case 3:  // an O
+        set(blendshape::mouth_funnel, uniform(rng, 0.f, 1.f));
+        set(blendshape::jaw_open, uniform(rng, 0.f, 1.f));
+        break;
+      case 4:  // a kiss (the lips pushed together: the jaw nearly closed)
+        set(blendshape::mouth_pucker, uniform(rng, 0.f, 1.f));
+        set(blendshape::jaw_open, uniform(rng, 0.f, 0.15f));
+        break;
+      case 5:  // spread lips
+        pair(blendshape::mouth_stretch_left, uniform(rng, 0.f, 1.f), 0.3f);
+        set(blendshape::jaw_open, uniform(rng, 0.f, 0.6f));
+        break;
+      case 6:  // a frown
+        pair(blendshape::mouth_frown_left, uniform(rng, 0.f, 1.f), 0.3f);
+        break;
+      default:
+        break;
+    }
+    if (uniform(rng, 0.f, 1.f) < 0.15f)
+      set(uniform(rng, 0.f, 1.f) < 0.5f ? blendshape::mouth_left : blendshape::mouth_right,
+          uniform(rng, 0.f, 0.6f));
+    switch (static_cast<int>(uniform(rng, 0.f, 6.f))) {
+      case 1:
+        set(blendshape::brow_inner_up, uniform(rng, 0.f, 1.f));
+        pair(blendshape::brow_outer_up_left, uniform(rng, 0.f, 1.f), 0.3f);
+        break;
+      case 2:
+        pair(blendshape::brow_outer_up_left, uniform(rng, 0.f, 1.f), 0.8f);
+        break;
+      case 3:
+        pair(blendshape::brow_down_left, uniform(rng, 0.f, 1.f), 0.3f);
+        break;
+      default:
+        break;
     }
   }
+  set_truth_expressions(p);
   return p;
 }
 
@@ -253,6 +310,11 @@ proxy_pose demo_motion_pose(double t_seconds, const proxy_skeleton& skeleton) {
   }
   p[expression::brow_up_left] = 0.7f * wave;
   p[expression::brow_up_right] = 0.7f * wave;
+
+  // The generator draws ARKit shapes: the expressions above converted, then the truth
+  // expressions derived back from them and from the eyes.
+  blendshapes_from_expressions(p, p.blendshapes);
+  set_truth_expressions(p);
 
   p.hips_position = glm::vec3(0.05f * std::sin(two_pi * t / 10.f), 0.f, 0.f);
   ground_pose(skeleton, p);

@@ -55,6 +55,7 @@ synth_options synth_scenario_options(synth_scenario scenario, std::uint32_t seed
   if (scenario == synth_scenario::demo) return o;
   o.motion = synth_motion::random;
   o.random_camera = true;
+  o.face_variation = true;  // each seed its own face (synth_face_shape)
   // Its own generator: the height draw must not shift the camera, noise or burst sequences.
   std::mt19937 g(seed ^ 0x4e16417u);
   o.person_height =

@@ -101,6 +101,10 @@ static int pose_is_finite(const avm_pose* p) {
   }
   for (k = 0; k < AVM_EXPRESSION_COUNT; ++k)
     if (!isfinite(p->expressions[k])) return 0;
+  for (k = 0; k < AVM_BLENDSHAPE_COUNT; ++k)
+    if (!isfinite(p->blendshapes[k])) return 0;
+  for (k = 0; k < 2; ++k)
+    if (!isfinite(p->foot_contact[k])) return 0;
   return 1;
 }
 
@@ -472,6 +476,32 @@ static void test_bones_and_expressions(void) {
     CHECK(avm_expression_name(e) != NULL);
     CHECK(avm_expression_from_name(avm_expression_name(e)) == e);
   }
+  CHECK(strcmp(avm_expression_name(AVM_EXPRESSION_HAPPY), "happy") == 0);
+  CHECK(strcmp(avm_expression_name(AVM_EXPRESSION_SURPRISED), "surprised") == 0);
+  CHECK(avm_expression_from_name("relaxed") == AVM_EXPRESSION_RELAXED);
+  CHECK(avm_expression_from_name("angry") == AVM_EXPRESSION_ANGRY);
+  CHECK(avm_expression_from_name("sad") == AVM_EXPRESSION_SAD);
+}
+
+/* ARKit's names, in Apple's alphabetical order (ARFaceAnchor.BlendShapeLocation). */
+static void test_blendshapes(void) {
+  int s;
+  CHECK(strcmp(avm_blendshape_name(AVM_BLENDSHAPE_BROW_DOWN_LEFT), "browDownLeft") == 0);
+  CHECK(strcmp(avm_blendshape_name(AVM_BLENDSHAPE_EYE_BLINK_RIGHT), "eyeBlinkRight") == 0);
+  CHECK(strcmp(avm_blendshape_name(AVM_BLENDSHAPE_JAW_OPEN), "jawOpen") == 0);
+  CHECK(strcmp(avm_blendshape_name(AVM_BLENDSHAPE_MOUTH_SMILE_LEFT), "mouthSmileLeft") == 0);
+  CHECK(strcmp(avm_blendshape_name(AVM_BLENDSHAPE_TONGUE_OUT), "tongueOut") == 0);
+  CHECK(avm_blendshape_name(AVM_BLENDSHAPE_COUNT) == NULL && avm_blendshape_name(-1) == NULL);
+  CHECK(avm_blendshape_from_name("cheekPuff") == AVM_BLENDSHAPE_CHEEK_PUFF);
+  CHECK(avm_blendshape_from_name("CheekPuff") == -1); /* case-sensitive */
+  CHECK(avm_blendshape_from_name("_neutral") == -1);  /* MediaPipe's extra, not ARKit's */
+  CHECK(avm_blendshape_from_name("") == -1 && avm_blendshape_from_name(NULL) == -1);
+  for (s = 0; s < AVM_BLENDSHAPE_COUNT; ++s) {
+    const char* name = avm_blendshape_name(s);
+    CHECK(name != NULL);
+    CHECK(avm_blendshape_from_name(name) == s);
+    if (s > 0 && name != NULL) CHECK(strcmp(avm_blendshape_name(s - 1), name) < 0);
+  }
 }
 
 static void test_sample_between_pushes(void) {
@@ -707,6 +737,7 @@ int main(void) {
   test_rest_pose();
   test_nan_frame();
   test_bones_and_expressions();
+  test_blendshapes();
   test_sample_between_pushes();
   test_solve_file();
   test_independent_handles();

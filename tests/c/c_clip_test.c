@@ -327,10 +327,53 @@ static void test_foot_contact_round_trip(void) {
   avm_clip_destroy(clip);
 }
 
+/* Blendshapes and the new emotions go into a clip (non-finite = the previous frame's, 0 for
+ * the first; clamped to [0, 1], as avm_clip_add says), out to .pose.jsonl and back through
+ * avm_clip_read exactly. */
+static void test_blendshape_round_trip(void) {
+  avm_clip* clip = NULL;
+  avm_clip* back = NULL;
+  avm_pose p, got[3];
+  char err[256];
+  int k, s;
+  CHECK(avm_clip_create(&clip) == AVM_OK);
+  if (clip == NULL) return;
+  for (k = 0; k < 3; ++k) {
+    motion_pose(k, &p);
+    for (s = 0; s < AVM_BLENDSHAPE_COUNT; ++s) p.blendshapes[s] = (float)(s + k) / 64.f;
+    p.expressions[AVM_EXPRESSION_SURPRISED] = 0.5f * (float)k;
+    if (k == 0) p.blendshapes[AVM_BLENDSHAPE_JAW_OPEN] = NAN; /* first frame: 0 */
+    if (k == 1) p.blendshapes[AVM_BLENDSHAPE_CHEEK_PUFF] = INFINITY;
+    if (k == 2) p.blendshapes[AVM_BLENDSHAPE_TONGUE_OUT] = 3.f;
+    CHECK(avm_clip_add(clip, &p) == AVM_OK);
+  }
+  CHECK(avm_clip_get_poses(clip, 0, 3, got) == AVM_OK);
+  CHECK(got[0].blendshapes[AVM_BLENDSHAPE_JAW_OPEN] == 0.f);
+  CHECK(got[1].blendshapes[AVM_BLENDSHAPE_CHEEK_PUFF] == 5.f / 64.f); /* frame 0's */
+  CHECK(got[2].blendshapes[AVM_BLENDSHAPE_TONGUE_OUT] == 1.f);
+  CHECK(got[2].blendshapes[AVM_BLENDSHAPE_BROW_INNER_UP] == 4.f / 64.f);
+  CHECK(got[2].expressions[AVM_EXPRESSION_SURPRISED] == 1.f);
+  CHECK(avm_clip_write(clip, "c_clip_shapes.pose.jsonl", 0.0, NULL, NULL, err, sizeof err) ==
+        AVM_OK);
+  CHECK(avm_clip_read("c_clip_shapes.pose.jsonl", &back, err, sizeof err) == AVM_OK);
+  if (back != NULL) {
+    avm_pose again[3];
+    CHECK(avm_clip_get_poses(back, 0, 3, again) == AVM_OK);
+    for (k = 0; k < 3; ++k) {
+      CHECK(memcmp(again[k].blendshapes, got[k].blendshapes, sizeof got[k].blendshapes) == 0);
+      CHECK(memcmp(again[k].expressions, got[k].expressions, sizeof got[k].expressions) == 0);
+    }
+    avm_clip_destroy(back);
+  }
+  remove("c_clip_shapes.pose.jsonl");
+  avm_clip_destroy(clip);
+}
+
 int main(void) {
   avm_clip* clip;
   test_collect();
   test_foot_contact_round_trip();
+  test_blendshape_round_trip();
   clip = make_clip();
   CHECK(clip != NULL);
   if (clip != NULL) {

@@ -13,7 +13,8 @@ foreach(fn avm_version avm_solver_create avm_solver_push avm_solver_sample avm_s
            avm_solver_options_init_sized avm_estimator_options_init avm_estimator_options_init_sized
            avm_convert_file avm_convert_options_init avm_convert_options_init_sized
            avm_motion_input_kind avm_retargeter_create_with_options avm_retargeter_options_init
-           avm_retargeter_options_init_sized avm_retargeter_reset)
+           avm_retargeter_options_init_sized avm_retargeter_reset avm_blendshape_name
+           avm_blendshape_from_name)
   if(NOT symbols MATCHES " ${fn}\n")
     message(FATAL_ERROR "${LIB} does not export ${fn}")
   endif()

@@ -286,5 +286,58 @@ TEST(face_geometry, points_to_rect_rejects_bad_arguments) {
   expect_rect(r, 0.3f, 0.4f, 0.4f, 0.4f, k_pi / 4);
 }
 
+// face_landmark_with_attention's outputs -> 478 points. Inputs carry their own index so that
+// every output point says where it came from.
+TEST(face_geometry, refine_face_mesh_assembles_478_points) {
+  std::vector<float> mesh(468 * 3), lips(80 * 2), le(71 * 2), re(71 * 2), li(5 * 2), ri(5 * 2);
+  for (int i = 0; i < 468; ++i) {
+    mesh[i * 3] = static_cast<float>(i);
+    mesh[i * 3 + 1] = 1000.f + i;
+    mesh[i * 3 + 2] = 2000.f + i;
+  }
+  auto fill = [](std::vector<float>& v, float base) {
+    for (size_t k = 0; k < v.size() / 2; ++k) {
+      v[k * 2] = base + k;
+      v[k * 2 + 1] = base + 500 + k;
+    }
+  };
+  fill(lips, -10000), fill(le, -20000), fill(re, -30000), fill(li, -40000), fill(ri, -50000);
+  std::vector<float> out(478 * 3, std::numeric_limits<float>::quiet_NaN());
+  refine_face_mesh(mesh.data(), lips.data(), le.data(), re.data(), li.data(), ri.data(),
+                   out.data());
+  int from[5] = {0, 0, 0, 0, 0};  // mesh, lips, left eye, right eye, other
+  for (int i = 0; i < 468; ++i) {
+    EXPECT_EQ(out[i * 3 + 2], 2000.f + i) << i;  // z is never refined
+    const float x = out[i * 3];
+    const int src = x >= 0 ? 0 : x > -15000 ? 1 : x > -25000 ? 2 : x > -35000 ? 3 : 4;
+    ++from[src];
+    if (src > 0) EXPECT_EQ(out[i * 3 + 1], x + 500) << i;  // x and y from the same point
+  }
+  // Disjoint regions: 80 lips + 71 + 71 eye points replaced, the other 246 kept.
+  EXPECT_EQ(from[0], 468 - 80 - 71 - 71);
+  EXPECT_EQ(from[1], 80);
+  EXPECT_EQ(from[2], 71);
+  EXPECT_EQ(from[3], 71);
+  EXPECT_EQ(from[4], 0);
+  // The corners the model's own Landmarks2TransformMatrix operators align each region by
+  // (their left / right_rotation_idx options): mouth 61 -> 291, eyes 33 -> 133 and 362 -> 263,
+  // are the first and the ninth point of each list.
+  EXPECT_EQ(out[61 * 3], -10000.f);
+  EXPECT_EQ(out[291 * 3], -10000.f + 10);
+  EXPECT_EQ(out[33 * 3], -20000.f);
+  EXPECT_EQ(out[133 * 3], -20000.f + 8);
+  EXPECT_EQ(out[263 * 3], -30000.f);
+  EXPECT_EQ(out[362 * 3], -30000.f + 8);
+  // Irises: 468-472 from the left-iris output, 473-477 from the right; depth = the mean depth of
+  // the eye's 16 contour points (mean index 143.8125 around point 33, 371.75 around 263).
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_EQ(out[(468 + k) * 3], -40000.f + k);
+    EXPECT_EQ(out[(468 + k) * 3 + 1], -39500.f + k);
+    EXPECT_FLOAT_EQ(out[(468 + k) * 3 + 2], 2143.8125f);
+    EXPECT_EQ(out[(473 + k) * 3], -50000.f + k);
+    EXPECT_FLOAT_EQ(out[(473 + k) * 3 + 2], 2371.75f);
+  }
+}
+
 }  // namespace
 }  // namespace avatarmap

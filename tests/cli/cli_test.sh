@@ -502,6 +502,10 @@ open('black.png','wb').write(b'\\x89PNG\\r\\n\\x1a\\n'+chunk(b'IHDR',struct.pack
     done
     run 2 live in.mp4 --avatar me.vrm
     expect_in err.txt "use it with --vmc"
+    run 2 live in.mp4 --vmc 127.0.0.1 --vmc-blendshapes bad
+    expect_in err.txt "vrm0"
+    run 2 live in.mp4 --vmc-blendshapes arkit
+    expect_in err.txt "--vmc"
     run 2 live in.mp4 --vmc 127.0.0.1 --avatar ""
     run 1 live in.mp4 --vmc no-such-host.invalid
     expect_in err.txt "cannot resolve host 'no-such-host.invalid'"
@@ -544,11 +548,14 @@ open('black.png','wb').write(b'\\x89PNG\\r\\n\\x1a\\n'+chunk(b'IHDR',struct.pack
           }
           wait_dump /ready || fail "oscdump did not start"
           if [ -n "$avatar" ]; then
-            run 0 live "$input" --seconds 2 --models "$models" -o vmc.pose.jsonl --vmc "127.0.0.1:$port" --avatar "$avatar"
+            # With the receiver's avatar, both name sets: the 16 VRM 0.x presets and ARKit's 52.
+            run 0 live "$input" --seconds 2 --models "$models" -o vmc.pose.jsonl --vmc "127.0.0.1:$port" --avatar "$avatar" --vmc-blendshapes both
             bones=53
+            blends=68
           else
             run 0 live "$input" --seconds 2 --models "$models" -o vmc.pose.jsonl --vmc "127.0.0.1:$port"
             bones=55
+            blends=16
           fi
           wait_dump /done || fail "oscdump stopped receiving"
           kill "$dump_pid" 2>/dev/null
@@ -557,9 +564,9 @@ open('black.png','wb').write(b'\\x89PNG\\r\\n\\x1a\\n'+chunk(b'IHDR',struct.pack
           sent=$(sed -n 's/^vmc: \([0-9]*\) bundles sent.*/\1/p' err.txt)
           expect_in err.txt "vmc latency (frame delivered -> first packet with its pose"
           [ "$sent" = "$poses" ] || fail "vmc sent ${sent:-?} bundles for $poses output poses"
-          python3 - "$poses" "$bones" dump.txt <<'PY' || fail "oscdump's bundles (see above)"
+          python3 - "$poses" "$bones" "$blends" dump.txt <<'PY' || fail "oscdump's bundles (see above)"
 import sys
-want, bones, path = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
+want, bones, blends, path = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
 groups, last = [], None
 for line in open(path):
     f = line.split()
@@ -575,7 +582,7 @@ for g in groups:
     addr = [f[1] for f in g]
     names = {f[3].strip('"') for f in g if f[1] == "/VMC/Ext/Bone/Pos"}
     if (addr.count("/VMC/Ext/Bone/Pos") != bones or len(names) != bones
-            or addr.count("/VMC/Ext/Root/Pos") != 1 or addr.count("/VMC/Ext/Blend/Val") != 12
+            or addr.count("/VMC/Ext/Root/Pos") != 1 or addr.count("/VMC/Ext/Blend/Val") != blends
             or addr.count("/VMC/Ext/Blend/Apply") != 1 or addr[-1] != "/VMC/Ext/T"
             or ["/VMC/Ext/OK", "i", "1"] != next(f[1:] for f in g if f[1] == "/VMC/Ext/OK")):
         bad.append(addr[:3])
@@ -588,7 +595,12 @@ same = [(i, a) for i, (a, b) in enumerate(zip(times, times[1:])) if not b > a]
 if same:
     print("/VMC/Ext/T not increasing at bundle(s) %s" % same[:5])
     sys.exit(1)
-print("oscdump: %d bundles of %d bones" % (len(groups), bones))
+blend_names = [f[3].strip('"') for f in groups[-1] if f[1] == "/VMC/Ext/Blend/Val"]
+if blends == 68 and (blend_names[0] != "Blink" or blend_names[16] != "browDownLeft"
+                     or blend_names[-1] != "tongueOut" or "Joy" not in blend_names):
+    print("blend names: %s ... %s" % (blend_names[:17], blend_names[-1]))
+    sys.exit(1)
+print("oscdump: %d bundles of %d bones, %d blend values" % (len(groups), bones, blends))
 PY
         done
       else

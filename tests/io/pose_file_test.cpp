@@ -41,6 +41,11 @@ std::vector<proxy_pose> make_poses(int n, std::uint32_t seed) {
     }
     for (auto& c : p.confidence) c = u(rng);
     for (auto& e : p.expressions) e = u(rng);
+    // Every third pose has no blendshapes (the writer leaves the key out), one only jawOpen.
+    if (i % 3 == 1)
+      for (auto& w : p.blendshapes) w = u(rng);
+    else if (i % 3 == 2)
+      p[blendshape::jaw_open] = u(rng);
     p.foot_contact = {u(rng), i % 3 == 0 ? 1.f : 0.f};
   }
   return poses;
@@ -59,6 +64,9 @@ void expect_same_pose(const proxy_pose& a, const proxy_pose& b, bool with_confid
   }
   for (int e = 0; e < k_expression_count; ++e)
     EXPECT_TRUE(same_bits(a.expressions[e], b.expressions[e]));
+  for (int s = 0; s < k_blendshape_count; ++s)
+    EXPECT_TRUE(same_bits(a.blendshapes[s], b.blendshapes[s]))
+        << blendshape_name(static_cast<blendshape>(s));
   for (int f = 0; f < 2; ++f) EXPECT_TRUE(same_bits(a.foot_contact[f], b.foot_contact[f]));
 }
 
@@ -115,7 +123,55 @@ TEST(pose_file, writer_format) {
                       "[0.5,-0.5,0.5,0.5]},\"expressions\":{\"blink\":0,\"blinkLeft\":0.25,"),
             std::string::npos)
       << text;
-  EXPECT_NE(text.find("\"browDownRight\":0}}\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"surprised\":0}}\n"), std::string::npos) << text;
+  // All blendshapes 0: no "blendshapes" key at all.
+  EXPECT_EQ(text.find("blendshapes"), std::string::npos) << text;
+}
+
+TEST(pose_file, blendshapes_are_written_by_arkit_name_when_any_is_non_zero) {
+  temp_dir dir;
+  const std::string path = dir.file("b.pose.jsonl");
+  proxy_pose p;
+  p[blendshape::jaw_open] = 0.5f;
+  p[expression::happy] = 0.75f;
+  pose_writer w;
+  ASSERT_TRUE(w.open(path, {}).ok());
+  ASSERT_TRUE(w.write(p).ok());
+  ASSERT_TRUE(w.commit().ok());
+  std::string text = read_text(path);
+  EXPECT_NE(text.find("\"happy\":0.75,\"angry\":0,\"sad\":0,\"relaxed\":0,\"surprised\":0},"
+                      "\"blendshapes\":{\"browDownLeft\":0,\"browDownRight\":0,"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("\"jawLeft\":0,\"jawOpen\":0.5,\"jawRight\":0,"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"noseSneerRight\":0,\"tongueOut\":0}}\n"), std::string::npos) << text;
+}
+
+TEST(pose_file, blendshapes_and_emotions_read_by_name_missing_ones_are_zero) {
+  // A file written before 0.2.0 has no "blendshapes": all 0. A partial object sets only the
+  // shapes it names; stale values from the previous frame never survive.
+  const std::string text =
+      "{\"t\":0,\"expressions\":{\"aa\":0.5}}\n"
+      "{\"t\":1,\"expressions\":{\"sad\":0.25,\"relaxed\":1},"
+      "\"blendshapes\":{\"eyeBlinkRight\":0.125,\"tongueOut\":1}}\n"
+      "{\"t\":2}\n";
+  pose_reader r;
+  ASSERT_TRUE(r.open_memory(text.data(), text.size()).ok());
+  proxy_pose p;
+  p.blendshapes.fill(0.5f);
+  ASSERT_EQ(r.next(p), read_result::frame) << r.error();
+  for (float w : p.blendshapes) EXPECT_EQ(w, 0.f);
+  ASSERT_EQ(r.next(p), read_result::frame) << r.error();
+  EXPECT_EQ(p[expression::sad], 0.25f);
+  EXPECT_EQ(p[expression::relaxed], 1.f);
+  EXPECT_EQ(p[blendshape::eye_blink_right], 0.125f);
+  EXPECT_EQ(p[blendshape::tongue_out], 1.f);
+  float sum = 0.f;
+  for (float w : p.blendshapes) sum += w;
+  EXPECT_EQ(sum, 1.125f);
+  ASSERT_EQ(r.next(p), read_result::frame) << r.error();
+  for (float w : p.blendshapes) EXPECT_EQ(w, 0.f);
+  EXPECT_EQ(p[expression::sad], 0.f);
 }
 
 TEST(pose_file, foot_contact_is_optional_clamped_and_checked) {
@@ -197,6 +253,11 @@ TEST(pose_file, malformed_lines) {
       {"{\"t\":0,\"bones\":[]}", "expected '{'"},
       {"{\"t\":0,\"expressions\":{\"smile\":1}}", "unknown expression \"smile\""},
       {"{\"t\":0,\"expressions\":{\"aa\":null}}", "expression \"aa\" is null"},
+      {"{\"t\":0,\"blendshapes\":{\"mouthSmile\":1}}",
+       "unknown blendshape \"mouthSmile\" in \"blendshapes\""},
+      {"{\"t\":0,\"blendshapes\":{\"jawOpen\":null}}", "blendshape \"jawOpen\" is null"},
+      {"{\"t\":0,\"blendshapes\":{\"jawOpen\":1e999}}", "blendshape \"jawOpen\""},
+      {"{\"t\":0,\"blendshapes\":[0.5]}", "expected '{'"},
       {"{\"t\":0,\"confidence\":{\"tail\":1}}", "unknown bone \"tail\" in \"confidence\""},
       {"{\"t\":0,\"hips_position\":[0,null,0]}", "\"hips_position\" has a null value"},
       {"{\"t\":0,\"hips_position\":[0,1]}", "\"hips_position\" has 2 values"},

@@ -39,9 +39,10 @@ def read_landmarks_json(path):
     return out
 
 
-def read_poses_json(path, bone_names, expression_names):
-    """{"t", "hips_position", "rotations", "confidence", "expressions", "foot_contact"}
-    arrays of a *.pose.jsonl (absent confidence: None; absent foot_contact: 0, 0)."""
+def read_poses_json(path, bone_names, expression_names, blendshape_names=()):
+    """{"t", "hips_position", "rotations", "confidence", "expressions", "foot_contact",
+    "blendshapes"} arrays of a *.pose.jsonl (absent confidence: None; absent foot_contact:
+    0, 0; absent blendshapes: 0)."""
     frames = []
     with open(path, encoding="utf-8") as f:
         for i, line in enumerate(f):
@@ -58,7 +59,13 @@ def read_poses_json(path, bone_names, expression_names):
         "confidence" in fr for fr in frames) else None
     expr = np.zeros((n, len(expression_names)), dtype=np.float32)
     contact = np.zeros((n, 2), dtype=np.float32)
+    shapes = np.zeros((n, len(blendshape_names)), dtype=np.float32)
     for i, fr in enumerate(frames):
+        unknown = set(fr.get("blendshapes", {})) - set(blendshape_names)
+        assert not unknown or not blendshape_names, unknown
+        for s, name in enumerate(blendshape_names):
+            if name in fr.get("blendshapes", {}):
+                shapes[i, s] = np.float32(_f(fr["blendshapes"][name]))
         if "foot_contact" in fr:
             contact[i] = np.clip(np.float32([_f(v) for v in fr["foot_contact"]]), 0, 1)
         if "hips_position" in fr:
@@ -72,4 +79,5 @@ def read_poses_json(path, bone_names, expression_names):
             if name in fr.get("expressions", {}):
                 expr[i, e] = np.float32(_f(fr["expressions"][name]))
     return {"t": np.array([fr["t"] for fr in frames], dtype=np.float64), "hips_position": hips,
-            "rotations": rot, "confidence": conf, "expressions": expr, "foot_contact": contact}
+            "rotations": rot, "confidence": conf, "expressions": expr, "foot_contact": contact,
+            "blendshapes": shapes}

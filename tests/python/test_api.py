@@ -26,8 +26,9 @@ def test_bones_and_expressions_follow_the_header():
     for c_name, name in zip(c_names, am.BONE_NAMES):
         words = c_name.lower().split("_")
         assert name == words[0] + "".join(w.capitalize() for w in words[1:])
-    assert len(am.EXPRESSION_NAMES) == 16
+    assert len(am.EXPRESSION_NAMES) == 21
     assert am.EXPRESSION_NAMES[:4] == ("blink", "blinkLeft", "blinkRight", "aa")
+    assert am.EXPRESSION_NAMES[16:] == ("happy", "angry", "sad", "relaxed", "surprised")
     assert am.BONE_PARENTS[0] == -1
     assert all(0 <= p < i for i, p in enumerate(am.BONE_PARENTS) if i > 0)
     assert am.BONE_NAMES[am.BONE_PARENTS[am.bone_index("leftUpperArm")]] == "leftShoulder"
@@ -225,3 +226,28 @@ def test_close_while_another_thread_pushes():
     worker.join()
     assert outcome and (outcome[0] == "finished" or "closed" in outcome[0])
     assert len(pushed) >= 20
+
+
+def _camel(c_name):
+    words = c_name.lower().split("_")
+    return words[0] + "".join(w.capitalize() for w in words[1:])
+
+
+def test_expressions_and_blendshapes_follow_the_header():
+    text = _header_text()
+    enum = re.search(r"typedef enum avm_expression \{(.*?)\} avm_expression;", text, re.S).group(1)
+    assert tuple(_camel(n) for n in re.findall(r"AVM_EXPRESSION_([A-Z_]+)", enum)) == \
+        am.EXPRESSION_NAMES
+    enum = re.search(r"typedef enum avm_blendshape \{(.*?)\} avm_blendshape;", text, re.S).group(1)
+    c_names = re.findall(r"AVM_BLENDSHAPE_([A-Z_]+)", enum)
+    assert len(am.BLENDSHAPE_NAMES) == 52 == len(c_names)
+    # AVM_BLENDSHAPE_EYE_BLINK_LEFT <-> "eyeBlinkLeft", in the same order.
+    assert tuple(_camel(n) for n in c_names) == am.BLENDSHAPE_NAMES
+    # ARKit's names in Apple's alphabetical order, a few checked by hand.
+    assert list(am.BLENDSHAPE_NAMES) == sorted(am.BLENDSHAPE_NAMES)
+    assert am.BLENDSHAPE_NAMES[0] == "browDownLeft" and am.BLENDSHAPE_NAMES[-1] == "tongueOut"
+    assert am.BLENDSHAPE_NAMES.index("jawOpen") == 24
+    assert am.POSE_DTYPE["blendshapes"].shape == (52,)
+    assert am.POSE_DTYPE["expressions"].shape == (21,)
+    poses = am.Poses.empty(3)
+    assert poses.blendshapes.shape == (3, 52) and not poses.blendshapes.any()

@@ -19,9 +19,10 @@ def pose_file(synth_file, cli, tmp_path_factory):
 
 def test_read_poses_matches_the_json(pose_file):
     poses = am.read_poses(pose_file)
-    ref = read_poses_json(pose_file, am.BONE_NAMES, am.EXPRESSION_NAMES)
+    ref = read_poses_json(pose_file, am.BONE_NAMES, am.EXPRESSION_NAMES, am.BLENDSHAPE_NAMES)
     assert len(poses) == 120
-    for name in ("t", "hips_position", "rotations", "confidence", "expressions", "foot_contact"):
+    for name in ("t", "hips_position", "rotations", "confidence", "expressions", "foot_contact",
+                 "blendshapes"):
         np.testing.assert_array_equal(getattr(poses, name), ref[name], err_msg=name)
 
 
@@ -208,18 +209,29 @@ def test_pose_jsonl_round_trip(pose_file, tmp_path):
     # foot_contact travels too (a view of the records: writing to it changes them).
     poses.foot_contact[:, 0] = np.linspace(0.0, 1.0, len(poses), dtype=np.float32)
     poses.foot_contact[:, 1] = (np.arange(len(poses)) % 2).astype(np.float32)
+    # So do the blendshapes and the emotions (frames 0..59 none: the key is left out).
+    rng = np.random.default_rng(3)
+    poses.blendshapes[:60] = 0
+    poses.blendshapes[60:] = rng.random((len(poses) - 60, 52), dtype=np.float32)
+    poses.expressions[:, am.EXPRESSION_NAMES.index("surprised")] = 0.5
     am.write_animation(poses, out)
     back = am.read_poses(out)
     # (The clip writer writes no confidence, as `avatarmap convert` to .pose.jsonl.)
-    for name in ("t", "hips_position", "expressions", "foot_contact"):
+    for name in ("t", "hips_position", "expressions", "foot_contact", "blendshapes"):
         np.testing.assert_array_equal(getattr(back, name), getattr(poses, name), err_msg=name)
+    # ... as the file format says, by ARKit name (an independent JSON reader).
+    ref = read_poses_json(out, am.BONE_NAMES, am.EXPRESSION_NAMES, am.BLENDSHAPE_NAMES)
+    np.testing.assert_array_equal(ref["blendshapes"], poses.blendshapes)
+    lines = out.read_text().splitlines()
+    assert '"blendshapes"' not in lines[1] and '"blendshapes":{"browDownLeft":' in lines[61]
     # avm_clip_add normalises each rotation again: the last bit may change.
     np.testing.assert_allclose(back.rotations, poses.rotations, rtol=0, atol=2.5e-7)
     # Poses built from plain arrays (not views of records) write the same file.
     plain = am.Poses(t=np.array(poses.t), hips_position=np.array(poses.hips_position),
                      rotations=np.array(poses.rotations), confidence=np.array(poses.confidence),
                      expressions=np.array(poses.expressions),
-                     foot_contact=np.array(poses.foot_contact))
+                     foot_contact=np.array(poses.foot_contact),
+                     blendshapes=np.array(poses.blendshapes))
     out2 = tmp_path / "plain.pose.jsonl"
     am.write_animation(plain, out2)
     assert out2.read_bytes() == out.read_bytes()

@@ -577,7 +577,8 @@ def test_hostile_poses_for_writers(tmp_path, synth_file):
     plain = am.Poses(t=poses.t.copy(), hips_position=np.asfortranarray(poses.hips_position),
                      rotations=poses.rotations[:, :, ::-1][:, :, ::-1],
                      confidence=poses.confidence, expressions=poses.expressions,
-                     foot_contact=np.asfortranarray(poses.foot_contact))
+                     foot_contact=np.asfortranarray(poses.foot_contact),
+                     blendshapes=poses.blendshapes[:, ::-1][:, ::-1])
     am.write_animation(poses, tmp_path / "a.pose.jsonl")
     am.write_animation(plain, tmp_path / "b.pose.jsonl")
     assert (tmp_path / "a.pose.jsonl").read_bytes() == (tmp_path / "b.pose.jsonl").read_bytes()
@@ -605,7 +606,7 @@ def test_hostile_images_and_retargeter(data):
             rig.apply("poses")
         wrong = am.Poses(t=np.zeros(1), hips_position=np.zeros((1, 3)),
                          rotations=np.zeros((1, 54, 4)), confidence=np.zeros((1, 55)),
-                         expressions=np.zeros((1, 16)))
+                         expressions=np.zeros((1, 21)))
         with pytest.raises(am.InvalidArgumentError, match="rotations"):
             rig.apply(wrong)
     with pytest.raises(am.InvalidArgumentError, match="Retargeter is closed"):

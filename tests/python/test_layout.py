@@ -86,7 +86,7 @@ def test_ctypes_mirrors_match_the_header(tmp_path):
 def test_pose_dtype_matches_the_header(tmp_path):
     _, layout = _c_layout(tmp_path)
     size, offsets = layout["avm_pose"]
-    assert avatarmap.POSE_DTYPE.itemsize == size == 1192
+    assert avatarmap.POSE_DTYPE.itemsize == size == 1424  # 1192 before 0.2.0
     for field in avatarmap.POSE_DTYPE.names:
         assert avatarmap.POSE_DTYPE.fields[field][1] == offsets[field], field
     assert avatarmap.POSE_DTYPE["rotations"].shape == (55, 4)

@@ -111,8 +111,11 @@ def test_solve_file_without_output_returns_the_poses_of_solve(synth_file, file_f
 
 def test_live_filter_equals_the_per_frame_solver(synth_file):
     """file_filter="live" is avm_solver_push's filtering: solve() over the arrays equals a
-    Solver pushed frame by frame (another C path: avm_frame, one call per frame)."""
+    Solver pushed frame by frame (another C path: avm_frame, one call per frame). Without the
+    face: a file's face is calibrated over the whole take first, the Solver's live
+    (docs/expressions.md, "Calibration over a take")."""
     lm = am.read_landmarks(synth_file)
+    lm = am.Landmarks(**{**lm.__dict__, "face": np.full_like(lm.face, np.nan)})
     lm.image_width, lm.image_height = 1280, 720
     poses = am.solve(lm, file_filter="live")
     with am.Solver(image_width=1280, image_height=720) as solver:

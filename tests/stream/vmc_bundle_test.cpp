@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "avatarmap/rig/avatar_loader.hpp"
 #include "avatarmap/stream/unity_space.hpp"
@@ -30,10 +31,11 @@ struct decoded {
 };
 
 // Builds the bundle and decodes it; fails the test when either step fails.
-void build(const vmc_skeleton& s, const proxy_pose& pose, float time, decoded& out) {
+void build(const vmc_skeleton& s, const proxy_pose& pose, float time, decoded& out,
+           vmc_blend_set blends = vmc_blend_set::vrm0) {
   std::array<std::uint8_t, k_vmc_bundle_capacity> buf{};
   osc_writer w(buf.data(), buf.size());
-  ASSERT_TRUE(write_vmc_bundle(s, pose, time, w));
+  ASSERT_TRUE(write_vmc_bundle(s, pose, time, w, blends));
   ASSERT_TRUE(test::read_osc_packet(w.data(), w.size(), out.packet));
   for (const auto& m : out.packet.messages) {
     if (m.address == "/VMC/Ext/Bone/Pos") out.bones[m.args[0].s] = &m;
@@ -62,7 +64,7 @@ TEST(vmc_bundle, messages_in_order_with_every_bone_and_preset) {
   const auto& msgs = d.packet.messages;
   ASSERT_TRUE(d.packet.is_bundle);
   EXPECT_EQ(d.packet.time_tag, 1u);  // immediately
-  ASSERT_EQ(msgs.size(), 1u + 55u + 12u + 3u);
+  ASSERT_EQ(msgs.size(), 1u + 55u + 16u + 3u);
   EXPECT_EQ(msgs[0].address, "/VMC/Ext/Root/Pos");
   EXPECT_EQ(msgs[0].types, "sfffffff");
   EXPECT_EQ(msgs[0].args[0].s, "root");
@@ -74,23 +76,27 @@ TEST(vmc_bundle, messages_in_order_with_every_bone_and_preset) {
     EXPECT_EQ(m.types, "sfffffff");
     EXPECT_EQ(m.args[0].s, unity_bone_name(static_cast<bone>(b)));
   }
+  // VRM 0.x's preset names (UniVRM's BlendShapePreset), in the proxy's expression order.
   const char* presets[] = {"Blink", "Blink_L", "Blink_R", "A",        "I",        "U",
-                           "E",     "O",       "LookUp",  "LookDown", "LookLeft", "LookRight"};
-  for (int k = 0; k < 12; ++k) {
+                           "E",     "O",       "LookUp",  "LookDown", "LookLeft", "LookRight",
+                           "Joy",   "Angry",   "Sorrow",  "Fun"};
+  for (int k = 0; k < 16; ++k) {
     const auto& m = msgs[56 + k];
     EXPECT_EQ(m.address, "/VMC/Ext/Blend/Val");
     EXPECT_EQ(m.types, "sf");
     EXPECT_EQ(m.args[0].s, presets[k]);
   }
-  EXPECT_EQ(msgs[68].address, "/VMC/Ext/Blend/Apply");
-  EXPECT_EQ(msgs[68].types, "");
-  EXPECT_EQ(msgs[69].address, "/VMC/Ext/OK");
-  ASSERT_EQ(msgs[69].types, "i");
-  EXPECT_EQ(msgs[69].args[0].i, 1);
-  EXPECT_EQ(msgs[70].address, "/VMC/Ext/T");
-  ASSERT_EQ(msgs[70].types, "f");
-  EXPECT_EQ(msgs[70].args[0].f, 2.5f);
-  EXPECT_EQ(vmc_blend_count(), 12);
+  EXPECT_EQ(msgs[72].address, "/VMC/Ext/Blend/Apply");
+  EXPECT_EQ(msgs[72].types, "");
+  EXPECT_EQ(msgs[73].address, "/VMC/Ext/OK");
+  ASSERT_EQ(msgs[73].types, "i");
+  EXPECT_EQ(msgs[73].args[0].i, 1);
+  EXPECT_EQ(msgs[74].address, "/VMC/Ext/T");
+  ASSERT_EQ(msgs[74].types, "f");
+  EXPECT_EQ(msgs[74].args[0].f, 2.5f);
+  EXPECT_EQ(vmc_blend_count(), 16);
+  EXPECT_EQ(vmc_blend_count(vmc_blend_set::arkit), 52);
+  EXPECT_EQ(vmc_blend_count(vmc_blend_set::both), 68);
 }
 
 TEST(vmc_bundle, unity_bone_names_are_humanbodybones) {
@@ -227,9 +233,18 @@ TEST(vmc_bundle, expressions_by_vrm0_names_clamped) {
   pose[expression::oh] = std::numeric_limits<float>::quiet_NaN();
   pose[expression::ee] = -0.2f;
   pose[expression::brow_up_left] = 0.9f;  // no VRM 0.x preset: not sent
+  pose[expression::surprised] = 0.8f;     // likewise
+  pose[expression::happy] = 0.6f;         // VRM 0.x's Joy
+  pose[expression::sad] = 0.25f;          // Sorrow
+  pose[blendshape::jaw_open] = 0.5f;      // ARKit: not in the vrm0 set
   decoded d;
   build(s, pose, 0.f, d);
-  EXPECT_EQ(d.blends.size(), 12u);
+  EXPECT_EQ(d.blends.size(), 16u);
+  EXPECT_FLOAT_EQ(d.blends.at("Joy"), 0.6f);
+  EXPECT_FLOAT_EQ(d.blends.at("Sorrow"), 0.25f);
+  EXPECT_FLOAT_EQ(d.blends.at("Angry"), 0.f);
+  EXPECT_FLOAT_EQ(d.blends.at("Fun"), 0.f);
+  EXPECT_EQ(d.blends.count("jawOpen"), 0u);
   EXPECT_FLOAT_EQ(d.blends.at("A"), 0.7f);
   EXPECT_FLOAT_EQ(d.blends.at("Blink_L"), 0.3f);
   EXPECT_FLOAT_EQ(d.blends.at("LookRight"), 1.f);
@@ -237,6 +252,75 @@ TEST(vmc_bundle, expressions_by_vrm0_names_clamped) {
   EXPECT_FLOAT_EQ(d.blends.at("E"), 0.f);
   EXPECT_FLOAT_EQ(d.blends.at("Blink"), 0.f);
   for (const auto& [name, w] : d.blends) EXPECT_EQ(name.find("brow"), std::string::npos);
+}
+
+// Perfect Sync: ARKit's 52 by Apple's names (checked against Apple's list written out here, not
+// the library's table), in ARKit's alphabetical order, after the VRM 0.x presets with `both`.
+TEST(vmc_bundle, arkit_blendshapes_by_apple_names) {
+  const char* apple[] = {
+      "browDownLeft",      "browDownRight",      "browInnerUp",         "browOuterUpLeft",
+      "browOuterUpRight",  "cheekPuff",          "cheekSquintLeft",     "cheekSquintRight",
+      "eyeBlinkLeft",      "eyeBlinkRight",      "eyeLookDownLeft",     "eyeLookDownRight",
+      "eyeLookInLeft",     "eyeLookInRight",     "eyeLookOutLeft",      "eyeLookOutRight",
+      "eyeLookUpLeft",     "eyeLookUpRight",     "eyeSquintLeft",       "eyeSquintRight",
+      "eyeWideLeft",       "eyeWideRight",       "jawForward",          "jawLeft",
+      "jawOpen",           "jawRight",           "mouthClose",          "mouthDimpleLeft",
+      "mouthDimpleRight",  "mouthFrownLeft",     "mouthFrownRight",     "mouthFunnel",
+      "mouthLeft",         "mouthLowerDownLeft", "mouthLowerDownRight", "mouthPressLeft",
+      "mouthPressRight",   "mouthPucker",        "mouthRight",          "mouthRollLower",
+      "mouthRollUpper",    "mouthShrugLower",    "mouthShrugUpper",     "mouthSmileLeft",
+      "mouthSmileRight",   "mouthStretchLeft",   "mouthStretchRight",   "mouthUpperUpLeft",
+      "mouthUpperUpRight", "noseSneerLeft",      "noseSneerRight",      "tongueOut"};
+  const vmc_skeleton s = make_vmc_skeleton(make_proxy_skeleton());
+  proxy_pose pose;
+  for (int b = 0; b < k_blendshape_count; ++b) pose.blendshapes[b] = 0.01f * float(b + 1);
+  pose[blendshape::tongue_out] = 2.f;                                      // clamped
+  pose[blendshape::cheek_puff] = std::numeric_limits<float>::quiet_NaN();  // sent as 0
+  pose[expression::aa] = 0.4f;
+  for (vmc_blend_set set : {vmc_blend_set::arkit, vmc_blend_set::both}) {
+    decoded d;
+    build(s, pose, 0.f, d, set);
+    std::vector<std::string> names;
+    for (const auto& m : d.packet.messages)
+      if (m.address == "/VMC/Ext/Blend/Val") names.push_back(m.args[0].s);
+    const std::size_t first = set == vmc_blend_set::both ? 16u : 0u;
+    ASSERT_EQ(names.size(), first + 52u);
+    for (std::size_t k = 0; k < 52; ++k) EXPECT_EQ(names[first + k], apple[k]);
+    EXPECT_FLOAT_EQ(d.blends.at("browDownLeft"), 0.01f);
+    EXPECT_FLOAT_EQ(d.blends.at("jawOpen"), 0.25f);
+    EXPECT_FLOAT_EQ(d.blends.at("tongueOut"), 1.f);
+    EXPECT_FLOAT_EQ(d.blends.at("cheekPuff"), 0.f);
+    EXPECT_EQ(d.blends.count("A"), set == vmc_blend_set::both ? 1u : 0u);
+    if (set == vmc_blend_set::both) {
+      EXPECT_FLOAT_EQ(d.blends.at("A"), 0.4f);
+      EXPECT_EQ(names[0], "Blink");
+    }
+  }
+  EXPECT_EQ(vmc_blend_set_from_name("arkit"), vmc_blend_set::arkit);
+  EXPECT_EQ(vmc_blend_set_from_name("both"), vmc_blend_set::both);
+  EXPECT_EQ(vmc_blend_set_from_name("vrm0"), vmc_blend_set::vrm0);
+  EXPECT_FALSE(vmc_blend_set_from_name("ARKit").has_value());
+  EXPECT_FALSE(vmc_blend_set_from_name("").has_value());
+}
+
+// The eye bones go out as LeftEye/RightEye with the solver's gaze rotation (the proxy sends
+// every bone; an avatar without eye bones sends none: the bone-subset tests).
+TEST(vmc_bundle, eye_bones_carry_the_gaze) {
+  const vmc_skeleton s = make_vmc_skeleton(make_proxy_skeleton());
+  proxy_pose pose;
+  // Looking 20 degrees to the avatar's left (about +Y in VRM space), both eyes.
+  const glm::quat gaze = glm::angleAxis(20.f * k_pi / 180.f, glm::vec3(0, 1, 0));
+  pose[bone::left_eye] = gaze;
+  pose[bone::right_eye] = gaze;
+  pose[bone::head] = glm::angleAxis(0.2f, glm::vec3(1, 0, 0));
+  decoded d;
+  build(s, pose, 0.f, d);
+  ASSERT_EQ(d.bones.count("LeftEye"), 1u);
+  ASSERT_EQ(d.bones.count("RightEye"), 1u);
+  // Local to the head (the eyes' parent), Unity space: a turn about Y reverses its sense.
+  const float h = std::sin(10.f * k_pi / 180.f), c = std::cos(10.f * k_pi / 180.f);
+  expect_quat_near(rotation_of(*d.bones.at("LeftEye")), glm::quat(c, 0.f, -h, 0.f));
+  expect_quat_near(rotation_of(*d.bones.at("RightEye")), glm::quat(c, 0.f, -h, 0.f));
 }
 
 TEST(vmc_bundle, small_buffer_fails_cleanly) {
@@ -252,6 +336,11 @@ TEST(vmc_bundle, small_buffer_fails_cleanly) {
   ASSERT_TRUE(write_vmc_bundle(s, pose, 0.f, w2));
   EXPECT_LT(w2.size(), 6000u);
   EXPECT_GT(w2.size(), 5000u);
+  std::array<std::uint8_t, k_vmc_bundle_capacity> all{};
+  osc_writer w3(all.data(), all.size());
+  ASSERT_TRUE(write_vmc_bundle(s, pose, 0.f, w3, vmc_blend_set::both));
+  EXPECT_LT(w3.size(), 9000u);
+  EXPECT_GT(w3.size(), 7500u);
 }
 
 // Loads a shared avatar into a rig (skips without the data folder).

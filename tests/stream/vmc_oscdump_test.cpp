@@ -189,7 +189,7 @@ TEST(vmc_oscdump, bundles_arrive_at_an_independent_receiver) {
     }
     EXPECT_EQ(root, 1);
     EXPECT_EQ(bones.size(), 55u);
-    EXPECT_EQ(blends, 12);
+    EXPECT_EQ(blends, 16);  // the VRM 0.x presets (default set)
     EXPECT_EQ(apply, 1);
     EXPECT_EQ(ok, 1);
     EXPECT_EQ(t, 1);
@@ -208,6 +208,74 @@ TEST(vmc_oscdump, bundles_arrive_at_an_independent_receiver) {
     const dumped_message& hips = *bones.at("Hips");
     EXPECT_NEAR(std::stod(hips.args[1]), -0.01 * i, 2e-6);
     EXPECT_NEAR(std::stod(hips.args[2]), 0.9, 2e-6);
+  }
+}
+
+// --vmc-blendshapes both, as a Perfect Sync receiver gets it: the VRM 0.x presets and ARKit's
+// 52 by Apple's names with their values, and the eye bones with the gaze, in one datagram each.
+TEST(vmc_oscdump, perfect_sync_names_and_eye_bones_arrive) {
+  const std::string exe = find_oscdump();
+  if (exe.empty()) GTEST_SKIP() << "oscdump not found (Debian package liblo-tools)";
+  test::temp_dir dir("vmc_oscdump_arkit");
+  const std::string dump_path = (dir.path() / "dump.txt").string();
+  const int port = free_port();
+  oscdump_process rx(exe, port, dump_path);
+  ASSERT_TRUE(rx.started());
+  vmc_stream stream;
+  ASSERT_TRUE(stream
+                  .open({"127.0.0.1", port}, make_vmc_skeleton(make_proxy_skeleton()), {},
+                        vmc_blend_set::both)
+                  .ok());
+  EXPECT_EQ(stream.blend_messages(), 68);
+  udp_sender probe;
+  ASSERT_TRUE(probe.open({"127.0.0.1", port}).ok());
+  ASSERT_TRUE(rx.wait_for(probe, "/ready")) << "oscdump did not start: " << read_all(dump_path);
+
+  const int frames = 5;
+  proxy_pose pose;
+  for (int i = 0; i < frames; ++i) {
+    pose[blendshape::jaw_open] = 0.125f * static_cast<float>(i);
+    pose[blendshape::eye_blink_left] = 0.25f;
+    pose[blendshape::mouth_smile_right] = 0.5f;
+    pose[expression::happy] = 0.375f;
+    pose[bone::left_eye] = glm::angleAxis(0.1f * static_cast<float>(i), glm::vec3(0, 1, 0));
+    ASSERT_TRUE(stream.send(pose, 0.5f * static_cast<float>(i)));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_TRUE(rx.wait_for(probe, "/done"));
+  rx.stop();
+
+  std::vector<std::vector<dumped_message>> bundles;
+  std::string last;
+  for (auto& m : parse_dump(read_all(dump_path))) {
+    if (m.address == "/ready" || m.address == "/done") continue;
+    if (bundles.empty() || m.stamp != last) bundles.emplace_back();
+    last = m.stamp;
+    bundles.back().push_back(std::move(m));
+  }
+  ASSERT_EQ(static_cast<int>(bundles.size()), frames);
+  for (int i = 0; i < frames; ++i) {
+    std::map<std::string, double> blends;
+    const dumped_message* eye = nullptr;
+    for (const auto& m : bundles[static_cast<size_t>(i)]) {
+      if (m.address == "/VMC/Ext/Blend/Val") {
+        ASSERT_EQ(m.types, "sf");
+        blends[m.args.at(0)] = std::stod(m.args.at(1));
+      }
+      if (m.address == "/VMC/Ext/Bone/Pos" && m.args.at(0) == "LeftEye") eye = &m;
+    }
+    EXPECT_EQ(blends.size(), 68u);
+    EXPECT_NEAR(blends.at("jawOpen"), 0.125 * i, 1e-6);
+    EXPECT_NEAR(blends.at("eyeBlinkLeft"), 0.25, 1e-6);
+    EXPECT_NEAR(blends.at("mouthSmileRight"), 0.5, 1e-6);
+    EXPECT_NEAR(blends.at("tongueOut"), 0.0, 1e-6);
+    EXPECT_NEAR(blends.at("Joy"), 0.375, 1e-6);
+    EXPECT_NEAR(blends.at("A"), 0.0, 1e-6);
+    ASSERT_NE(eye, nullptr);
+    // A turn about VRM's +Y arrives about Unity's Y reversed: {0, -sin(a/2), 0, cos(a/2)}.
+    const double a = 0.1 * i;
+    EXPECT_NEAR(std::stod(eye->args.at(5)), -std::sin(a / 2), 2e-6);
+    EXPECT_NEAR(std::stod(eye->args.at(7)), std::cos(a / 2), 2e-6);
   }
 }
 

@@ -212,9 +212,11 @@ TEST(Synth, RestPoseRelations) {
   EXPECT_NEAR(glm::length(F[291] - F[61]), 0.05f * s, 1e-5f);
   EXPECT_NEAR(glm::length(F[454] - F[234]), 0.14f * s, 1e-5f);
   EXPECT_NEAR(F[13].y - F[14].y, 0.f, 1e-5f);  // mouth closed
+  // Lids on an arc: 0.85, 1 and 0.9 of the middle gap 0.22 w (outer -> inner).
   const int up[6] = {160, 159, 158, 387, 386, 385}, lo[6] = {144, 145, 153, 373, 374, 380};
+  const float arc[3] = {0.85f, 1.f, 0.9f};
   for (int i = 0; i < 6; ++i) {
-    EXPECT_NEAR(F[up[i]].y - F[lo[i]].y, 0.22f * w, 1e-5f);
+    EXPECT_NEAR(F[up[i]].y - F[lo[i]].y, arc[i % 3] * 0.22f * w, 1e-5f);
     float line = i < 3 ? F[133].y : F[362].y;
     EXPECT_NEAR(F[up[i]].y - line, line - F[lo[i]].y, 1e-5f);
   }
@@ -222,9 +224,9 @@ TEST(Synth, RestPoseRelations) {
   EXPECT_NEAR(F[334].y - F[386].y, 0.012f * s, 1e-5f);
   // Irises.
   for (auto [c, inner, outer] : {std::array<int, 3>{468, 133, 130}, {473, 362, 263}}) {
-    glm::vec3 expect = F[inner] + 0.55f * (F[outer] - F[inner]);
+    glm::vec3 expect = F[inner] + 0.5f * (F[outer] - F[inner]);
     EXPECT_NEAR(F[c].x, expect.x, 1e-5f);
-    EXPECT_NEAR(F[c].y - expect.y, 0.06f * w, 1e-5f);
+    EXPECT_NEAR(F[c].y - expect.y, 0.02f * w, 1e-5f);
     for (int r = 1; r <= 4; ++r) EXPECT_NEAR(glm::length(F[c + r] - F[c]), 0.0058f * s, 1e-5f);
   }
   // The template function agrees with the generated rest face (head joint + offset).
@@ -415,18 +417,18 @@ TEST(Synth, FaceCounts) {
   EXPECT_TRUE(f.has(frame_part::left_hand_world));
 }
 
-TEST(Synth, ExpressionsDriveTheFace) {
+TEST(Synth, BlendshapesDriveTheFace) {
   landmark_synth gen(all_parts());
   const float s = gen.skeleton().scale, w = 0.03f * s;
   proxy_pose p;
   // A turned head: measure along the head's axes.
   p[bone::head] = axis_angle(glm::normalize(glm::vec3(0.3f, 1.f, 0.2f)), 0.6f);
-  p[expression::blink] = 0.5f;
-  p[expression::blink_left] = 0.8f;
-  p[expression::aa] = 1.f;
-  p[expression::oh] = 1.f;  // sum 2: normalised to half each
-  p[expression::brow_up_left] = 1.f;
-  p[expression::brow_down_right] = 1.f;
+  p[blendshape::eye_blink_left] = 1.f;
+  p[blendshape::eye_blink_right] = 0.5f;
+  p[blendshape::jaw_open] = 0.5f;
+  p[blendshape::brow_outer_up_left] = 1.f;
+  p[blendshape::brow_down_right] = 1.f;
+  p[blendshape::mouth_smile_left] = 1.f;
   const float yaw = 0.3f, pitch = 0.2f;
   glm::quat eye =
       axis_angle(glm::vec3(0.f, 1.f, 0.f), yaw) * axis_angle(glm::vec3(1.f, 0.f, 0.f), pitch);
@@ -438,26 +440,58 @@ TEST(Synth, ExpressionsDriveTheFace) {
   const glm::quat head = world[idx(bone::head)];
   const glm::vec3 up = head * glm::vec3(0.f, 1.f, 0.f), lat = head * glm::vec3(1.f, 0.f, 0.f);
   const auto& F = gen.points().face;
-  const float cl = 1.f, cr = 0.5f;
-  EXPECT_NEAR(glm::dot(F[386] - F[374], up), (0.22f * (1 - cl) + 0.02f * cl) * w, 1e-5f);
-  EXPECT_NEAR(glm::dot(F[159] - F[145], up), (0.22f * (1 - cr) + 0.02f * cr) * w, 1e-5f);
-  const float open = 0.5f * 0.60f + 0.5f * 0.45f, ws = 0.5f * 1.f + 0.5f * 0.8f;
-  const float width = 0.05f * s * ws;
-  EXPECT_NEAR(glm::length(F[291] - F[61]), width, 1e-5f);
-  EXPECT_NEAR(glm::dot(F[13] - F[14], up), open * width, 1e-5f);
-  EXPECT_NEAR(blend_visemes(p).open, open, 1e-6f);
-  EXPECT_NEAR(glm::dot(F[334] - gen.points().head_joint, up) - face_template_point(334, s).y,
-              0.008f * s, 1e-5f);
-  EXPECT_NEAR(glm::dot(F[105] - gen.points().head_joint, up) - face_template_point(105, s).y,
-              -0.005f * s, 1e-5f);
+  const glm::vec3 o = gen.points().head_joint;
+  auto rest = [&](int i) { return o + head * face_template_point(i, s); };
+  // The population face (synth_face_shape{}): lids 0.22 w apart in the middle, shut at 0.09
+  // of that; the upper lid makes 80 % of the change.
+  EXPECT_NEAR(glm::dot(F[386] - F[374], up), 0.22f * 0.09f * w, 1e-5f);
+  EXPECT_NEAR(glm::dot(F[159] - F[145], up), 0.22f * w * (1.f - 0.91f * 0.5f), 1e-5f);
+  EXPECT_NEAR(glm::dot(F[386] - rest(386), up), -0.8f * 0.22f * 0.91f * w, 1e-5f);
+  // The lower inner lip drops 29 mm at jawOpen 1; the corners follow half; the left corner
+  // rises 9 mm for its smile and moves out by 0.6 of that.
+  const float drop = 0.029f * s * 0.5f;
+  EXPECT_NEAR(glm::dot(F[13] - F[14], up), drop, 1e-5f);
+  EXPECT_NEAR(glm::dot(F[291] - rest(291), up), 0.009f * s - 0.5f * drop, 1e-5f);
+  EXPECT_NEAR(glm::dot(F[291] - rest(291), lat), 0.6f * 0.009f * s, 1e-5f);
+  EXPECT_NEAR(glm::dot(F[61] - rest(61), up), -0.5f * drop, 1e-5f);
+  // Brows: the left outer end rises 7.5 mm, its middle half of that; the right brow lowers
+  // 5 mm in the middle.
+  EXPECT_NEAR(glm::dot(F[300] - rest(300), up), 0.0075f * s, 1e-5f);
+  EXPECT_NEAR(glm::dot(F[334] - rest(334), up), 0.5f * 0.0075f * s, 1e-5f);
+  EXPECT_NEAR(glm::dot(F[105] - rest(105), up), -0.005f * s, 1e-5f);
   // Left iris moved toward +X and down (positive pitch turns the gaze down); right one not.
-  glm::vec3 dl = F[473] - (gen.points().head_joint + head * face_template_point(473, s));
+  glm::vec3 dl = F[473] - rest(473);
   EXPECT_NEAR(glm::dot(dl, lat), 0.012f * s * std::sin(yaw), 1e-5f);
   EXPECT_NEAR(glm::dot(dl, up), -0.012f * s * std::sin(pitch), 1e-5f);
-  glm::vec3 dr = F[468] - (gen.points().head_joint + head * face_template_point(468, s));
-  EXPECT_NEAR(glm::length(dr), 0.f, 1e-5f);
+  EXPECT_NEAR(glm::length(F[468] - rest(468)), 0.f, 1e-5f);
   // Pose mouth corners follow the mouth.
   EXPECT_NEAR(glm::length(gen.points().pose[9] - F[291]), 0.f, 1e-6f);
+
+  // A pose with expressions only draws their blendshapes (blendshapes_from_expressions): aa
+  // opens the jaw fully.
+  proxy_pose q;
+  q[bone::head] = p[bone::head];
+  q[expression::aa] = 1.f;
+  gen.generate(q, f);
+  EXPECT_NEAR(glm::dot(gen.points().face[13] - gen.points().face[14], up), 0.029f * s, 1e-5f);
+}
+
+TEST(Synth, FaceVariationDrawsEachSeedItsOwnFace) {
+  synth_options o = all_parts();
+  o.face_variation = true;
+  o.seed = 3;
+  const synth_face_shape a = landmark_synth(o).face_shape();
+  o.seed = 4;
+  const synth_face_shape b = landmark_synth(o).face_shape();
+  EXPECT_NE(a.eye_open[0], b.eye_open[0]);
+  for (const synth_face_shape& f : {a, b}) {
+    EXPECT_GE(f.eye_open[0], 0.17f * 0.95f);
+    EXPECT_LE(f.eye_open[0], 0.28f * 1.05f);
+    EXPECT_GE(f.jaw_drop, 0.027f);
+    EXPECT_LE(f.jaw_drop, 0.031f);
+  }
+  o.face_variation = false;
+  EXPECT_EQ(landmark_synth(o).face_shape().eye_open[0], 0.22f);
 }
 
 TEST(RandomPose, FingersFlexTowardThePalmOnBothHands) {

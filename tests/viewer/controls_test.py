@@ -12,7 +12,8 @@ ratio, generous tolerance); without loop the clip stops at its end; a .glb and a
 opened through the file input play; an unknown file gets a message; `view x.glb` and `view
 x.bvh` play (the .bvh's poses are `avatarmap convert x.bvh -o y.pose.jsonl`'s); `view x.txt`
 exits 2 naming what it accepts; --video shows a <video> whose time follows the timeline; the
-built-in avatar is labelled as such and served on every page load. Exit 77 (skipped) without
+built-in avatar is labelled as such and served on every page load; the gaze of a .vrma we write
+(its lookAt) turns the avatar's eyes as three-vrm's lookAt maps it. Exit 77 (skipped) without
 chromium, the test data or the viewer's modules."""
 
 import json
@@ -271,6 +272,90 @@ def check_pose_seek(browser, poses, what, times=(6.0, 2.5, 8.9)):
               f"t {ref['t']:.3f} {fmt(want)}")
 
 
+def quat_mul(a, b):
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return [aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz]
+
+
+def axis_quat(axis, degrees):
+    import math
+    h = math.radians(degrees) / 2
+    return [math.sin(h) * c for c in axis] + [math.cos(h)]
+
+
+def gaze_pose_file(path, yaw, pitch, switch=2.0):
+    """A 4 s pose file: a still T-pose; from `switch` s both eyes turned by yaw (about +Y,
+    toward the avatar's left) then pitch (about +X, down) and happy = 1, before that straight
+    ahead and happy = 0. Returns the eye rotation [x, y, z, w]."""
+    eye = quat_mul(axis_quat((0, 1, 0), yaw), axis_quat((1, 0, 0), pitch))
+    with open(path, "w") as f:
+        f.write('{"format":"avatarmap.pose","version":1,"fps":30}\n')
+        for i in range(121):
+            t = i / 30
+            on = t >= switch - 1e-9
+            frame = {"t": t, "expressions": {"happy": 1 if on else 0}}
+            if on:
+                frame["bones"] = {"leftEye": eye, "rightEye": eye}
+            f.write(json.dumps(frame) + "\n")
+    return eye
+
+
+def avatar_look_at(path):
+    """The VRMC_vrm.lookAt object of a .vrm (GLB), read here."""
+    blob = open(path, "rb").read()
+    size = struct.unpack_from("<I", blob, 12)[0]
+    return json.loads(blob[20:20 + size])["extensions"]["VRMC_vrm"]["lookAt"]
+
+
+def check_gaze(browser):
+    """The gaze of a .vrma we write is played by three-vrm: the clip's eye rotations become the
+    file's lookAt, and the avatar's eye bones turn by the yaw and pitch of the gaze mapped through
+    the avatar's own lookAt range maps (read here from the .vrm: three-vrm's VRMLookAtBoneApplier
+    turns each eye by Euler YXZ (pitch', yaw'), yaw' = outputScale * min(yaw / inputMaxValue, 1),
+    the left eye's yaw toward its outer side by rangeMapHorizontalOuter, the right eye's by
+    rangeMapHorizontalInner, a positive pitch by rangeMapVerticalUp)."""
+    yaw, pitch = 20.0, 10.0
+    poses = os.path.join(WORK, "gaze.pose.jsonl")
+    clip = os.path.join(WORK, "gaze.vrma")
+    gaze_pose_file(poses, yaw, pitch)
+    run("convert", poses, "-o", clip)
+    look = avatar_look_at(ROBOT)
+    check(look.get("type", "bone") == "bone", f"{ROBOT}: a bone-type lookAt")
+
+    def mapped(name, value):
+        m = look[name]
+        return m["outputScale"] * min(max(value / m["inputMaxValue"], 0.0), 1.0)
+
+    def eye_rotation(horizontal):
+        return quat_mul(axis_quat((0, 1, 0), mapped(horizontal, yaw)),
+                        axis_quat((1, 0, 0), mapped("rangeMapVerticalUp", pitch)))
+
+    view = View(clip, "--avatar", ROBOT, "--quiet")
+    try:
+        state = loaded(browser, view.url, "vrma")
+        check(abs(state["clipDuration"] - 4.0) < 0.05,
+              f"gaze.vrma (with lookAt and happy) loads: {state['clipDuration']:.2f} s")
+        click(browser, "play")  # pause
+        seek(browser, "1.0")
+        for eye in ("leftEye", "rightEye"):
+            page = js(browser, f"window.avatarmapViewer.boneRotation('{eye}')")
+            check(same_rotation(page, [0, 0, 0, 1], 1e-6),
+                  f"gaze.vrma at 1 s: {eye} straight ahead {fmt(page)}")
+        seek(browser, "3.0")
+        for eye, horizontal in (("leftEye", "rangeMapHorizontalOuter"),
+                                ("rightEye", "rangeMapHorizontalInner")):
+            page = js(browser, f"window.avatarmapViewer.boneRotation('{eye}')")
+            want = eye_rotation(horizontal)
+            check(page is not None and angle_between(page, want) < 0.05,
+                  f"gaze.vrma at 3 s: {eye} {fmt(page)} = the gaze ({yaw:.0f} deg left, "
+                  f"{pitch:.0f} deg down) through the avatar's range maps {fmt(want)} "
+                  f"({angle_between(page, want) if page else float('nan'):.3f} deg)")
+    finally:
+        view.stop()
+
+
 def check_pose_file(browser, url, pose_file):
     loaded(browser, url, "poses")
     click(browser, "play")  # pause
@@ -434,6 +519,7 @@ def main():
             print(f"note: {VIDEO} is missing: --video not tried")
 
         check_builtin(browser)
+        check_gaze(browser)
         check(not browser.exceptions, f"no page exceptions: {browser.exceptions[:2]}")
     finally:
         browser.quit()

@@ -8,7 +8,10 @@ two canvas sizes) with a magenta marker at a bone; the marker's pixel must be wh
 rest position, read from the avatar file itself (the glTF nodes' translations), projects by hand
 through a pinhole with those numbers — within 2 pixels. Also: the background and floor colours,
 renderAt(t) on a .vrma clip is deterministic (the same t twice gives the same picture, another t
-another one), and no exception in the page. Exit 77 (skipped) without chromium, Pillow or the
+another one), an emotion preset (`happy`) of a .vrma we write is played by three-vrm (the face of
+an avatar whose happy moves its texture changes, and only when happy does), a pose's ARKit
+blendshapes move the built-in avatar's face and win over the expressions bound to the same
+morph target, and no exception in the page. Exit 77 (skipped) without chromium, Pillow or the
 viewer's modules."""
 
 import io
@@ -230,6 +233,110 @@ CAMERAS = [
 ]
 
 
+def still_face_clip(name, happy_from):
+    """A .vrma made by `avatarmap convert` from a pose file whose body stands still in the T-pose
+    for 4 s and whose `happy` weight is 0 before `happy_from` seconds and 1 from there (None:
+    never)."""
+    poses = os.path.join(WORK, name + ".pose.jsonl")
+    with open(poses, "w") as f:
+        f.write('{"format":"avatarmap.pose","version":1,"fps":30}\n')
+        for i in range(121):
+            t = i / 30
+            happy = 1 if happy_from is not None and t >= happy_from - 1e-9 else 0
+            f.write(json.dumps({"t": t, "expressions": {"happy": happy}}) + "\n")
+    clip = os.path.join(WORK, name + ".vrma")
+    subprocess.run([EXE, "convert", poses, "-o", clip, "--quiet"], check=True, capture_output=True)
+    return clip
+
+
+def check_emotion():
+    """three-vrm plays an emotion preset of our .vrma: with an avatar whose `happy` moves its
+    face texture (the VRM spec sample vrm1_spec_expressions.vrm), a still body renders the same
+    picture at two times while happy is 0, another one once happy is 1; the same clip without
+    happy renders the same picture at all three times."""
+    data = os.environ.get("AVATARMAP_TEST_DATA", "")
+    avatar = os.path.join(data, "avatars", "vrm1_spec_expressions.vrm")
+    if not data or not os.path.exists(avatar):
+        print("skip  the emotion check: AVATARMAP_TEST_DATA lacks avatars/vrm1_spec_expressions.vrm")
+        return
+    cam = CAMERAS[0][1]
+    for name, happy_from in (("happy", 2.0), ("no_happy", None)):
+        clip = still_face_clip(name, happy_from)
+        view = View(clip, "--avatar", avatar)
+        browser = cdp.Browser(640, 360)
+        try:
+            open_page(browser, view.url + query(cam, "none"), cam["size"])
+            pictures = []
+            for t in (0.5, 1.5, 3.0):
+                call(browser, f"window.avatarmapViewer.renderAt({t})")
+                pictures.append(shot(browser, cam["size"]).tobytes())
+            check(pictures[0] == pictures[1], f"{name}.vrma: a still body, the same picture at 0.5 "
+                                              "and 1.5 s")
+            if happy_from is None:
+                check(pictures[0] == pictures[2], f"{name}.vrma: without happy, the same at 3 s")
+            else:
+                changed = sum(1 for a, b in zip(pictures[0], pictures[2]) if a != b) // 3
+                check(changed > 0, f"{name}.vrma: happy = 1 at 3 s changes the face "
+                                   f"(~{changed} pixel components differ)")
+            check(not browser.exceptions, f"{name}.vrma: no exception in the page "
+                                          f"{browser.exceptions[:2]}")
+        finally:
+            browser.quit()
+            view.stop()
+
+
+def check_arkit(avatar):
+    """A pose's ARKit blendshapes move the built-in avatar's face (its 52 ARKit morph targets,
+    set directly), and win over the expressions bound to the same target: aa (bound to
+    jawOpen x 0.75) with jawOpen 0.75 draws what jawOpen 0.75 alone draws, not a mouth open
+    1.5 times; aa alone draws the same (three-vrm applies 0.75 to the same target); a pose
+    without blendshapes afterwards draws the neutral face again."""
+    cam = dict(pos=[0, 1.6, 0.7], look=[0, 1.6, 0], hfov=30, size=(320, 320))
+    view = View("--avatar", avatar)
+    browser = cdp.Browser(320, 320)
+    try:
+        state = open_page(browser, view.url + query(cam, "none"), cam["size"])
+        # Its custom expressions browDownLeft/Right are ARKit names too: they claim those two
+        # shapes (bound to the targets of the same names, weight 1); the 50 others are targets.
+        check(state.get("arkitTargets") == 50 and state.get("arkitExpressions") == 2,
+              f"the built-in avatar: 50 ARKit targets and 2 ARKit-named expressions "
+              f"({state.get('arkitTargets')}, {state.get('arkitExpressions')})")
+        poses = {
+            "neutral": {},
+            "jawOpen 1": {"blendshapes": {"jawOpen": 1}},
+            "aa": {"expressions": {"aa": 1}},
+            "jawOpen 0.75": {"blendshapes": {"jawOpen": 0.75}},
+            "aa + jawOpen 0.75": {"expressions": {"aa": 1}, "blendshapes": {"jawOpen": 0.75}},
+            "tongueOut": {"blendshapes": {"tongueOut": 1}},
+            "browDownLeft": {"blendshapes": {"browDownLeft": 1}},
+            "neutral again": {"expressions": {"aa": 0}},
+        }
+        pictures = {}
+        for name, pose in poses.items():
+            call(browser, f"window.avatarmapViewer.renderPose({json.dumps(pose)})")
+            pictures[name] = shot(browser, cam["size"]).tobytes()
+
+        def differ(a, b):
+            return sum(1 for x, y in zip(pictures[a], pictures[b]) if x != y) // 3
+
+        for name in ("jawOpen 1", "aa", "tongueOut", "browDownLeft"):
+            check(differ("neutral", name) > 50,
+                  f"{name} changes the face ({differ('neutral', name)} pixel components)")
+        check(differ("aa", "jawOpen 0.75") == 0,
+              f"aa = jawOpen x 0.75 on the built-in avatar ({differ('aa', 'jawOpen 0.75')})")
+        check(differ("aa + jawOpen 0.75", "jawOpen 0.75") == 0,
+              "aa with jawOpen 0.75: the blendshape alone drives jawOpen "
+              f"({differ('aa + jawOpen 0.75', 'jawOpen 0.75')})")
+        check(differ("neutral again", "neutral") == 0,
+              f"a pose without blendshapes: the neutral face again "
+              f"({differ('neutral again', 'neutral')})")
+        check(not browser.exceptions, f"ARKit poses: no exception in the page "
+                                      f"{browser.exceptions[:2]}")
+    finally:
+        browser.quit()
+        view.stop()
+
+
 def main():
     avatar = os.path.join(WORK, "builtin.vrm")
     subprocess.run([EXE, "avatar", "-o", avatar], check=True, capture_output=True)
@@ -306,6 +413,8 @@ def main():
     finally:
         browser.quit()
         view.stop()
+    check_emotion()
+    check_arkit(avatar)
     if failures:
         print(f"{len(failures)} check(s) failed")
         sys.exit(1)

@@ -7,8 +7,13 @@ DENSIFY, SAME / VALID padding with odd sizes, dilation, depth multiplier,
 fused activations - converts it, runs onnx.checker and strict shape
 inference, compares against the numpy reference interpreter when an ORT runner
 is available ($AVATARMAP_ORT_RUN or --ort-run, see ort_run.cpp), and checks
---drop-outputs pruning.  When $AVATARMAP_MODELS names a directory of real
-.tflite files, verify.py runs on them too (needs the ORT runner).
+--drop-outputs pruning.  A second synthetic model holds MediaPipe's custom
+operators (Landmarks2TransformMatrix, TransformTensorBilinear and
+TransformLandmarks, version 2, options as FlexBuffers) and STRIDED_SLICE: the
+FlexBuffer reader is checked on a hand-encoded buffer, and each operator's ONNX
+rewrite against the numpy reference on random inputs (with the ORT runner).
+When $AVATARMAP_MODELS names a directory of real .tflite files, verify.py runs
+on them too (needs the ORT runner).
 
 Exit status 0 on success, 1 on failure; 77 ("skipped") when python3-onnx or
 numpy is missing, so CTest can mark it skipped (SKIP_RETURN_CODE 77).
@@ -32,7 +37,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import tflite2onnx  # noqa: E402
 from tflite_numpy_ref import Interpreter, densify_ref  # noqa: E402
-from tflite_reader import OPS, Model  # noqa: E402
+from tflite_reader import OPS, Model, read_flexbuffer  # noqa: E402
 
 
 # ---------------------------------------------------------------- flatbuffer writer
@@ -144,7 +149,7 @@ class TFLiteBuilder:
     def const(self, array):
         return self.tensor(np.asarray(array).shape, np.asarray(array))
 
-    def op(self, name, inputs, out_shape, options=None):
+    def op(self, name, inputs, out_shape, options=None, custom=None):
         if name not in self.opcodes:
             self.opcodes.append(name)
         out = self.tensor(out_shape)
@@ -153,6 +158,8 @@ class TFLiteBuilder:
         if options is not None:
             f[3] = ("B", 1)  # union type byte; this reader decodes options by opcode
             f[4] = ("off", ("table", options))
+        if custom is not None:
+            f[5] = ("off", ("vec", "B", list(custom)))
         self.ops.append(("table", f))
         return out
 
@@ -160,7 +167,9 @@ class TFLiteBuilder:
         if names:  # rename output tensors
             for i, n in zip(outputs, names):
                 self.tensors[i][1][3] = ("off", ("str", n))
-        codes = [("table", {0: ("b", min(CODES[n], 127)), 2: ("i", 1), 3: ("i", CODES[n])}) for n in self.opcodes]
+        codes = [("table", {0: ("b", 32), 1: ("off", ("str", n[7:])), 2: ("i", 2), 3: ("i", 32)})
+                 if n.startswith("CUSTOM:") else
+                 ("table", {0: ("b", min(CODES[n], 127)), 2: ("i", 1), 3: ("i", CODES[n])}) for n in self.opcodes]
         sub = ("table", {0: ("off", ("tables", self.tensors)), 1: ("off", ("vec", "i", inputs)),
                          2: ("off", ("vec", "i", outputs)), 3: ("off", ("tables", self.ops)),
                          4: ("off", ("str", "main"))})
@@ -240,6 +249,80 @@ def synthetic_model():
     return b.build([x], [o0, o1, o2, o3, o4, o5, o6], names), dense
 
 
+def flexbuffer_map(d):
+    """Encode {key: int | float | [int]} as a FlexBuffer map (all widths 4 bytes), written
+    from the FlexBuffers format description: keys (C strings), int vectors, the keys vector,
+    the map (keys offset, keys width, size, values, one type byte per value), then the root
+    (offset, packed type, width)."""
+    buf = bytearray()
+
+    def align():
+        while len(buf) % 4:
+            buf.append(0)
+
+    keys = sorted(d)
+    kpos, vpos = {}, {}
+    for k in keys:
+        kpos[k] = len(buf)
+        buf += k.encode() + b"\0"
+    for k in keys:
+        if isinstance(d[k], list):
+            align()
+            buf += struct.pack("<I", len(d[k]))
+            vpos[k] = len(buf)
+            buf += b"".join(struct.pack("<i", v) for v in d[k])
+    align()
+    buf += struct.pack("<I", len(keys))
+    keys_vec = len(buf)
+    for k in keys:
+        buf += struct.pack("<I", len(buf) - kpos[k])
+    buf += struct.pack("<I", len(buf) - keys_vec) + struct.pack("<II", 4, len(keys))
+    map_pos = len(buf)
+    types = []
+    for k in keys:
+        v = d[k]
+        if isinstance(v, list):
+            buf += struct.pack("<I", len(buf) - vpos[k])
+            types.append((11 << 2) | 2)   # VECTOR_INT, 4-byte elements
+        elif isinstance(v, float):
+            buf += struct.pack("<f", v)
+            types.append((3 << 2) | 2)    # FLOAT
+        else:
+            buf += struct.pack("<i", v)
+            types.append((1 << 2) | 2)    # INT
+    buf += bytes(types)
+    buf += struct.pack("<I", len(buf) - map_pos) + bytes([(9 << 2) | 2, 4])  # MAP root
+    return bytes(buf)
+
+
+# The custom-operator model: the input (a 6x7 map, 3 channels) doubles as landmarks
+# (x, y, z), 42 of them, scaled into the map's pixel range, so the matrices land on the map.
+L2TM_OPTS = {"left_rotation_idx": 2, "right_rotation_idx": 9, "output_width": 4, "output_height": 5,
+             "scale_x": 1.5, "scale_y": 1.25, "target_rotation_radians": 0.3,
+             "subset_idxs": [1, 3, 4, 7, 8, 11, 13]}  # odd count: the last pairs with itself
+
+
+def custom_ops_model():
+    rs = np.random.RandomState(11)
+    b = TFLiteBuilder()
+    x = b.tensor([1, 6, 7, 3], name="input")
+    lm = b.op("RESHAPE", [x, b.const(np.array([1, 42, 3], np.int32))], [1, 42, 3])
+    lm = b.op("MUL", [lm, b.const(np.array([3.0], np.float32))], [1, 42, 3], {0: ("b", 0)})
+    lm = b.op("ADD", [lm, b.const(np.array([3.0], np.float32))], [1, 42, 3], {0: ("b", 0)})
+    mat = b.op("CUSTOM:Landmarks2TransformMatrix", [lm], [1, 4, 4], custom=flexbuffer_map(L2TM_OPTS))
+    smp = b.op("CUSTOM:TransformTensorBilinear", [x, mat], [1, 5, 4, 3],
+               custom=flexbuffer_map({"output_height": 5, "output_width": 4}))
+    flat = b.op("RESHAPE", [smp, b.const(np.array([1, 30, 2], np.int32))], [1, 30, 2])
+    m2 = b.op("MUL", [mat, b.const((1 + 0.1 * rs.randn(1, 4, 4)).astype(np.float32))], [1, 4, 4], {0: ("b", 0)})
+    t2 = b.op("CUSTOM:TransformLandmarks", [flat, m2], [1, 30, 2])
+    t3 = b.op("CUSTOM:TransformLandmarks", [lm, mat], [1, 42, 3])
+    ss = b.op("STRIDED_SLICE", [x, b.const(np.array([0, 1, 5, 0], np.int32)), b.const(np.array([1, 6, 0, 2], np.int32)),
+                                b.const(np.array([1, 2, -2, 1], np.int32))], [1, 3, 3, 3],
+              {0: ("i", 0), 1: ("i", 0b1100)})  # end_mask on W and C: W 5, 3, 1; C all
+    names = ["matrix", "sampled", "landmarks2", "landmarks3", "sliced"]
+    return b.build([x], [mat, smp, t2, t3, ss], names)
+
+
 def run_ort(ort_run, onnx_path, x, work):
     sys.path.insert(0, HERE)
     from verify import run_ort as vr
@@ -293,6 +376,40 @@ def main(argv=None):
     except tflite2onnx.ConversionError:
         check(True, "--drop-outputs rejects unknown names")
 
+    # ---- custom operators
+    fb_opts = read_flexbuffer(flexbuffer_map(L2TM_OPTS))
+    check(fb_opts == {k: (np.float32(v).item() if isinstance(v, float) else v) for k, v in L2TM_OPTS.items()},
+          "FlexBuffer map decodes (ints, floats, int vector)")
+    csrc = os.path.join(work, "custom.tflite")
+    open(csrc, "wb").write(custom_ops_model())
+    cm = Model.load(csrc)
+    check([o.version for o in cm.operators if o.op.startswith("CUSTOM:")] == [2, 2, 2, 2]
+          and read_flexbuffer(cm.operators[3].custom)["subset_idxs"] == L2TM_OPTS["subset_idxs"],
+          "reader keeps custom operators' version and options")
+    cdst = os.path.join(work, "custom.onnx")
+    cgraph = tflite2onnx.convert_file(csrc, cdst)
+    cops = {n.op_type for n in cgraph.graph.node}
+    check(not any(n.domain for n in cgraph.graph.node) and {"Gather", "MatMul", "Slice"} <= cops,
+          "custom operators become standard ONNX operators")
+    # The reference on a known case: identity-like landmarks give the documented matrix.
+    pts = np.zeros((1, 42, 3))
+    pts[0, 2, :2], pts[0, 9, :2] = (1.0, 1.0), (3.0, 1.0)   # horizontal: rotation = target
+    from tflite_numpy_ref import landmarks_to_transform_matrix_ref, transform_tensor_bilinear_ref
+    o = dict(L2TM_OPTS, target_rotation_radians=0.0, subset_idxs=[2, 9], scale_x=1.0, scale_y=1.0)
+    mref = landmarks_to_transform_matrix_ref(pts, o)[0]
+    # box x 1..3 (width 2), y 1..1 (height 0): centre (2, 1); scale 2/4, 0/5; shift -(2, 2.5)
+    check(np.allclose(mref, [[0.5, 0, 0, 1.0], [0, 0, 0, 1.0], [0, 0, 1, 0], [0, 0, 0, 1]]),
+          "reference Landmarks2TransformMatrix: known answer")
+    fmap = np.arange(12, dtype=np.float64).reshape(1, 3, 4, 1)
+    ident = np.eye(4)[None]
+    check(np.allclose(transform_tensor_bilinear_ref(fmap, ident, (1, 3, 4, 1)), fmap),
+          "reference TransformTensorBilinear: identity matrix reproduces the map")
+    half = np.eye(4)[None].copy()
+    half[0, 0, 3] = 0.5
+    shifted = transform_tensor_bilinear_ref(fmap, half, (1, 3, 4, 1))[0, :, :, 0]
+    check(np.allclose(shifted[:, :3], fmap[0, :, :3, 0] + 0.5) and np.allclose(shifted[:, 3], 0),
+          "reference TransformTensorBilinear: half-pixel shift interpolates, outside is 0")
+
     x = np.random.RandomState(1).uniform(-1, 1, (1, 9, 9, 3)).astype(np.float32)
     ref = Interpreter(src).run(x)
     if a.ort_run and os.path.exists(a.ort_run):
@@ -300,6 +417,24 @@ def main(argv=None):
         for (name, _), r in zip(outs, ref):
             d = float(np.max(np.abs(got[name] - r)))
             check(d < 1e-4, "ORT vs numpy %-8s max abs diff %.2e" % (name, d))
+        cinterp = Interpreter(csrc)
+        cnames = [o.name for o in cgraph.graph.output]
+        worst = {n: 0.0 for n in cnames}
+        inputs = [np.random.RandomState(100 + k).uniform(-1, 1, (1, 6, 7, 3)).astype(np.float32) for k in range(8)]
+        degenerate = inputs[0].copy().reshape(1, 42, 3)
+        degenerate[0, 9] = degenerate[0, 2]       # both rotation landmarks on one spot: atan2(0, 0)
+        inputs.append(degenerate.reshape(1, 6, 7, 3))
+        nonzero = 0
+        for cx in inputs:
+            cref = cinterp.run(cx)
+            cgot = run_ort(a.ort_run, cdst, cx, work)
+            for n, r in zip(cnames, cref):
+                worst[n] = max(worst[n], float(np.max(np.abs(cgot[n] - r))) / max(1.0, float(np.max(np.abs(r)))))
+            nonzero += int(np.count_nonzero(cref[1]))
+        for n in cnames:
+            check(worst[n] < 1e-4, "ORT vs numpy, custom model %-10s max rel diff %.2e (9 inputs)" % (n, worst[n]))
+        check(nonzero > 0.25 * 9 * 60, "the sampled maps are mostly inside the feature map (%d of %d)"
+              % (nonzero, 9 * 60))
         if a.models:
             rc = subprocess.call([sys.executable, os.path.join(HERE, "verify.py"), "--models", a.models,
                                   "--ort-run", a.ort_run, "--work", work])

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Convert a float TFLite model (MediaPipe's pose / hand / palm models) to ONNX.
+"""Convert a float TFLite model (MediaPipe's pose / hand / palm / face models) to ONNX.
 
 Usage: /usr/bin/python3 tools/convert/tflite2onnx.py in.tflite out.onnx
            [--drop-outputs NAME,NAME] [--opset 13]
@@ -12,6 +12,9 @@ internally; rank-4 graph outputs are transposed back to NHWC, flat outputs
 are passed through.  So the ONNX model has exactly the TFLite signature
 (names, shapes, element order).  Constant-only subgraphs (DEQUANTIZE of
 float16 weights, DENSIFY of sparse weights) are folded at conversion time.
+MediaPipe's custom operators of face_landmark_with_attention (version 2 of
+Landmarks2TransformMatrix, TransformTensorBilinear, TransformLandmarks) are
+rewritten as standard ONNX operators (custom_ops() below).
 See docs/convert.md.
 """
 
@@ -25,7 +28,7 @@ from onnx import TensorProto, helper, numpy_helper
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from tflite_reader import (ACT_NONE, ACT_RELU, ACT_RELU6, ACT_RELU_N1_TO_1, ACT_TANH,  # noqa: E402
-                           DIM_DENSE, PAD_SAME, Model)
+                           DIM_DENSE, PAD_SAME, Model, read_flexbuffer)
 
 NHWC_TO_NCHW = [0, 3, 1, 2]
 NCHW_TO_NHWC = [0, 2, 3, 1]
@@ -248,8 +251,215 @@ class Converter:
             xa, xb = self.value(a), self.operand_like(b, a)
         self.finish(op, self.node(kind, [xa, xb]))
 
+    # ---- MediaPipe's custom operators -------------------------------------------------
+    # Their meaning (version 2, the one face_landmark_with_attention uses) is documented in
+    # docs/convert.md "Custom operators"; tflite_numpy_ref.py holds an independent reference.
+    def scalar_const(self, v, dtype=np.float32):
+        """A true rank-0 initializer (init() makes 0-d arrays rank 1)."""
+        name = self.fresh("k")
+        self.inits.append(numpy_helper.from_array(np.array(v, dtype), name))
+        return name
+
+    def landmarks_to_transform_matrix(self, op, o):
+        """Similarity transform (4x4, row-major) mapping an output_width x output_height grid
+        onto the rotated box of a landmark subset: rotation from two landmarks, box = extent of
+        the subset in the rotated frame, scaled by scale_x / scale_y.  Trigonometry-free: the
+        rotation's cosine and sine come from the normalised direction vector."""
+        for key in ("left_rotation_idx", "right_rotation_idx", "output_width", "output_height",
+                    "scale_x", "scale_y", "subset_idxs"):
+            if key not in o:
+                raise ConversionError("Landmarks2TransformMatrix: option %s missing" % key)
+        n_points = self.shape(op.inputs[0])[1]
+        subset = [int(i) for i in o["subset_idxs"]]
+        li, ri = int(o["left_rotation_idx"]), int(o["right_rotation_idx"])
+        if not subset or min(subset + [li, ri]) < 0 or max(subset + [li, ri]) >= n_points:
+            raise ConversionError("Landmarks2TransformMatrix: landmark index out of range")
+        ow, oh = float(o["output_width"]), float(o["output_height"])
+        sx, sy = float(o["scale_x"]), float(o["scale_y"])
+        if not (ow > 0 and oh > 0 and sx > 0 and sy > 0):
+            raise ConversionError("Landmarks2TransformMatrix: sizes and scales must be > 0")
+        target = float(o.get("target_rotation_radians", 0.0))
+        x = self.value(op.inputs[0])                                     # [1, N, 3]
+        i0 = self.scalar_const(0, np.int64)
+        i1 = self.scalar_const(1, np.int64)
+        d = self.node("Sub", [self.node("Gather", [x, self.init("ri", np.array([ri], np.int64))], axis=1),
+                              self.node("Gather", [x, self.init("li", np.array([li], np.int64))], axis=1)])
+        dx = self.node("Gather", [d, i0], axis=2)                       # [1, 1]
+        dy = self.node("Gather", [d, i1], axis=2)
+        norm = self.node("Sqrt", [self.node("Add", [self.node("Mul", [dx, dx]), self.node("Mul", [dy, dy])])])
+        # atan2(0, 0) = 0: a zero direction counts as (1, 0)
+        zero = self.node("Cast", [self.node("Equal", [norm, self.scalar_const(0.0)])], to=TensorProto.FLOAT)
+        den = self.node("Add", [norm, zero])
+        cos_t = self.node("Div", [self.node("Add", [dx, zero]), den])
+        sin_t = self.node("Div", [dy, den])
+        # r = target - theta
+        ct, st = self.scalar_const(np.cos(target)), self.scalar_const(np.sin(target))
+        c = self.node("Add", [self.node("Mul", [cos_t, ct]), self.node("Mul", [sin_t, st])])
+        s = self.node("Sub", [self.node("Mul", [cos_t, st]), self.node("Mul", [sin_t, ct])])
+        p = self.node("Gather", [x, self.init("subset", np.array(subset, np.int64))], axis=1)  # [1, K, 3]
+        px = self.node("Gather", [p, i0], axis=2)                       # [1, K]
+        py = self.node("Gather", [p, i1], axis=2)
+        rx = self.node("Sub", [self.node("Mul", [c, px]), self.node("Mul", [s, py])])
+        ry = self.node("Add", [self.node("Mul", [s, px]), self.node("Mul", [c, py])])
+        half = self.scalar_const(0.5)
+        ext = {}
+        for name, v in (("x", rx), ("y", ry)):
+            hi = self.node("ReduceMax", [v], axes=[1], keepdims=1)      # [1, 1]
+            lo = self.node("ReduceMin", [v], axes=[1], keepdims=1)
+            ext[name] = (self.node("Sub", [hi, lo]), self.node("Mul", [self.node("Add", [hi, lo]), half]))
+        (w, mx), (h, my) = ext["x"], ext["y"]
+        # box centre back in the landmarks' frame (rotation by -r)
+        cx = self.node("Add", [self.node("Mul", [c, mx]), self.node("Mul", [s, my])])
+        cy = self.node("Sub", [self.node("Mul", [c, my]), self.node("Mul", [s, mx])])
+        scale_x = self.node("Mul", [w, self.scalar_const(sx / ow)])
+        scale_y = self.node("Mul", [h, self.scalar_const(sy / oh)])
+        a00 = self.node("Mul", [c, scale_x])
+        a01 = self.node("Mul", [s, scale_y])
+        a10 = self.node("Neg", [self.node("Mul", [s, scale_x])])
+        a11 = self.node("Mul", [c, scale_y])
+        hw, hh = self.scalar_const(-ow / 2.0), self.scalar_const(-oh / 2.0)
+        tx = self.node("Add", [cx, self.node("Add", [self.node("Mul", [a00, hw]), self.node("Mul", [a01, hh])])])
+        ty = self.node("Add", [cy, self.node("Add", [self.node("Mul", [a10, hw]), self.node("Mul", [a11, hh])])])
+        z, one = self.init("zero11", np.zeros((1, 1), np.float32)), self.init("one11", np.ones((1, 1), np.float32))
+        flat = self.node("Concat", [a00, a01, z, tx, a10, a11, z, ty, z, z, one, z, z, z, z, one], axis=1)
+        self.node("Reshape", [flat, self.init("shape", np.array([1, 4, 4], np.int64))],
+                  [self.out_name(op.outputs[0])])
+
+    def matrix_parts(self, m_idx):
+        """2x2 linear part (or its transpose) and translation of a [1, 4, 4] affine matrix."""
+        m = self.node("Reshape", [self.value(m_idx), self.init("shape", np.array([16], np.int64))])
+        a = self.node("Reshape", [self.node("Gather", [m, self.init("a", np.array([0, 1, 4, 5], np.int64))], axis=0),
+                                  self.init("shape", np.array([2, 2], np.int64))])
+        at = self.node("Reshape", [self.node("Gather", [m, self.init("at", np.array([0, 4, 1, 5], np.int64))], axis=0),
+                                   self.init("shape", np.array([2, 2], np.int64))])
+        t = self.node("Gather", [m, self.init("t", np.array([3, 7], np.int64))], axis=0)   # [2]
+        return a, at, t
+
+    def transform_tensor_bilinear(self, op, o):
+        """Bilinear sampling of an NHWC feature map at (A (x + 0.5, y + 0.5) + t - 0.5) for each
+        output pixel (x, y); samples outside [0, W-1] x [0, H-1] are 0.  Done with gathers on the
+        flattened map (exact at every position, opset 13)."""
+        f_idx, m_idx = op.inputs[0], op.inputs[1]
+        n, h, w, ch = self.shape(f_idx)
+        _, oh, ow, och = self.shape(op.outputs[0])
+        if n != 1 or och != ch:
+            raise ConversionError("TransformTensorBilinear: batch must be 1 and channels kept")
+        if "output_height" in o and (o["output_height"], o["output_width"]) != (oh, ow):
+            raise ConversionError("TransformTensorBilinear: options disagree with the output shape")
+        a, _, t = self.matrix_parts(m_idx)
+        gy, gx = np.meshgrid(np.arange(oh, dtype=np.float32) + 0.5, np.arange(ow, dtype=np.float32) + 0.5,
+                             indexing="ij")
+        grid = self.init("grid", np.stack([gx.ravel(), gy.ravel()]))   # [2, P], row-major pixels
+        shift = self.node("Sub", [self.node("Reshape", [t, self.init("shape", np.array([2, 1], np.int64))]),
+                                  self.scalar_const(0.5)])
+        tc = self.node("Add", [self.node("MatMul", [a, grid]), shift])  # [2, P]
+        tcx = self.node("Gather", [tc, self.scalar_const(0, np.int64)], axis=0)   # [P]
+        tcy = self.node("Gather", [tc, self.scalar_const(1, np.int64)], axis=0)
+        zero = self.scalar_const(0.0)
+        inside = self.node("And", [
+            self.node("And", [self.node("GreaterOrEqual", [tcx, zero]),
+                              self.node("LessOrEqual", [tcx, self.scalar_const(w - 1.0)])]),
+            self.node("And", [self.node("GreaterOrEqual", [tcy, zero]),
+                              self.node("LessOrEqual", [tcy, self.scalar_const(h - 1.0)])])])
+        mask = self.node("Cast", [inside], to=TensorProto.FLOAT)
+        sx = self.node("Where", [inside, tcx, zero])  # NaN and far-away positions -> a safe 0
+        sy = self.node("Where", [inside, tcy, zero])
+        x0f, y0f = self.node("Floor", [sx]), self.node("Floor", [sy])
+        fx, fy = self.node("Sub", [sx, x0f]), self.node("Sub", [sy, y0f])
+        x0 = self.node("Cast", [x0f], to=TensorProto.INT64)
+        y0 = self.node("Cast", [y0f], to=TensorProto.INT64)
+        one_i = self.scalar_const(1, np.int64)
+        # x0 + 1 == W only when fx == 0: clamping the index keeps that corner's weight at 0
+        x1 = self.node("Min", [self.node("Add", [x0, one_i]), self.scalar_const(w - 1, np.int64)])
+        y1 = self.node("Min", [self.node("Add", [y0, one_i]), self.scalar_const(h - 1, np.int64)])
+        wi = self.scalar_const(w, np.int64)
+        row0, row1 = self.node("Mul", [y0, wi]), self.node("Mul", [y1, wi])
+        flat = self.node("Reshape", [self.value(f_idx), self.init("shape", np.array([ch, h * w], np.int64))])
+        one = self.scalar_const(1.0)
+        gx_, gy_ = self.node("Sub", [one, fx]), self.node("Sub", [one, fy])
+        acc = None
+        for row, col, wy, wx in ((row0, x0, gy_, gx_), (row0, x1, gy_, fx), (row1, x0, fy, gx_), (row1, x1, fy, fx)):
+            q = self.node("Gather", [flat, self.node("Add", [row, col])], axis=1)   # [C, P]
+            term = self.node("Mul", [q, self.node("Mul", [self.node("Mul", [wy, wx]), mask])])
+            acc = term if acc is None else self.node("Add", [acc, term])
+        self.node("Reshape", [acc, self.init("shape", np.array([1, ch, oh, ow], np.int64))],
+                  [self.out_name(op.outputs[0])])
+
+    def transform_landmarks(self, op, o):
+        """(x, y) -> A (x, y) + t for each landmark of a [1, K, D] tensor (D = 2 or 3; z is
+        passed through)."""
+        l_idx, m_idx = op.inputs[0], op.inputs[1]
+        shp = self.shape(l_idx)
+        if len(shp) != 3 or shp[2] not in (2, 3):
+            raise ConversionError("TransformLandmarks: landmarks must be [1, K, 2 or 3], got %s" % shp)
+        _, at, t = self.matrix_parts(m_idx)
+        x = self.value(l_idx)
+
+        def last_axis(begin, end):
+            return self.node("Slice", [x, self.init("s", np.array([begin], np.int64)),
+                                       self.init("e", np.array([end], np.int64)),
+                                       self.init("ax", np.array([2], np.int64))])
+
+        xy = last_axis(0, 2) if shp[2] == 3 else x
+        y = self.node("Add", [self.node("MatMul", [xy, at]), t])
+        out = self.out_name(op.outputs[0])
+        if shp[2] == 2:
+            self.node("Identity", [y], [out])
+        else:
+            self.node("Concat", [y, last_axis(2, 3)], [out], axis=2)
+
+    def custom_op(self, op):
+        name = op.op[7:]
+        handlers = {"Landmarks2TransformMatrix": self.landmarks_to_transform_matrix,
+                    "TransformTensorBilinear": self.transform_tensor_bilinear,
+                    "TransformLandmarks": self.transform_landmarks}
+        if name not in handlers:
+            raise ConversionError("custom operator %s is not supported (op #%d)" % (name, op.index))
+        if op.version != 2:
+            raise ConversionError("custom operator %s version %d is not supported (only 2)" % (name, op.version))
+        try:
+            opts = read_flexbuffer(op.custom) if op.custom else {}
+        except (ValueError, IndexError, KeyError) as e:
+            raise ConversionError("custom operator %s: bad options (%s)" % (name, e))
+        if not isinstance(opts, dict):
+            raise ConversionError("custom operator %s: options are not a map" % name)
+        handlers[name](op, opts)
+
+    def strided_slice(self, op):
+        o = op.opt
+        if o["ellipsis_mask"] or o["new_axis_mask"] or o["shrink_axis_mask"]:
+            raise ConversionError("STRIDED_SLICE with ellipsis / new-axis / shrink masks")
+        x_idx = op.inputs[0]
+        rank = len(self.shape(x_idx))
+        begin = [int(v) for v in self.need_const(op.inputs[1], "STRIDED_SLICE")]
+        end = [int(v) for v in self.need_const(op.inputs[2], "STRIDED_SLICE")]
+        steps = [int(v) for v in self.need_const(op.inputs[3], "STRIDED_SLICE")]
+        big = np.iinfo(np.int64).max
+        starts, ends = [], []
+        for a in range(rank):
+            st = steps[a]
+            if st == 0:
+                raise ConversionError("STRIDED_SLICE with a zero stride")
+            b = begin[a] if not (o["begin_mask"] >> a) & 1 else (0 if st > 0 else -1)
+            if (o["end_mask"] >> a) & 1:
+                e = big if st > 0 else -big
+            else:
+                e = begin[a] + end[a] if o["offset"] else end[a]
+            starts.append(b)
+            ends.append(e)
+        axes = list(range(rank))
+        if rank == 4:
+            axes = [NHWC_TO_NCHW.index(a) for a in axes]
+        self.node("Slice", [self.value(x_idx), self.init("starts", np.array(starts, np.int64)),
+                            self.init("ends", np.array(ends, np.int64)), self.init("axes", np.array(axes, np.int64)),
+                            self.init("steps", np.array(steps, np.int64))], [self.out_name(op.outputs[0])])
+
     def convert_op(self, op):
         k = op.op
+        if k.startswith("CUSTOM:"):
+            return self.custom_op(op)
+        if k == "STRIDED_SLICE":
+            return self.strided_slice(op)
         if k in ("DEQUANTIZE", "DENSIFY"):
             src = op.inputs[0]
             v = self.const(src)
@@ -425,8 +635,6 @@ class Converter:
             else:
                 self.names[i] = name
         for op in self.live_operators(outputs):
-            if op.op.startswith("CUSTOM:"):
-                raise ConversionError("custom operator %s is not supported" % op.op[7:])
             self.convert_op(op)
         graph_outputs = []
         for i in outputs:

@@ -15,7 +15,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tflite_reader import DIM_DENSE, Model  # noqa: E402
+from tflite_reader import DIM_DENSE, Model, read_flexbuffer  # noqa: E402
 
 
 def densify_ref(values, shape, sp):
@@ -163,6 +163,90 @@ def depth_to_space(x, bs):
     return out
 
 
+# ---- MediaPipe's custom operators (version 2), straight from their documented meaning ------
+# Written as MediaPipe describes them (atan2, explicit 4x4 products, per-pixel loops), not as
+# the ONNX rewrite in tflite2onnx.py does them.
+def mat_translate(x, y):
+    m = np.eye(4)
+    m[0, 3], m[1, 3] = x, y
+    return m
+
+
+def mat_rotate(r):
+    m = np.eye(4)
+    m[0, 0], m[0, 1], m[1, 0], m[1, 1] = np.cos(r), -np.sin(r), np.sin(r), np.cos(r)
+    return m
+
+
+def landmarks_to_transform_matrix_ref(landmarks, o):
+    """[1, N, 3] landmarks -> [1, 4, 4]: Landmarks2TransformMatrix v2."""
+    pts = np.asarray(landmarks, np.float64).reshape(-1, 3)
+    left, right = pts[o["left_rotation_idx"]], pts[o["right_rotation_idx"]]
+    rot = o.get("target_rotation_radians", 0.0) - np.arctan2(right[1] - left[1], right[0] - left[0])
+    idx = list(o["subset_idxs"])
+    if len(idx) % 2:  # an odd list pairs its last index with itself
+        idx.append(idx[-1])
+    sub = np.array([[pts[i][0], pts[i][1], 0.0, 1.0] for i in idx])
+    rotated = sub @ mat_rotate(rot).T
+    lo, hi = rotated[:, :2].min(axis=0), rotated[:, :2].max(axis=0)
+    centre = mat_rotate(-rot) @ np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, 0.0, 1.0])
+    scale = np.diag([o["scale_x"] * (hi[0] - lo[0]) / o["output_width"],
+                     o["scale_y"] * (hi[1] - lo[1]) / o["output_height"], 1.0, 1.0])
+    t = (mat_translate(centre[0], centre[1]) @ mat_rotate(-rot) @ scale
+         @ mat_translate(-o["output_width"] / 2.0, -o["output_height"] / 2.0))
+    return t[None]
+
+
+def transform_tensor_bilinear_ref(x, m, out_shape):
+    """[1, H, W, C] map, [1, 4, 4] matrix -> [1, oh, ow, C]: TransformTensorBilinear v2."""
+    x = np.asarray(x, np.float64)
+    m = np.asarray(m, np.float64).reshape(4, 4)
+    _, h, w, c = x.shape
+    _, oh, ow, _ = out_shape
+    # v2 samples pixel centres: S(-0.5) . M . S(+0.5)
+    mm = mat_translate(-0.5, -0.5) @ m @ mat_translate(0.5, 0.5)
+    out = np.zeros((1, oh, ow, c))
+
+    def read(yy, xx):
+        if 0 <= yy < h and 0 <= xx < w:
+            return x[0, yy, xx]
+        return np.zeros(c)
+
+    for oy in range(oh):
+        for ox in range(ow):
+            px, py = (mm @ np.array([ox, oy, 0.0, 1.0]))[:2]
+            if not (0.0 <= px <= w - 1 and 0.0 <= py <= h - 1):
+                continue
+            x0, y0 = int(np.floor(px)), int(np.floor(py))
+            ax, ay = px - x0, py - y0
+            top = (1 - ax) * read(y0, x0) + ax * read(y0, x0 + 1)
+            bottom = (1 - ax) * read(y0 + 1, x0) + ax * read(y0 + 1, x0 + 1)
+            out[0, oy, ox] = (1 - ay) * top + ay * bottom
+    return out
+
+
+def transform_landmarks_ref(lm, m):
+    """[1, K, D] landmarks (D = 2 or 3), [1, 4, 4] matrix -> [1, K, D]: TransformLandmarks v2
+    (x, y transformed as the point (x, y, 0, 1); z kept)."""
+    lm = np.asarray(lm, np.float64)
+    m = np.asarray(m, np.float64).reshape(4, 4)
+    out = lm.copy()
+    for k in range(lm.shape[1]):
+        v = m @ np.array([lm[0, k, 0], lm[0, k, 1], 0.0, 1.0])
+        out[0, k, 0], out[0, k, 1] = v[0], v[1]
+    return out
+
+
+def strided_slice_ref(x, begin, end, strides, o):
+    assert not (o["ellipsis_mask"] or o["new_axis_mask"] or o["shrink_axis_mask"])
+    sl = []
+    for a in range(x.ndim):
+        b = None if (o["begin_mask"] >> a) & 1 else int(begin[a])
+        e = None if (o["end_mask"] >> a) & 1 else int(end[a]) + (int(begin[a]) if o["offset"] else 0)
+        sl.append(slice(b, e, int(strides[a])))
+    return x[tuple(sl)]
+
+
 class Interpreter:
     def __init__(self, model):
         self.m = model if isinstance(model, Model) else Model.load(model)
@@ -233,6 +317,22 @@ class Interpreter:
             return act(np.concatenate(ins, axis=o["axis"]), o["act"])
         if k == "DEPTH_TO_SPACE":
             return depth_to_space(ins[0], o["block_size"])
+        if k == "SUB":
+            return act(f(ins[0]) - f(ins[1]), o["act"])
+        if k == "DIV":
+            return act(f(ins[0]) / f(ins[1]), o["act"])
+        if k == "STRIDED_SLICE":
+            return strided_slice_ref(ins[0], ins[1], ins[2], ins[3], o)
+        if k.startswith("CUSTOM:"):
+            if op.version != 2:
+                raise NotImplementedError("%s version %d" % (k, op.version))
+            co = read_flexbuffer(op.custom) if op.custom else {}
+            if k == "CUSTOM:Landmarks2TransformMatrix":
+                return landmarks_to_transform_matrix_ref(ins[0], co)
+            if k == "CUSTOM:TransformTensorBilinear":
+                return transform_tensor_bilinear_ref(ins[0], ins[1], self.m.tensors[op.outputs[0]].shape)
+            if k == "CUSTOM:TransformLandmarks":
+                return transform_landmarks_ref(ins[0], ins[1])
         raise NotImplementedError(k)
 
 

@@ -28,8 +28,8 @@ OPS = {
     4: "DEPTHWISE_CONV_2D", 5: "DEPTH_TO_SPACE", 6: "DEQUANTIZE", 9: "FULLY_CONNECTED",
     14: "LOGISTIC", 17: "MAX_POOL_2D", 18: "MUL", 19: "RELU", 20: "RELU_N1_TO_1",
     21: "RELU6", 22: "RESHAPE", 23: "RESIZE_BILINEAR", 25: "SOFTMAX", 28: "TANH",
-    32: "CUSTOM", 34: "PAD", 40: "MEAN", 41: "SUB", 42: "DIV", 54: "PRELU",
-    124: "DENSIFY",
+    32: "CUSTOM", 34: "PAD", 40: "MEAN", 41: "SUB", 42: "DIV", 45: "STRIDED_SLICE",
+    54: "PRELU", 124: "DENSIFY",
 }
 
 # ActivationFunctionType
@@ -114,8 +114,10 @@ class Tensor:
 
 
 class Operator:
-    def __init__(self, index, op, inputs, outputs, options):
+    def __init__(self, index, op, inputs, outputs, options, version=1, custom=None):
         self.index, self.op, self.inputs, self.outputs, self.opt = index, op, inputs, outputs, options
+        self.version = version  # the operator code's version (custom ops change meaning with it)
+        self.custom = custom    # raw custom_options bytes of a CUSTOM op (a FlexBuffer), or None
 
     def __repr__(self):
         return "Op(%d %s in=%s out=%s %s)" % (self.index, self.op, self.inputs, self.outputs, self.opt)
@@ -180,7 +182,98 @@ def _read_options(fb, op, opt):
         return dict(block_size=s(0, "i", 0))
     if op == "SOFTMAX":
         return dict(beta=s(0, "f", 1.0))
+    if op == "STRIDED_SLICE":
+        return dict(begin_mask=s(0, "i", 0), end_mask=s(1, "i", 0), ellipsis_mask=s(2, "i", 0),
+                    new_axis_mask=s(3, "i", 0), shrink_axis_mask=s(4, "i", 0), offset=bool(s(5, "B", 0)))
     return {}
+
+
+# FlexBuffer types (flatbuffers/flexbuffers.h, the format of a custom operator's options).
+FBT_NULL, FBT_INT, FBT_UINT, FBT_FLOAT, FBT_KEY, FBT_STRING = 0, 1, 2, 3, 4, 5
+FBT_INDIRECT_INT, FBT_INDIRECT_UINT, FBT_INDIRECT_FLOAT, FBT_MAP, FBT_VECTOR = 6, 7, 8, 9, 10
+FBT_VECTOR_INT, FBT_VECTOR_UINT, FBT_VECTOR_FLOAT, FBT_VECTOR_KEY = 11, 12, 13, 14
+FBT_BLOB, FBT_BOOL, FBT_VECTOR_BOOL = 25, 26, 36
+
+
+def read_flexbuffer(data):
+    """Decode a FlexBuffer (the format MediaPipe's custom ops keep their options in) into
+    Python values: maps -> dict, vectors -> list, scalars -> int / float / bool / str.
+
+    Layout recap: the buffer ends with the root's packed type byte and the root's byte width;
+    a packed type is (type << 2) | log2(width of the value's elements); offsets are unsigned
+    and point backwards; an untyped vector's elements are followed by one packed type byte
+    per element; a map is a vector of values preceded by (keys vector offset, keys byte
+    width, size); typed vectors hold one scalar type, fixed ones (INT2..FLOAT4) omit the size.
+    """
+    b = bytes(data)
+    if len(b) < 3:
+        raise ValueError("flexbuffer too short")
+
+    def uint(p, w):
+        return int.from_bytes(b[p:p + w], "little")
+
+    def sint(p, w):
+        return int.from_bytes(b[p:p + w], "little", signed=True)
+
+    def flt(p, w):
+        return struct.unpack_from("<f" if w == 4 else "<d", b, p)[0] if w in (4, 8) else \
+            float(np.frombuffer(b[p:p + 2], "<f2")[0])
+
+    def cstr(p):
+        e = b.index(b"\0", p)
+        return b[p:e].decode("utf-8", "replace")
+
+    def value(p, parent_w, packed):
+        t, w = packed >> 2, 1 << (packed & 3)
+        if t == FBT_NULL:
+            return None
+        if t == FBT_INT:
+            return sint(p, parent_w)
+        if t in (FBT_UINT,):
+            return uint(p, parent_w)
+        if t == FBT_BOOL:
+            return bool(uint(p, parent_w))
+        if t == FBT_FLOAT:
+            return flt(p, parent_w)
+        q = p - uint(p, parent_w)  # everything else is stored behind an offset
+        if t == FBT_INDIRECT_INT:
+            return sint(q, w)
+        if t == FBT_INDIRECT_UINT:
+            return uint(q, w)
+        if t == FBT_INDIRECT_FLOAT:
+            return flt(q, w)
+        if t == FBT_KEY:
+            return cstr(q)
+        if t in (FBT_STRING, FBT_BLOB):
+            n = uint(q - w, w)
+            raw = b[q:q + n]
+            return raw.decode("utf-8", "replace") if t == FBT_STRING else raw
+        if t in (FBT_VECTOR, FBT_MAP):
+            n = uint(q - w, w)
+            types = q + n * w
+            vals = [value(q + i * w, w, b[types + i]) for i in range(n)]
+            if t == FBT_VECTOR:
+                return vals
+            kq = q - 3 * w
+            keys_at = kq - uint(kq, w)
+            kw = uint(q - 2 * w, w)
+            keys = [cstr(keys_at + i * kw - uint(keys_at + i * kw, kw)) for i in range(n)]
+            return dict(zip(keys, vals))
+        if FBT_VECTOR_INT <= t <= FBT_VECTOR_KEY or t == FBT_VECTOR_BOOL:
+            n = uint(q - w, w)
+            elem = {FBT_VECTOR_INT: FBT_INT, FBT_VECTOR_UINT: FBT_UINT, FBT_VECTOR_FLOAT: FBT_FLOAT,
+                    FBT_VECTOR_KEY: FBT_KEY, FBT_VECTOR_BOOL: FBT_BOOL}[t]
+            if elem == FBT_KEY:
+                return [cstr(q + i * w - uint(q + i * w, w)) for i in range(n)]
+            return [value(q + i * w, w, elem << 2) for i in range(n)]
+        if 16 <= t <= 24:  # fixed-length typed vectors: INT2, UINT2, FLOAT2, INT3, ..., FLOAT4
+            n = 2 + (t - 16) // 3
+            elem = (FBT_INT, FBT_UINT, FBT_FLOAT)[(t - 16) % 3]
+            return [value(q + i * w, w, elem << 2) for i in range(n)]
+        raise ValueError("flexbuffer type %d not supported" % t)
+
+    root_w = b[-1]
+    return value(len(b) - 2 - root_w, root_w, b[-2])
 
 
 class Model:
@@ -194,7 +287,9 @@ class Model:
         model = fb.root()
         self.version = fb.scalar(model, 0, "I", 0)
         self.opcodes = []
+        self.opcode_versions = []
         for oc in fb.tables(model, 1):
+            self.opcode_versions.append(fb.scalar(oc, 2, "i", 1))
             dep = fb.scalar(oc, 0, "b", 0)
             code = fb.scalar(oc, 3, "i", 0)
             code = max(int(dep), int(code))  # builtin_code wins once past 127
@@ -227,13 +322,16 @@ class Model:
         self.outputs = [int(x) for x in fb.array(sg, 2, np.int32)]
         self.operators = []
         for i, o in enumerate(fb.tables(sg, 3)):
-            op = self.opcodes[fb.scalar(o, 0, "I", 0)]
+            code = fb.scalar(o, 0, "I", 0)
+            op = self.opcodes[code]
             ins = fb.array(o, 1, np.int32)
             outs = fb.array(o, 2, np.int32)
+            custom = fb.array(o, 5, np.uint8) if op.startswith("CUSTOM:") else None
             self.operators.append(Operator(
                 i, op, [] if ins is None else [int(x) for x in ins],
                 [] if outs is None else [int(x) for x in outs],
-                _read_options(fb, op, fb.ref(o, 4))))
+                _read_options(fb, op, fb.ref(o, 4)), self.opcode_versions[code],
+                None if custom is None else bytes(custom)))
 
     @classmethod
     def load(cls, path):

@@ -9,10 +9,11 @@ random in the model's input range, and a real 8-bit image crop (a PNG from
 the shared data, resampled to the model's input size).  Where a third-party
 conversion (zaru_*.onnx, NCHW input) exists, its outputs are compared too.
 
-Usage: /usr/bin/python3 tools/convert/verify.py --models DIR --ort-run PATH
+Usage: /usr/bin/python3 tools/convert/verify.py [--models DIR] --ort-run PATH
            [--zaru DIR] [--image PNG] [--work DIR] [name ...]
 Exit status 1 when any difference exceeds --tol (default 1e-3 relative to the
-output's magnitude, see check()).
+output's magnitude, see check()); 77 (skipped) when no model named (or none at
+all) is in --models (default $AVATARMAP_MODELS).
 """
 
 import argparse
@@ -33,7 +34,8 @@ from tflite_numpy_ref import Interpreter  # noqa: E402
 MODELS = {  # name -> outputs to drop as a second variant
     "hand_landmark_lite": None, "hand_landmark_full": None,
     "palm_detection_lite": None, "palm_detection_full": None,
-    "pose_detection": None,
+    "pose_detection": None, "face_detection_short_range": None, "face_landmark": None,
+    "face_landmark_with_attention": None,
     "pose_landmark_lite": "Identity_2,Identity_3", "pose_landmark_full": "Identity_2,Identity_3",
     "pose_landmark_heavy": "Identity_2,Identity_3",
 }
@@ -111,17 +113,30 @@ def run_ort(ort_run, onnx_path, x, work, threads=1, bench=0):
 
 def main(argv=None):
     ap = argparse.ArgumentParser()
-    ap.add_argument("--models", required=True, help="directory with the .tflite files")
+    ap.add_argument("--models", default=os.environ.get("AVATARMAP_MODELS", ""),
+                    help="directory with the .tflite files (default $AVATARMAP_MODELS)")
     ap.add_argument("--ort-run", required=True, help="ort_run binary built from ort_run.cpp")
     ap.add_argument("--zaru", default="", help="directory with zaru_*.onnx third-party conversions")
     ap.add_argument("--image", default="", help="8-bit RGB PNG crop used as real input")
+    ap.add_argument("--test-data-image", default="",
+                    help="like --image, relative to $AVATARMAP_TEST_DATA (ignored when that is unset)")
     ap.add_argument("--work", default="")
     ap.add_argument("--bench", type=int, default=0, help="also time N runs with ORT (1 thread)")
     ap.add_argument("--tol", type=float, default=1e-3)
     ap.add_argument("names", nargs="*")
     a = ap.parse_args(argv)
     work = a.work or tempfile.mkdtemp(prefix="tflite2onnx_")
-    names = a.names or [n for n in MODELS if os.path.exists(os.path.join(a.models, n + ".tflite"))]
+    if a.models and os.path.basename(os.path.normpath(a.models)) == "onnx" and os.path.isdir(a.models) \
+            and not any(f.endswith(".tflite") for f in os.listdir(a.models)):
+        a.models = os.path.dirname(os.path.normpath(a.models))  # $AVATARMAP_MODELS/onnx: the .tflite are above
+    names = [n for n in (a.names or MODELS) if a.models and os.path.exists(os.path.join(a.models, n + ".tflite"))]
+    if not names:
+        print("verify: skipped: none of %s in --models / $AVATARMAP_MODELS (%r); scripts/fetch_models.sh"
+              % (", ".join(a.names or MODELS), a.models))
+        return 77
+    if not a.image and a.test_data_image and os.environ.get("AVATARMAP_TEST_DATA"):
+        path = os.path.join(os.environ["AVATARMAP_TEST_DATA"], a.test_data_image)
+        a.image = path if os.path.exists(path) else ""
     image = read_png_rgb(a.image) if a.image else None
     worst = 0.0
     for name in names:

@@ -13,8 +13,10 @@
 # recording has no low-visibility burst). A last row per scenario and filter gives the mean
 # over the seeds. Columns: bone-direction error overall and per group, head orientation,
 # "body" (torso, arms and legs together), "lv-frame" (every bone on the frames with a
-# low-visibility burst) and "lv-bone" (the bones of the limbs in a burst only). Needs python3
-# (to read eval-pose --json).
+# low-visibility burst), "lv-bone" (the bones of the limbs in a burst only), and the face:
+# "blink" (mean absolute error of each eye's closure), "jaw" (jawOpen, from the files'
+# blendshapes), "visemes" (the mean of aa, ih, ou, ee, oh's errors) and "gaze" (degrees,
+# the eyes relative to the head). Needs python3 (to read eval-pose --json).
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")/../.." && pwd)
@@ -42,8 +44,8 @@ else
   trap 'rm -rf "$work"' EXIT
 fi
 
-printf '%-6s %-6s %-8s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n' seed scene filter overall torso arms \
-  legs fingers head body lv-frame lv-bone
+printf '%-6s %-6s %-8s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n' seed scene filter \
+  overall torso arms legs fingers head body lv-frame lv-bone blink jaw visemes gaze
 declare -A sums counts
 for scene in clean noisy; do
   for seed in "${seeds[@]}"; do
@@ -63,15 +65,19 @@ v = [a[k]["mean"] for k in ("overall", "torso", "arms", "legs", "fingers", "head
 n = sum(a[k]["count"] for k in ("torso", "arms", "legs"))
 v.append(sum(a[k]["mean"] * a[k]["count"] for k in ("torso", "arms", "legs")) / max(n, 1))
 f = lambda s, ok: "%.4f" % s if ok else "-"
+fa = d["face"]
+face = [fa["blink"]["mean"], fa["jawOpen"]["mean"],
+        sum(fa[k]["mean"] for k in ("aa", "ih", "ou", "ee", "oh")) / 5, fa["gaze"]["mean"]]
 print(" ".join("%.4f" % x for x in v), f(lv["overall"]["mean"], lv["overall"]["count"] > 0),
-      f(m["mean"], m["count"] > 0))
+      f(m["mean"], m["count"] > 0), " ".join("%.4f" % x for x in face))
 ' <<<"$json")
-      read -r o t a l f h body lf m <<<"$row"
+      read -r o t a l f h body lf m fb fj fv fg <<<"$row"
       fmt() { [ "$1" = - ] && echo - || printf '%.2f' "$1"; }
-      printf '%-6s %-6s %-8s %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8s %8s\n' "$seed" "$scene" \
-        "$filter" "$o" "$t" "$a" "$l" "$f" "$h" "$body" "$(fmt "$lf")" "$(fmt "$m")"
+      printf '%-6s %-6s %-8s %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8s %8s %8.3f %8.3f %8.3f %8.2f\n' \
+        "$seed" "$scene" "$filter" "$o" "$t" "$a" "$l" "$f" "$h" "$body" "$(fmt "$lf")" \
+        "$(fmt "$m")" "$fb" "$fj" "$fv" "$fg"
       key="$scene $filter"
-      vals=("$o" "$t" "$a" "$l" "$f" "$h" "$body" "$lf" "$m")
+      vals=("$o" "$t" "$a" "$l" "$f" "$h" "$body" "$lf" "$m" "$fb" "$fj" "$fv" "$fg")
       for i in "${!vals[@]}"; do
         [ "${vals[$i]}" = - ] && continue
         sums[$key.$i]=$(awk -v x="${sums[$key.$i]:-0}" -v y="${vals[$i]}" 'BEGIN{print x + y}')
@@ -82,15 +88,17 @@ print(" ".join("%.4f" % x for x in v), f(lv["overall"]["mean"], lv["overall"]["c
   for filter in $filters; do
     key="$scene $filter"
     means=()
-    for i in 0 1 2 3 4 5 6 7 8; do
+    for i in 0 1 2 3 4 5 6 7 8 9 10 11 12; do
       if [ -n "${counts[$key.$i]:-}" ]; then
-        means+=("$(awk -v x="${sums[$key.$i]}" -v n="${counts[$key.$i]}" \
-          'BEGIN{printf "%.2f", x / n}')")
+        format=%.2f
+        [ "$i" -ge 9 ] && [ "$i" -le 11 ] && format=%.3f
+        means+=("$(awk -v x="${sums[$key.$i]}" -v n="${counts[$key.$i]}" -v f="$format" \
+          'BEGIN{printf f, x / n}')")
       else
         means+=(-)
       fi
     done
-    printf '%-6s %-6s %-8s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n' mean "$scene" "$filter" \
-      "${means[@]}"
+    printf '%-6s %-6s %-8s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s %8s\n' mean "$scene" \
+      "$filter" "${means[@]}"
   done
 done

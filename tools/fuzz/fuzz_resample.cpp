@@ -1,6 +1,6 @@
 // libFuzzer target: the time resamplers. The bytes become a few proxy-pose frames with
 // arbitrary times (ordered, equal, reversed, far apart, non-finite), rotations (unit, or
-// arbitrary bits), hips positions and expression weights, and a frame rate.
+// arbitrary bits), hips positions, expression and blendshape weights, and a frame rate.
 //  - resample_clip (time/resample_clip.hpp), the batch resampler of the exporters: must not
 //    crash or allocate without bound, must refuse exactly the clips its documented rules
 //    refuse (times not finite or out of order, span or frame count over the limits), and
@@ -162,6 +162,7 @@ void check_sample(const pose_resampler& r, double t) {
   }
   for (int k = 0; k < 3; ++k) check(std::isfinite(out.hips_position[k]), "sampled hips finite");
   for (float e : out.expressions) check(e >= 0.f && e <= 1.f, "sampled expressions in [0, 1]");
+  for (float w : out.blendshapes) check(w >= 0.f && w <= 1.f, "sampled blendshapes in [0, 1]");
 }
 
 }  // namespace
@@ -202,6 +203,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     p.expressions[static_cast<std::size_t>(in.ConsumeIntegralInRange(0, k_expression_count - 1))] =
         raw_float(in);
     p.confidence[0] = raw_float(in);
+    p.blendshapes[static_cast<std::size_t>(in.ConsumeIntegralInRange(0, k_blendshape_count - 1))] =
+        raw_float(in);
   }
 
   check_batch(frames, fps, rebase, rotations_unit);

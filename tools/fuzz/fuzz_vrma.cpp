@@ -4,12 +4,15 @@
 // scaling, the two paths a user takes (`convert in.vrma`, `convert --fps 30`). Checks that
 // nothing crashes or throws, that a failure names the file, and that a clip that loads keeps
 // the documented promises: frames in increasing time order, finite times within the key range,
-// unit rotations, finite hips positions, expressions in [0, 1], confidence 0 or 1 (1 exactly
-// for the bones the file maps), and that resampling gives the documented number of frames.
+// unit rotations, finite hips positions, expression and blendshape weights in [0, 1] (0 for
+// those the file lacks), confidence 0 or 1 (1 exactly for the bones the file maps, and the eyes
+// when it has a lookAt), eyes at rest without a lookAt, and that resampling gives the
+// documented number of frames.
 #include <cmath>
 #include <cstdint>
 #include <string>
 
+#include "avatarmap/core/rotation.hpp"
 #include "avatarmap/export/vrma.hpp"
 #include "avatarmap/time/resample_clip.hpp"
 #include "fuzz_support.hpp"
@@ -36,7 +39,9 @@ void check_clip(const vrma_clip& clip) {
     if (f > 0) check(p.t > clip.frames[f - 1].t, "frame times increase");
     for (int b = 0; b < k_bone_count; ++b) {
       check(unit(p.rotations[b]), "rotations unit length");
-      check(p.confidence[b] == (clip.has_bone[b] ? 1.f : 0.f), "confidence 1 for mapped bones");
+      const bool eye = b == idx(bone::left_eye) || b == idx(bone::right_eye);
+      check(p.confidence[b] == (clip.has_bone[b] || (eye && clip.has_look_at) ? 1.f : 0.f),
+            "confidence 1 for mapped bones (and the eyes with a lookAt)");
     }
     for (int k = 0; k < 3; ++k) check(std::isfinite(p.hips_position[k]), "hips position finite");
     for (int e = 0; e < k_expression_count; ++e) {
@@ -44,6 +49,14 @@ void check_clip(const vrma_clip& clip) {
       check(w >= 0.f && w <= 1.f, "expressions in [0, 1]");
       if (!clip.has_expression[e]) check(w == 0.f, "expressions the file lacks are 0");
     }
+    for (int sh = 0; sh < k_blendshape_count; ++sh) {
+      const float w = p.blendshapes[sh];
+      check(w >= 0.f && w <= 1.f, "blendshapes in [0, 1]");
+      if (!clip.has_blendshape[sh]) check(w == 0.f, "blendshapes the file lacks are 0");
+    }
+    if (!clip.has_look_at)
+      check(p[bone::left_eye] == identity_quat() && p[bone::right_eye] == identity_quat(),
+            "eyes at rest without a lookAt");
   }
 }
 

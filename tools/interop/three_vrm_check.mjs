@@ -43,9 +43,9 @@ avatar.scene.traverse((o) => { if (o.isMesh && o.morphTargetDictionary) face = o
 vrm.expressionManager.setValue('blink', 1);
 vrm.update(0);
 const dict = face ? face.morphTargetDictionary : {};
-const closed = face && face.morphTargetInfluences[dict.blinkLeft] === 1 &&
-  face.morphTargetInfluences[dict.blinkRight] === 1;
-check(closed, `${avatarFile}: blink = 1 closes both eyes (blinkLeft and blinkRight targets at 1)`);
+const closed = face && face.morphTargetInfluences[dict.eyeBlinkLeft] === 1 &&
+  face.morphTargetInfluences[dict.eyeBlinkRight] === 1;
+check(closed, `${avatarFile}: blink = 1 closes both eyes (eyeBlinkLeft and eyeBlinkRight targets at 1)`);
 
 const animated = await load(animatedFile);
 const ours = JSON.parse(fs.readFileSync(oursFile, 'utf8'));

@@ -54,6 +54,12 @@ void sanitized_pose(const avm_pose& in, const am::proxy_pose* prev, am::proxy_po
     out.expressions[ei] =
         std::isfinite(w) ? clamp01(w) : (prev != nullptr ? prev->expressions[ei] : 0.f);
   }
+  for (int s = 0; s < am::k_blendshape_count; ++s) {
+    const auto si = static_cast<std::size_t>(s);
+    const float w = in.blendshapes[s];
+    out.blendshapes[si] =
+        std::isfinite(w) ? clamp01(w) : (prev != nullptr ? prev->blendshapes[si] : 0.f);
+  }
   for (int f = 0; f < 2; ++f) {
     const float c = in.foot_contact[f];
     out.foot_contact[static_cast<std::size_t>(f)] = std::isfinite(c) ? clamp01(c) : 0.f;

@@ -2,6 +2,8 @@
 #include "c_frames.hpp"
 
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 
 #include "avatarmap/core/rotation.hpp"
 
@@ -61,6 +63,12 @@ void to_c_pose(const am::proxy_pose& p, avm_pose& out) noexcept {
   }
   for (int e = 0; e < AVM_EXPRESSION_COUNT; ++e) out.expressions[e] = p.expressions[e];
   for (int f = 0; f < 2; ++f) out.foot_contact[f] = p.foot_contact[f];
+  for (int s = 0; s < AVM_BLENDSHAPE_COUNT; ++s) out.blendshapes[s] = p.blendshapes[s];
+  // Since 0.2.0 the struct ends in 4 bytes of padding (its size is a multiple of the double's
+  // alignment): written as 0, so that a pose the library gives is the same bytes every time.
+  constexpr std::size_t end = offsetof(avm_pose, blendshapes) + sizeof out.blendshapes;
+  if constexpr (sizeof(avm_pose) > end)
+    std::memset(reinterpret_cast<unsigned char*>(&out) + end, 0, sizeof(avm_pose) - end);
 }
 
 void to_c_frame(const am::landmark_frame& in, frame_storage& storage, avm_frame& out) noexcept {

@@ -1,5 +1,5 @@
-// The C API's library-wide functions: version, status strings, bone and expression names,
-// the create error, the shipped folders (bindings/c/include/avatarmap/avatarmap.h).
+// The C API's library-wide functions: version, status strings, bone, expression and blendshape
+// names, the create error, the shipped folders (bindings/c/include/avatarmap/avatarmap.h).
 #include <cstring>
 #include <string>
 #include <string_view>
@@ -8,6 +8,7 @@
 #include "avatarmap/core/limits.hpp"
 #include "avatarmap/io/resources.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
+#include "avatarmap/skeleton/blendshape.hpp"
 #include "avatarmap/skeleton/bone.hpp"
 #include "avatarmap/skeleton/expression.hpp"
 #include "avatarmap/version.hpp"
@@ -26,6 +27,7 @@ static_assert(AVM_MAX_MODEL_THREADS == am::k_max_model_threads,
               "AVM_MAX_MODEL_THREADS must be core/limits.hpp's k_max_model_threads");
 static_assert(AVM_BONE_COUNT == am::k_bone_count, "bone count");
 static_assert(AVM_EXPRESSION_COUNT == am::k_expression_count, "expression count");
+static_assert(AVM_BLENDSHAPE_COUNT == am::k_blendshape_count, "blendshape count");
 static_assert(AVM_POSE_LANDMARK_COUNT == am::k_pose_landmark_count, "pose landmark count");
 static_assert(AVM_HAND_LANDMARK_COUNT == am::k_hand_landmark_count, "hand landmark count");
 static_assert(AVM_FACE_LANDMARK_COUNT == am::k_face_mesh_count, "face landmark count");
@@ -41,8 +43,18 @@ static_assert(AVM_BONE_RIGHT_LITTLE_DISTAL == am::idx(am::bone::right_little_dis
                   AVM_BONE_JAW == am::idx(am::bone::jaw),
               "avm_bone must follow avatarmap::bone");
 static_assert(AVM_EXPRESSION_BROW_DOWN_RIGHT == am::idx(am::expression::brow_down_right) &&
-                  AVM_EXPRESSION_LOOK_UP == am::idx(am::expression::look_up),
+                  AVM_EXPRESSION_LOOK_UP == am::idx(am::expression::look_up) &&
+                  AVM_EXPRESSION_HAPPY == am::idx(am::expression::happy) &&
+                  AVM_EXPRESSION_SURPRISED == am::idx(am::expression::surprised) &&
+                  AVM_EXPRESSION_SURPRISED + 1 == AVM_EXPRESSION_COUNT,
               "avm_expression must follow avatarmap::expression");
+static_assert(AVM_BLENDSHAPE_BROW_DOWN_LEFT == am::idx(am::blendshape::brow_down_left) &&
+                  AVM_BLENDSHAPE_EYE_BLINK_LEFT == am::idx(am::blendshape::eye_blink_left) &&
+                  AVM_BLENDSHAPE_JAW_OPEN == am::idx(am::blendshape::jaw_open) &&
+                  AVM_BLENDSHAPE_MOUTH_SMILE_RIGHT == am::idx(am::blendshape::mouth_smile_right) &&
+                  AVM_BLENDSHAPE_TONGUE_OUT == am::idx(am::blendshape::tongue_out) &&
+                  AVM_BLENDSHAPE_TONGUE_OUT + 1 == AVM_BLENDSHAPE_COUNT,
+              "avm_blendshape must follow avatarmap::blendshape");
 
 namespace {
 // `value` is the caller's avm_status read as an int: a C caller may pass any int, and an
@@ -131,6 +143,21 @@ AVATARMAP_C_API int avm_expression_from_name(const char* name) {
     if (name == nullptr) return -1;
     auto e = am::expression_from_name(std::string_view(name));
     return e ? am::idx(*e) : -1;
+  });
+}
+
+AVATARMAP_C_API const char* avm_blendshape_name(int blendshape) {
+  return guard_value<const char*>(nullptr, [&]() -> const char* {
+    if (blendshape < 0 || blendshape >= AVM_BLENDSHAPE_COUNT) return nullptr;
+    return am::blendshape_name(static_cast<am::blendshape>(blendshape)).data();
+  });
+}
+
+AVATARMAP_C_API int avm_blendshape_from_name(const char* name) {
+  return guard_value(-1, [&] {
+    if (name == nullptr) return -1;
+    auto s = am::blendshape_from_name(std::string_view(name));
+    return s ? am::idx(*s) : -1;
   });
 }
 

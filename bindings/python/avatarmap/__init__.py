@@ -34,14 +34,14 @@ from ._lib import POSE_DTYPE
 __all__ = [
     "AvatarmapError", "InvalidArgumentError", "FileIOError", "ParseError", "UnsupportedError",
     "OutOfMemoryError", "InternalError",
-    "BONE_NAMES", "BONE_PARENTS", "EXPRESSION_NAMES", "POSE_DTYPE", "SOLVER_OPTION_NAMES",
+    "BONE_NAMES", "BONE_PARENTS", "EXPRESSION_NAMES", "BLENDSHAPE_NAMES", "POSE_DTYPE", "SOLVER_OPTION_NAMES",
     "bone_index", "version",
     "Landmarks", "Poses", "read_landmarks", "read_poses", "solve", "solve_file",
     "write_animation", "convert_file", "motion_input_kind",
     "Solver", "Retargeter", "Estimator", "Live", "LiveStats", "CaptureSummary", "capture_file",
 ]
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 #: VRM 1.0 names of the 55 proxy bones, in the order of Poses' arrays (parents first).
 BONE_NAMES: Tuple[str, ...] = tuple(_lib.text(_lib.fn("avm_bone_name")(b))
@@ -49,9 +49,14 @@ BONE_NAMES: Tuple[str, ...] = tuple(_lib.text(_lib.fn("avm_bone_name")(b))
 #: Parent index of each bone (-1 for hips, the root).
 BONE_PARENTS: Tuple[int, ...] = tuple(int(_lib.fn("avm_bone_parent")(b))
                                       for b in range(_lib.BONE_COUNT))
-#: Names of the 16 expressions, in the order of Poses.expressions.
+#: Names of the 21 expressions, in the order of Poses.expressions (VRM 1.0 presets, four
+#: custom brows, and since 0.2.0 the emotions happy, angry, sad, relaxed, surprised).
 EXPRESSION_NAMES: Tuple[str, ...] = tuple(_lib.text(_lib.fn("avm_expression_name")(e))
                                           for e in range(_lib.EXPRESSION_COUNT))
+#: ARKit's 52 blendshape names ("browDownLeft" .. "tongueOut"), in the order of
+#: Poses.blendshapes (Apple's alphabetical order; "Left" is the person's left).
+BLENDSHAPE_NAMES: Tuple[str, ...] = tuple(_lib.text(_lib.fn("avm_blendshape_name")(s))
+                                          for s in range(_lib.BLENDSHAPE_COUNT))
 
 _BONE_INDEX = {name: i for i, name in enumerate(BONE_NAMES)}
 

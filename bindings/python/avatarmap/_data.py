@@ -14,7 +14,7 @@ import numpy as np
 
 from . import _lib
 from ._errors import InvalidArgumentError, error_for
-from ._lib import (BONE_COUNT, EXPRESSION_COUNT, FACE_POINTS, FACE_POINTS_NO_IRIS, HAND_POINTS,
+from ._lib import (BLENDSHAPE_COUNT, BONE_COUNT, EXPRESSION_COUNT, FACE_POINTS, FACE_POINTS_NO_IRIS, HAND_POINTS,
                    POSE_DTYPE, POSE_POINTS, AvmFrameBlock, AvmSolverOptions, c_value, fn,
                    set_field, text)
 
@@ -108,9 +108,11 @@ class Poses:
     ``t`` (N,) float64 seconds; ``hips_position`` (N, 3) float32 metres in VRM space (Y =
     hips height above the soles); ``rotations`` (N, 55, 4) float32 local rotations as
     quaternions {x, y, z, w} (identity = VRM T-pose); ``confidence`` (N, 55) 0..1;
-    ``expressions`` (N, 16) weights 0..1 (``EXPRESSION_NAMES`` order); ``foot_contact``
+    ``expressions`` (N, 21) weights 0..1 (``EXPRESSION_NAMES`` order); ``foot_contact``
     (N, 2) float32 per foot, [:, 0] left, [:, 1] right: 0 = free .. 1 = planted
-    (docs/contacts.md; None = all 0 when writing). The arrays of poses
+    (docs/contacts.md; None = all 0 when writing); ``blendshapes`` (N, 52) float32 ARKit
+    blendshape weights 0..1 (``BLENDSHAPE_NAMES`` order; all 0 when the face was not
+    solved; None = all 0 when writing). The arrays of poses
     returned by this package are views of one record array laid out as the C API's avm_pose
     (``records``).
     """
@@ -121,6 +123,7 @@ class Poses:
     confidence: np.ndarray
     expressions: np.ndarray
     foot_contact: Optional[np.ndarray] = None
+    blendshapes: Optional[np.ndarray] = None
     _records: Optional[np.ndarray] = field(default=None, repr=False, compare=False)
 
     def __len__(self) -> int:
@@ -135,7 +138,7 @@ class Poses:
         return cls(t=records["t"], hips_position=records["hips_position"],
                    rotations=records["rotations"], confidence=records["confidence"],
                    expressions=records["expressions"], foot_contact=records["foot_contact"],
-                   _records=records)
+                   blendshapes=records["blendshapes"], _records=records)
 
     @classmethod
     def empty(cls, n: int) -> "Poses":
@@ -153,12 +156,13 @@ class Poses:
         if rec is not None and self._views(rec):
             return rec
         n = len(self)
-        rec = np.empty(n, dtype=POSE_DTYPE)
+        rec = np.zeros(n, dtype=POSE_DTYPE)  # padding 0, as the library writes it
         for name, shape in (("t", (n,)), ("hips_position", (n, 3)),
                             ("rotations", (n, BONE_COUNT, 4)), ("confidence", (n, BONE_COUNT)),
-                            ("expressions", (n, EXPRESSION_COUNT)), ("foot_contact", (n, 2))):
+                            ("expressions", (n, EXPRESSION_COUNT)), ("foot_contact", (n, 2)),
+                            ("blendshapes", (n, BLENDSHAPE_COUNT))):
             value = getattr(self, name)
-            if value is None and name == "foot_contact":
+            if value is None and name in ("foot_contact", "blendshapes"):
                 value = np.zeros(shape, dtype=np.float32)
             value = np.asarray(value)
             if value.shape != shape:
@@ -169,7 +173,7 @@ class Poses:
 
     def _views(self, rec: np.ndarray) -> bool:
         for name in ("t", "hips_position", "rotations", "confidence", "expressions",
-                     "foot_contact"):
+                     "foot_contact", "blendshapes"):
             a = getattr(self, name)
             b = rec[name]
             if not isinstance(a, np.ndarray) or a.shape != b.shape or a.strides != b.strides \

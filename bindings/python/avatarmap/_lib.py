@@ -17,7 +17,8 @@ from typing import Any, Callable, Dict, List, Optional, Tuple
 import numpy as np
 
 BONE_COUNT = 55
-EXPRESSION_COUNT = 16
+EXPRESSION_COUNT = 21
+BLENDSHAPE_COUNT = 52  # ARKit's face blendshapes (0.2.0)
 POSE_POINTS = 33
 HAND_POINTS = 21
 FACE_POINTS = 478  # with iris refinement; a 468-point face has rows 468..477 NaN
@@ -70,7 +71,8 @@ class AvmFrame(ctypes.Structure):
 class AvmPose(ctypes.Structure):
     _fields_ = [("t", _F64), ("hips_position", _F32 * 3),
                 ("rotations", (_F32 * 4) * BONE_COUNT), ("confidence", _F32 * BONE_COUNT),
-                ("expressions", _F32 * EXPRESSION_COUNT), ("foot_contact", _F32 * 2)]
+                ("expressions", _F32 * EXPRESSION_COUNT), ("foot_contact", _F32 * 2),
+                ("blendshapes", _F32 * BLENDSHAPE_COUNT)]
 
 
 # The avm_pose array as NumPy sees it: one record per pose, same offsets as the C struct
@@ -79,7 +81,8 @@ POSE_DTYPE = np.dtype([("t", "<f8"), ("hips_position", "<f4", (3,)),
                        ("rotations", "<f4", (BONE_COUNT, 4)),
                        ("confidence", "<f4", (BONE_COUNT,)),
                        ("expressions", "<f4", (EXPRESSION_COUNT,)),
-                       ("foot_contact", "<f4", (2,))], align=True)
+                       ("foot_contact", "<f4", (2,)),
+                       ("blendshapes", "<f4", (BLENDSHAPE_COUNT,))], align=True)
 
 
 class AvmSolverOptions(ctypes.Structure):
@@ -303,6 +306,7 @@ _SIGNATURES: Dict[str, Tuple[object, List[object]]] = {
     "avm_bone_parent": (ctypes.c_int, [ctypes.c_int]),
     "avm_bone_from_name": (ctypes.c_int, [_STR]),
     "avm_expression_name": (_STR, [ctypes.c_int]),
+    "avm_blendshape_name": (_STR, [ctypes.c_int]),
     "avm_solver_options_init_sized": (_S, [ctypes.POINTER(AvmSolverOptions), _SIZE]),
     "avm_solver_create": (_S, [ctypes.POINTER(AvmSolverOptions), _PP]),
     "avm_last_create_error": (_STR, []),

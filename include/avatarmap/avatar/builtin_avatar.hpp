@@ -87,9 +87,11 @@ struct builtin_avatar {
   /// hips at (0, standing_hips_height(skeleton), 0).
   std::array<glm::vec3, k_bone_count> joints{};
   std::vector<avatar_material> materials;
-  /// [0] "Body" (no morph targets), [1] "Face" (head, eyes, lids, brows, mouth; the morph
-  /// targets). Both skinned to the one skin.
+  /// [0] "Body" (no morph targets), [1] "Face" (head, eyes, lids, brows, mouth, tongue; the
+  /// morph targets: ARKit's 52 blendshapes, target i = blendshape i of skeleton/blendshape.hpp,
+  /// named as Apple names them). Both skinned to the one skin.
   std::vector<avatar_mesh> meshes;
+  /// The VRM expressions, each a combination of the face's ARKit targets (docs/avatar.md).
   std::vector<avatar_expression> expressions;
 };
 

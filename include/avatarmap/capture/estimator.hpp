@@ -65,6 +65,10 @@ struct estimator_options {
   int lanes = 2;
   /// onnx: the models' precision, for every model (docs/capture.md "int8 models").
   model_precision precision = model_precision::float32;
+  /// onnx: the face mesh model: 0 face_landmark_with_attention (478 points with irises,
+  /// refined lips and eyes; falls back to 1 when its file is missing), 1 face_landmark (468
+  /// points, cheaper). docs/capture-face.md has the costs.
+  int face_model = 0;
 };
 
 /// The estimator's options as every front end takes them (the CLI's capture, live and animate
@@ -91,7 +95,7 @@ inline constexpr option_row<estimator_options> k_estimator_option_table[] = {
         .boolean()
         .defaults_to(1)
         .cli("--face", nullptr, "--no-face")
-        .help("estimate the face mesh (468 points)"),
+        .help("estimate the face mesh (478 points with irises; 468 with --face-model mesh)"),
     option_row<estimator_options>("hand_model_complexity",
                                   AVATARMAP_OPTION_FIELD(estimator_options, hand_model_complexity))
         .choices("lite|full")
@@ -126,6 +130,13 @@ inline constexpr option_row<estimator_options> k_estimator_option_table[] = {
         .help("with hands or face and 2+ threads: 2 runs the hands and face beside the body "
               "(of the next frame, for files), each model on one thread; 1 runs every model "
               "on all threads in turn"),
+    option_row<estimator_options>("face_model",
+                                  AVATARMAP_OPTION_FIELD(estimator_options, face_model))
+        .choices("attention|mesh")
+        .cli("--face-model")
+        .not_in_c()
+        .help("face mesh model: attention = 478 points with irises (gaze), refined lips and "
+              "eyes; mesh = 468 points, about half the face stage's cost"),
     option_row<estimator_options>("spin", AVATARMAP_OPTION_FIELD(estimator_options, spin))
         .boolean()
         .cli("--spin")

@@ -13,20 +13,23 @@
 //    by 0.1 of its height, is the mesh's region (FaceDetectionFrontDetectionsToRoi). A face
 //    that is small in a full-body frame is found this way where the whole-image short-range
 //    detector (faces within ~2 m) misses it.
-// The mesh (a rotated 192x192 crop) gives 468 points; the next frame's region is the
-// bounding box of those points, rotated by mesh point 33 (right eye, outer corner) -> 263
-// (left eye, outer corner), squared and scaled by 1.5 (FaceLandmarkLandmarksToRoi), so the
-// detector does not run while the face is tracked. With a body, the tracked region also moves
-// by the body's head motion since the previous frame (follow_body_motion; not in MediaPipe,
-// whose Holistic graph re-runs the detector on every frame instead). When the mesh's
-// face-presence score drops below a threshold (or, with a body, the tracked region's centre
-// leaves the body's face region) the next frame acquires again. docs/capture-face.md has the
-// figures.
+// The mesh (a rotated 192x192 crop) gives 478 points (or 468, see below); the next frame's
+// region is the bounding box of those points, rotated by mesh point 33 (right eye, outer
+// corner) -> 263 (left eye, outer corner), squared and scaled by 1.5
+// (FaceLandmarkLandmarksToRoi), so the detector does not run while the face is tracked. With a
+// body, the tracked region also moves by the body's head motion since the previous frame
+// (follow_body_motion; not in MediaPipe, whose Holistic graph re-runs the detector on every
+// frame instead). When the mesh's face-presence score drops below a threshold (or, with a body,
+// the tracked region's centre leaves the body's face region) the next frame acquires again.
+// docs/capture-face.md has the figures.
 //
-// 468, not 478: MediaPipe's refine_landmarks (face_landmark_with_attention, which refines
-// lips and eyes and adds the 10 iris points 468-477) needs three MediaPipe-only custom ops
-// and does not convert to ONNX, and no package ships iris_landmark.tflite. The face part is
-// therefore always the 468-point mesh (landmark_frame::face_count == 468).
+// 478 or 468 points: by default the mesh stage runs face_landmark_with_attention, MediaPipe's
+// refine_landmarks model (lips and eyes refined, the 10 iris points 468-477 added; its three
+// MediaPipe-only custom operators are rewritten as standard ONNX by tools/convert/
+// tflite2onnx.py), and assembles its six outputs as MediaPipe's LandmarksRefinementCalculator
+// does (refine_face_mesh() below): landmark_frame::face_count == 478. face_mesh_model::mesh, or
+// a models folder without face_landmark_with_attention.onnx, runs the 468-point
+// face_landmark model instead (face_count == 468; the fallback is named by note()).
 //
 // The geometry below is plain C++ (src/capture/face_geometry.cpp, always built);
 // face_pipeline needs AVATARMAP_WITH_ONNX (ONNX Runtime never appears in this header).
@@ -98,7 +101,32 @@ bool face_landmarks_to_roi(const landmark* mesh, int count, int image_width, int
 bool face_region_from_pose(const landmark* pose, int image_width, int image_height,
                            normalized_rect& out, float scale = 3.0f);
 
+/// face_landmark_with_attention's refined regions, points per output: lips 80, each eye 71
+/// (contour and halos), each iris 5 (centre, then the edges: right, top, left, bottom).
+inline constexpr int k_face_refined_lips = 80;
+inline constexpr int k_face_refined_eye = 71;
+inline constexpr int k_face_refined_iris = 5;
+
+/// Assembles face_landmark_with_attention's outputs into the 478-point mesh, as MediaPipe's
+/// tensors_to_face_landmarks_with_attention graph (LandmarksRefinementCalculator) does: the 468
+/// mesh points (x, y, z), then x and y of the lips, left-eye and right-eye points overwrite
+/// their mesh points (z kept), then the left iris becomes points 468-472 and the right iris
+/// 473-477, each with z the mean z of its eye's 16 contour points. Inputs are the raw outputs
+/// in crop pixels: `mesh` 468 x 3, `lips` 80 x 2, `left_eye` / `right_eye` 71 x 2,
+/// `left_iris` / `right_iris` 5 x 2 (the model's "left" is the eye around mesh point 33, the
+/// person's right eye in a non-mirrored image: face_landmark.hpp's right_iris = 468). `out`:
+/// 478 x 3 floats, same units. Never fails; no allocation.
+void refine_face_mesh(const float* mesh, const float* lips, const float* left_eye,
+                      const float* right_eye, const float* left_iris, const float* right_iris,
+                      float* out);
+
 // ---- the pipeline (AVATARMAP_WITH_ONNX) ----------------------------------------------------
+
+/// Which network the mesh stage runs.
+enum class face_mesh_model : std::uint8_t {
+  attention,  // face_landmark_with_attention: 478 points (irises), refined lips and eyes
+  mesh,       // face_landmark: 468 points, cheaper (docs/capture-face.md has the costs)
+};
 
 /// Where a face is looked for when none is tracked.
 enum class face_roi_source : std::uint8_t {
@@ -108,9 +136,12 @@ enum class face_roi_source : std::uint8_t {
 };
 
 struct face_pipeline_options {
-  /// Folder holding face_detection_short_range.onnx and face_landmark.onnx (converted with
-  /// tools/convert/tflite2onnx.py).
+  /// Folder holding face_detection_short_range.onnx and face_landmark_with_attention.onnx or
+  /// face_landmark.onnx (converted with tools/convert/tflite2onnx.py).
   std::string models_dir;
+  /// attention: face_landmark_with_attention when the folder has it, else face_landmark with
+  /// a note (note()); mesh: face_landmark always.
+  face_mesh_model model = face_mesh_model::attention;
   face_roi_source roi_source = face_roi_source::automatic;
   /// float32: face_detection_short_range.onnx etc.; int8: *.int8.onnx.
   model_precision precision = model_precision::float32;
@@ -156,7 +187,7 @@ enum class face_acquisition : std::uint8_t {
 };
 
 enum class face_result : std::uint8_t {
-  found,      // face written (468 points)
+  found,      // face written (478 points, or 468 with the plain mesh model)
   not_found,  // no face (no detection, no body for roi_source::pose, presence too low)
   error,      // bad image or an ONNX Runtime failure: see last_error()
 };
@@ -166,14 +197,16 @@ enum class face_result : std::uint8_t {
 class face_pipeline {
  public:
   /// Loads the models. Fails (naming the file) when a model is missing, does not load, or
-  /// has unexpected input or output shapes; or when an option is out of range.
+  /// has unexpected input or output shapes; or when an option is out of range. A missing
+  /// face_landmark_with_attention model is not a failure: the 468-point model is used and
+  /// note() says so.
   static status create(const face_pipeline_options& options, std::unique_ptr<face_pipeline>& out);
   ~face_pipeline();
   face_pipeline(const face_pipeline&) = delete;
   face_pipeline& operator=(const face_pipeline&) = delete;
 
   /// Processes one frame. `body` (may be null; read only, same image) supplies the pose part
-  /// for the pose-derived region. Sets the face part of `out` (face_count = 468 points:
+  /// for the pose-derived region. Sets the face part of `out` (face_count = mesh_points():
   /// normalised x, y; z relative depth in units of the image width, smaller = closer, as
   /// MediaPipe's mesh gives it; visibility and presence 1) when found, clears it
   /// otherwise; other parts are untouched (`out` may be `*body`). No allocation in the
@@ -184,6 +217,13 @@ class face_pipeline {
 
   /// Forgets the tracked region: the next frame acquires again.
   void reset();
+
+  /// The mesh model loaded (after a fallback, mesh) and its point count (478 or 468).
+  face_mesh_model mesh_model() const;
+  int mesh_points() const;
+  /// One line when create() fell back from the attention model to the plain mesh (which file
+  /// was missing, how to get it), else empty. Valid for the pipeline's lifetime.
+  const std::string& note() const;
 
   /// Region used for the last mesh inference, and whether one is tracked for the next frame.
   const normalized_rect& last_roi() const;

@@ -1,8 +1,10 @@
 // Streaming reader and writer of *.pose.jsonl (docs/file-formats.md).
 // Quaternions are written [x, y, z, w]; bones are VRM 1.0 names; bones at identity may be
 // omitted when reading (missing bones mean identity). "foot_contact": [left, right] is always
-// written and optional when reading (older files: 0, 0; values clamped to [0, 1]). Same error
-// and atomicity rules as landmark_file.hpp.
+// written and optional when reading (older files: 0, 0; values clamped to [0, 1]).
+// "blendshapes": {ARKit name: weight} is written (all 52) when any weight is non-zero and
+// optional when reading (missing shapes are 0). Same error and atomicity rules as
+// landmark_file.hpp.
 #pragma once
 
 #include <memory>
@@ -33,9 +35,9 @@ class pose_reader {
   status open(const std::string& path);
   status open_memory(const char* data, std::size_t size, const std::string& name = "<memory>");
   const pose_file_header& header() const;
-  /// Reads the next pose (reset to rest first). Unknown bone or expression names are an
-  /// error naming them; quaternions are normalised; a zero or non-finite quaternion is an
-  /// error.
+  /// Reads the next pose (reset to rest first). Unknown bone, expression or blendshape names
+  /// are an error naming them; a non-finite weight is an error; quaternions are normalised; a zero
+  /// or non-finite quaternion is an error.
   read_result next(proxy_pose& out);
   const std::string& error() const;
   /// The kind of the last error: parse (a malformed or over-long line), io (reading failed).
@@ -64,7 +66,8 @@ class pose_writer {
   status open(const std::string& path, const pose_file_header& header,
               const pose_write_options& options = {});
   /// Writes one pose: t, hips_position, all bones (VRM 1.0 names, bone enum order,
-  /// [x, y, z, w]), all expressions, and confidence when asked. Non-finite numbers are
+  /// [x, y, z, w]), all expressions, all 52 blendshapes when any is non-zero (none when all
+  /// are 0), and confidence when asked. Non-finite numbers are
   /// written as null (which the reader rejects).
   status write(const proxy_pose& pose);
   status commit();

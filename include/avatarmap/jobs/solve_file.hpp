@@ -8,6 +8,12 @@
 // offline filter, its window of poses (offline_smoother_options::capacity_frames, ~300 kB by
 // default); the poses are streamed, never held all. Per-frame state lives in the pose stream
 // the job creates for one run.
+//
+// The face: before solving, the job calibrates the face's neutral over the take
+// (frame_solver::calibrate_face; docs/expressions.md, "Calibration over a take"): a regular
+// file is read once beforehand for it (whatever the filter); a source callback, a pipe or
+// standard input is calibrated over its first 300 frames, held back until then (so a take of
+// 300 frames or fewer gives the same poses either way).
 #pragma once
 
 #include <functional>

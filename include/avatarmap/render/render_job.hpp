@@ -45,6 +45,11 @@ struct render_options {
   std::string video;
   /// Its landmarks (*.landmarks.jsonl), drawn on it with overlay_job; needs `video`.
   std::string landmarks;
+  /// What the camera frames: the whole motion (body), or the head in close-up (face: the
+  /// head's rest height over the motion's mean hips, about 0.5 m of height in view), as a
+  /// webcam sees a face; for checking the face end to end (docs/render.md).
+  enum class framing_kind { body, face };
+  framing_kind framing = framing_kind::body;
   /// The browser; empty = `chromium` (else `chromium-browser`, `google-chrome`) on the PATH.
   std::string chromium;
   /// The viewer's page and modules folders; empty = find_resource's (as `avatarmap view`).

@@ -1,5 +1,7 @@
 // Face expressions the proxy pose carries: VRM 1.0 preset names where VRM has one, plus four
 // custom brow expressions. Weights are in [0, 1]. "left" is the person's (= avatar's) left.
+// The solver derives them from ARKit's 52 blendshapes (skeleton/blendshape.hpp), which the
+// proxy pose carries too; docs/expressions.md gives each derivation.
 #pragma once
 
 #include <array>
@@ -26,15 +28,23 @@ enum class expression : std::uint8_t {
   brow_up_right,
   brow_down_left,  // custom: lowered (frowning) left brow
   brow_down_right,
+  happy,  // VRM 1.0 emotion presets (appended in 0.2.0)
+  angry,
+  sad,
+  relaxed,
+  surprised,
 };
 
-inline constexpr int k_expression_count = 16;
+inline constexpr int k_expression_count = 21;
 
 namespace detail {
 inline constexpr std::array<std::string_view, k_expression_count> k_expression_names = {
-    "blink",      "blinkLeft",   "blinkRight",   "aa",           "ih",       "ou",
-    "ee",         "oh",          "lookUp",       "lookDown",     "lookLeft", "lookRight",
-    "browUpLeft", "browUpRight", "browDownLeft", "browDownRight"};
+    "blink",      "blinkLeft",   "blinkRight",   "aa",
+    "ih",         "ou",          "ee",           "oh",
+    "lookUp",     "lookDown",    "lookLeft",     "lookRight",
+    "browUpLeft", "browUpRight", "browDownLeft", "browDownRight",
+    "happy",      "angry",       "sad",          "relaxed",
+    "surprised"};
 }
 
 constexpr int idx(expression e) { return static_cast<int>(e); }

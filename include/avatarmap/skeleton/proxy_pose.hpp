@@ -1,12 +1,13 @@
 // A pose of the proxy skeleton in VRM 1.0 normalised space: a local rotation per bone
 // (relative to its parent; identity = VRM T-pose), the hips position in metres, expression
-// weights and a per-bone confidence. Fixed-size: never allocates.
+// weights, ARKit's 52 blendshape weights and a per-bone confidence. Fixed-size: never allocates.
 #pragma once
 
 #include <array>
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "avatarmap/skeleton/blendshape.hpp"
 #include "avatarmap/skeleton/bone.hpp"
 #include "avatarmap/skeleton/expression.hpp"
 
@@ -23,6 +24,7 @@ struct proxy_pose {
   std::array<glm::quat, k_bone_count> rotations;        // local, {w,x,y,z} in GLM's storage
   std::array<float, k_bone_count> confidence{};         // 0 = not observed .. 1 = observed
   std::array<float, k_expression_count> expressions{};  // 0 .. 1
+  std::array<float, k_blendshape_count> blendshapes{};  // ARKit's 52, 0 .. 1
   /// Foot contact per foot ([0] left, [1] right): 0 = the foot moves freely .. 1 = planted
   /// on the floor; values between blend foot locking in and out. Set by the contact stage
   /// (time/foot_contacts.hpp); 0 when no stage ran.
@@ -36,6 +38,7 @@ struct proxy_pose {
     rotations.fill(glm::quat(1.f, 0.f, 0.f, 0.f));
     confidence.fill(0.f);
     expressions.fill(0.f);
+    blendshapes.fill(0.f);
     foot_contact.fill(0.f);
   }
 
@@ -43,6 +46,8 @@ struct proxy_pose {
   const glm::quat& operator[](bone b) const { return rotations[idx(b)]; }
   float& operator[](expression e) { return expressions[idx(e)]; }
   float operator[](expression e) const { return expressions[idx(e)]; }
+  float& operator[](blendshape s) { return blendshapes[idx(s)]; }
+  float operator[](blendshape s) const { return blendshapes[idx(s)]; }
 };
 
 /// World (model-space) rotations of every bone from a pose's local rotations.

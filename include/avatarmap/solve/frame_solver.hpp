@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <memory>
@@ -26,6 +27,9 @@ struct prepared_frame;  // src/solve/solve_prepare.hpp
 struct body_lengths;    // src/solve/solve_fit.hpp
 struct camera_gravity;
 struct body_fit;
+struct face_calibration;  // src/solve/solve_face.hpp
+struct face_features;
+struct face_take;
 }  // namespace solve_detail
 
 /// One bone's measurement before confidence gating and its confidence (0 = not measured this
@@ -46,8 +50,9 @@ struct frame_measurement {
   float hips_height = 0.f;  // metres above the lowest foot point
   bool hips_ground_valid = false;
   glm::vec2 hips_ground{0.f};  // X, Z in metres from the camera axis / depth
-  std::array<float, k_expression_count> expressions{};
-  bool expressions_valid = false;
+  std::array<float, k_expression_count> expressions{};  // derived from the blendshapes
+  std::array<float, k_blendshape_count> blendshapes{};  // ARKit's 52 (docs/expressions.md)
+  bool expressions_valid = false;                       // both set (a face mesh was read)
 };
 
 class frame_solver {
@@ -115,6 +120,27 @@ class frame_solver {
   /// plausible or the legs not seen (options().lower_body_rest; body_plausibility.hpp), and
   /// why. restart_take() and reset() start the count again.
   const body_hold_stats& hold_stats() const { return hold_stats_; }
+  /// Whether the face's neutral is calibrated (docs/expressions.md, "Calibration"): every
+  /// measurement of the mesh has its own neutral from the face's first frontal frames; until
+  /// then the population's is used. restart_take() keeps the calibration, reset() forgets it.
+  bool face_calibrated() const;
+  /// Frontal face frames the calibration has learnt from (calibrated over a take: the take's
+  /// frames whose face was read).
+  long face_calibration_frames() const;
+  /// Calibrates the face over a whole take before it is solved (docs/expressions.md,
+  /// "Calibration over a take"): every measurement but the irises' gets the take's neutral,
+  /// its dependence on the head's turn from the camera and a dead zone of the take's noise,
+  /// and is not learnt further (the irises still learn as live). The frames are read with
+  /// what the solver knows now (its field of view), nothing else is learnt; a take with fewer
+  /// than 8 frames whose face is read changes nothing (false). restart_take() keeps it,
+  /// reset() forgets it. The file job (jobs/solve_file.hpp) calls it on every file.
+  bool calibrate_face(const landmark_frame* frames, std::size_t count);
+  /// The same one frame at a time, for a take too long to hold (a file read twice):
+  /// begin_face_take(), add_face_take() for each frame in order, then end_face_take().
+  /// Allocates (a few hundred bytes per frame).
+  void begin_face_take();
+  void add_face_take(const landmark_frame& in);
+  bool end_face_take();
   /// How much of the body the last solved frame followed.
   body_follow body_follow_state() const { return hold_.state(); }
 
@@ -122,8 +148,7 @@ class frame_solver {
   // The gate stage (src/solve/solve_gate.cpp): this frame's measurement -> what is shown.
   void gate_bones(const frame_measurement& m, double t, proxy_pose& out);
   glm::vec3 gate_hips_position(const frame_measurement& m, double t);
-  void gate_expressions(const frame_measurement& m, double t,
-                        std::array<float, k_expression_count>& out);
+  void gate_expressions(const frame_measurement& m, double t, proxy_pose& out);
   const glm::quat& previous_world(int b) const;
   // Adds this frame's evidence on the focal length (horizontal_fov_degrees 0 only).
   void update_focal(const landmark_frame& in);
@@ -135,7 +160,8 @@ class frame_solver {
   bool fits_hand(const solve_detail::prepared_frame& f, int side) const;
   // The measuring stages on a prepared frame whose hands are fitted already.
   void measure_prepared(const landmark_frame& in, const solve_detail::prepared_frame& f,
-                        body_follow follow, frame_measurement& m) const;
+                        body_follow follow, frame_measurement& m,
+                        solve_detail::face_features& features) const;
 
   solver_options options_;
   float focal_per_width_ = 1.f;  // focal length / image width, from the field of view
@@ -161,6 +187,7 @@ class frame_solver {
   glm::vec2 ground_origin_{0.f};
   bool have_origin_ = false;
   std::array<float, k_expression_count> expressions_held_{};
+  std::array<float, k_blendshape_count> blendshapes_held_{};
   double last_t_ = 0.0;
   bool started_ = false;
   mutable frame_measurement scratch_{};
@@ -172,6 +199,11 @@ class frame_solver {
   std::unique_ptr<solve_detail::body_lengths> lengths_;
   std::unique_ptr<solve_detail::camera_gravity> gravity_;
   std::unique_ptr<solve_detail::body_fit> fit_;
+  // The face's neutral measurements (learnt over the take, kept by restart_take) and this
+  // frame's measurements (allocated once, at construction).
+  std::unique_ptr<solve_detail::face_calibration> face_calibration_;
+  std::unique_ptr<solve_detail::face_features> face_features_;
+  std::unique_ptr<solve_detail::face_take> face_take_;  // between begin_ and end_face_take
 };
 
 }  // namespace avatarmap

@@ -126,6 +126,9 @@ class pose_stream {
   const pose_stream_stats& stats() const noexcept { return stats_; }
   /// The solver (its field-of-view estimate, the options it runs with).
   const frame_solver& solver() const noexcept { return solver_; }
+  /// The solver, to calibrate its face over a take (frame_solver::calibrate_face) before the
+  /// first frame is pushed; changing it mid-stream is the caller's responsibility.
+  frame_solver& solver() noexcept { return solver_; }
 
  private:
   // The point filter (when on), then the solver, into solved_.

@@ -71,17 +71,19 @@ inline constexpr std::array<std::string_view, k_bone_count> k_unity_bone_names =
     "RightLittleIntermediate",
     "RightLittleDistal"};
 
-// VRM 0.x presets for the proxy's expressions; "" where VRM 0.x has none (the custom brows).
+// VRM 0.x presets for the proxy's expressions; "" where VRM 0.x has none (the custom brows,
+// surprised). VRM 1.0's happy, angry, sad and relaxed were VRM 0.x's Joy, Angry, Sorrow, Fun.
 inline constexpr std::array<std::string_view, k_expression_count> k_vrm0_blend_names = {
-    "Blink",  "Blink_L",  "Blink_R",  "A",         "I", "U", "E", "O",
-    "LookUp", "LookDown", "LookLeft", "LookRight", "",  "",  "",  ""};
+    "Blink", "Blink_L", "Blink_R",  "A",        "I",         "U",   "E",
+    "O",     "LookUp",  "LookDown", "LookLeft", "LookRight", "",    "",
+    "",      "",        "Joy",      "Angry",    "Sorrow",    "Fun", ""};
 }  // namespace detail
 
 /// Unity HumanBodyBones name of a proxy bone ("Hips", "LeftThumbProximal", ...).
 constexpr std::string_view unity_bone_name(bone b) { return detail::k_unity_bone_names[idx(b)]; }
 
 /// VRM 0.x blend shape preset name of an expression ("A", "Blink_L", ...), or "" when VRM 0.x
-/// has no preset for it (browUpLeft, browUpRight, browDownLeft, browDownRight).
+/// has no preset for it (browUpLeft, browUpRight, browDownLeft, browDownRight, surprised).
 constexpr std::string_view vrm0_blend_name(expression e) {
   return detail::k_vrm0_blend_names[idx(e)];
 }

@@ -33,9 +33,10 @@ class vmc_stream {
   /// Resolves `to` and keeps `skeleton` (copied). `foot_lock` (docs/foot-locking.md): planted
   /// feet (proxy_pose::foot_contact) are locked on the 1.70 m proxy skeleton before each pose
   /// is sent, the anchors kept from one send() to the next; enabled = false sends the poses as
-  /// given. Fails as udp_sender::open does, or (invalid_argument) on invalid foot_lock options.
+  /// given. `blends`: the blend values each bundle carries (vmc_bundle.hpp). Fails as
+  /// udp_sender::open does, or (invalid_argument) on invalid foot_lock options.
   status open(const host_port& to, const vmc_skeleton& skeleton,
-              const foot_lock_options& foot_lock = {});
+              const foot_lock_options& foot_lock = {}, vmc_blend_set blends = vmc_blend_set::vrm0);
   void close() { sender_.close(); }
   bool is_open() const { return sender_.is_open(); }
 
@@ -53,7 +54,8 @@ class vmc_stream {
   const std::string& warning() const { return sender_.warning(); }
   /// /VMC/Ext/Bone/Pos and /VMC/Ext/Blend/Val messages in each bundle.
   int bone_messages() const { return skeleton_.sent_count; }
-  int blend_messages() const { return vmc_blend_count(); }
+  int blend_messages() const { return vmc_blend_count(blends_); }
+  vmc_blend_set blend_set() const { return blends_; }
   /// Size in bytes of the last bundle built.
   std::size_t last_bundle_bytes() const { return writer_.size(); }
 
@@ -63,6 +65,7 @@ class vmc_stream {
   udp_sender sender_;
   vmc_skeleton skeleton_{};
   long encode_failures_ = 0;
+  vmc_blend_set blends_ = vmc_blend_set::vrm0;
   float last_time_ = -std::numeric_limits<float>::infinity();  // the last /VMC/Ext/T sent
   proxy_foot_lock lock_;
   bool lock_on_ = false;

@@ -46,6 +46,7 @@
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "avatarmap/skeleton/proxy_skeleton.hpp"
+#include "avatarmap/solve/face_expressions.hpp"
 
 namespace avatarmap {
 
@@ -100,6 +101,10 @@ struct synth_options {
   /// draws and the burst schedule use their own generators derived from it, so turning them
   /// on leaves the noise sequence as it was.
   std::uint32_t seed = 1;
+  /// Face variation: when true the face's own proportions and how far its shapes move
+  /// (synth_face_shape) are drawn once from the seed, as real faces differ; when false every
+  /// seed has the population face (synth_face_shape{}).
+  bool face_variation = false;
 
   /// Random camera: when true, camera_position and horizontal_fov_degrees are ignored and
   /// drawn once from the seed: field of view uniform in [fov_min_degrees, fov_max_degrees]
@@ -149,6 +154,51 @@ struct synth_points {
   glm::vec3 head_joint{0.f};
 };
 
+/// A face's own proportions and the reach of its shapes (metres at the 1.70 m reference
+/// scale; shares and ratios without unit). The defaults are the population face; with
+/// synth_options::face_variation each is drawn per seed from the range in brackets.
+/// docs/expressions.md ("The generator") describes how each shape deforms the mesh.
+struct synth_face_shape {
+  float eye_open[2] = {
+      0.22f,
+      0.22f};  // middle lid gap / eye width at rest, person's L, R [0.17, 0.28] x [0.95, 1.05]
+  float shut_fraction = 0.09f;        // a shut eye's gap / its open gap [0.05, 0.14]
+  float wide_gain = 0.4f;             // extra gap at eyeWide 1 / open gap [0.34, 0.46]
+  float brow_offset[2] = {0.f, 0.f};  // brow height at rest beyond the template's [-2, 2] mm
+  float brow_raise = 0.0075f;         // brow end's rise at browInnerUp/OuterUp 1 [6.8, 8.2] mm
+  float brow_lower = 0.005f;          // inner end's drop at browDown 1 [4.5, 5.5] mm
+  float cheek_raise = 0.0035f;        // rise below the lid at cheekSquint 1 [3, 4] mm
+  float mouth_width = 0.05f;          // corner to corner at rest [45, 56] mm
+  float jaw_drop = 0.029f;            // lower lip's drop at jawOpen 1 [27, 31] mm
+  float corner_follow = 0.5f;         // share of that drop the corners follow [0.46, 0.54]
+  float narrow = 0.3f;                // width lost at mouthFunnel/Pucker 1 [0.27, 0.33]
+  float funnel_open = 0.006f;         // lips parted by mouthFunnel 1 [5, 7] mm
+  float smile_rise = 0.009f;          // corner's rise at mouthSmile 1 [8.2, 9.8] mm
+  float smile_out = 0.6f;             // its outward move / rise [0.5, 0.7]
+  float stretch_out = 0.007f;         // corner's outward move at mouthStretch 1 [6.5, 7.5] mm
+  float frown_drop = 0.005f;          // corner's drop at mouthFrown 1 [4.5, 5.5] mm
+  float shift = 0.007f;               // lips' sideways move at mouthLeft/Right 1 [6.5, 7.5] mm
+  float eyeball_radius = 0.012f;      // iris move per sine of the eye's turn [11.2, 12.8] mm
+  float iris_u = 0.f, iris_v = 0.f;   // iris rest offset (eye widths, out / up) [-0.03, 0.03]
+};
+
+/// Draws a face for `seed` (the ranges of synth_face_shape).
+synth_face_shape draw_face_shape(std::uint32_t seed);
+
+/// The truth expressions of a pose the generator draws: its eyeLook* blendshapes set from the
+/// eye bones' turn (euler YXZ of each eye's local rotation; sideways and up as sines, the
+/// definitions of solve/face_expressions.hpp), then the 21 expressions derived from the 52
+/// (expressions_from_blendshapes).
+void set_truth_expressions(proxy_pose& pose);
+
+/// The blendshapes the generator draws for a pose that carries only expressions (every
+/// blendshape 0): eyeBlinkLeft/Right = blink + blinkLeft/Right; jawOpen = aa + ih + oh,
+/// mouthStretch = ih + ee, mouthFunnel = oh, mouthPucker = ou (clamped); browOuterUp =
+/// browUp per side, browInnerUp = the smaller browUp, browDown per side. A single viseme,
+/// blink or brow then derives back to itself. Emotions and looks are not converted (the eye
+/// bones give the gaze).
+void blendshapes_from_expressions(const proxy_pose& pose, blendshape_weights& out);
+
 /// Pose -> landmark frame generator. Holds the skeleton, the face template, the noise RNG and
 /// scratch buffers: generate() allocates nothing. Not thread-safe (one object per thread).
 class landmark_synth {
@@ -189,6 +239,8 @@ class landmark_synth {
 
   const proxy_skeleton& skeleton() const { return skeleton_; }
   const synth_options& options() const { return options_; }
+  /// The face drawn (synth_options::face_variation) or the population face.
+  const synth_face_shape& face_shape() const { return face_shape_; }
   /// 3-D points of the last generate() call.
   const synth_points& points() const { return points_; }
   /// FK of the last generate() call (of the mirrored pose when options.mirror is set).
@@ -204,6 +256,7 @@ class landmark_synth {
 
   proxy_skeleton skeleton_;
   synth_options options_;
+  synth_face_shape face_shape_;
   glm::vec3 camera_{0.f};
   float focal_ = 1.f;
   std::array<glm::vec3, k_face_mesh_iris_count> face_template_{};

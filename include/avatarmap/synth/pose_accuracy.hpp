@@ -85,6 +85,41 @@ struct accuracy_figures {
   angle_histogram head_histogram;                           // its percentiles
 };
 
+/// Mean and maximum of absolute weight errors (weights in [0, 1]).
+struct weight_stats {
+  double sum = 0.0;
+  double max = 0.0;
+  long count = 0;
+  void add(double error) {
+    const double e = error < 0.0 ? -error : error;
+    const double v = e == e ? e : 1.0;  // NaN counts as the largest error
+    sum += v;
+    if (v > max) max = v;
+    ++count;
+  }
+  /// 0 when empty.
+  double mean() const { return count > 0 ? sum / static_cast<double>(count) : 0.0; }
+};
+
+/// The face's figures (docs/accuracy.md, "The face"), over every frame:
+/// - blink: per eye, the eye's closure blink + blinkLeft / blink + blinkRight (expressions,
+///   so *.pose.jsonl files carry it); two samples a frame.
+/// - jaw_open: ARKit's jawOpen blendshape (0 on both sides where a file carries no
+///   blendshapes).
+/// - visemes: aa, ih, ou, ee, oh (expressions).
+/// - gaze: per eye, the angle between the eye's forward (+Z) under the truth's and the
+///   solved local rotation (relative to the head, so the head's error is not counted);
+///   two samples a frame, and its percentiles.
+/// - shapes: every ARKit blendshape's error (zero where neither side has it).
+struct face_accuracy {
+  weight_stats blink;
+  weight_stats jaw_open;
+  std::array<weight_stats, 5> visemes;
+  angle_stats gaze;
+  angle_histogram gaze_histogram;
+  std::array<weight_stats, k_blendshape_count> shapes;
+};
+
 struct pose_accuracy {
   long frames = 0;                  // truth frames compared
   long low_visibility_frames = 0;   // of those, frames with a marked bone
@@ -94,6 +129,7 @@ struct pose_accuracy {
   /// Per bone over every frame: the direction error (head: its orientation error; eyes and
   /// jaw stay empty). For finding which bone a group's figure comes from.
   std::array<angle_stats, k_bone_count> bones;
+  face_accuracy face;  // every frame
 };
 
 /// Adds one frame (truth and solved at the same time) to `acc`. Non-finite or zero

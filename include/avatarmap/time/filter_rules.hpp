@@ -22,7 +22,7 @@ namespace avatarmap {
 struct pose_filter_channels {
   bool rotations = true;
   bool position = true;
-  bool expressions = true;
+  bool expressions = true;  // the expression weights and the ARKit blendshape weights
 };
 
 /// Filters `raw` into `out` with `filter`, then puts back the channels of `raw` whose
@@ -32,7 +32,10 @@ inline void filter_pose_channels(pose_filter& filter, const pose_filter_channels
   filter.apply(raw, out);
   if (!channels.rotations) out.rotations = raw.rotations;
   if (!channels.position) out.hips_position = raw.hips_position;
-  if (!channels.expressions) out.expressions = raw.expressions;
+  if (!channels.expressions) {
+    out.expressions = raw.expressions;
+    out.blendshapes = raw.blendshapes;
+  }
 }
 
 /// How solved poses are smoothed over time (docs/smoothing.md).

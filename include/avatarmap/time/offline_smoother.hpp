@@ -35,7 +35,7 @@
 //   (e.g. unobservable bones the solver sets from priors), smoothed.
 // - confidence is copied unchanged (a filled bone stays marked as not observed; a false
 //   detection is written 0); `t` is the centre's.
-// The hips position and the expression weights are Gaussian-smoothed (unweighted by
+// The hips position and the expression and blendshape weights are Gaussian-smoothed (unweighted by
 // confidence: the solver already holds and eases them).
 //
 // Time: frames are expected in increasing `t` (duplicates are fine). A frame whose `t` is
@@ -67,7 +67,7 @@ struct offline_smoother_options {
   float finger_sigma_seconds = 0.30f;
   /// Gaussian sigma for the hips position.
   float position_sigma_seconds = 0.05f;
-  /// Gaussian sigma for the expression weights.
+  /// Gaussian sigma for the expression weights and the ARKit blendshape weights.
   float expression_sigma_seconds = 0.03f;
   /// Least sigma in frame intervals (of the frames around the centre), for every sigma above
   /// while strength > 0: at a low frame rate a sigma of a fraction of a frame would smooth

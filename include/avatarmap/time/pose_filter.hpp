@@ -1,5 +1,6 @@
 // Temporal smoothing of whole frames with One Euro filters (avatarmap/time/one_euro.hpp):
-// - pose_filter: a proxy_pose's 55 local bone rotations, hips position and expression weights;
+// - pose_filter: a proxy_pose's 55 local bone rotations, hips position, expression weights and
+//   ARKit blendshape weights;
 // - landmark_filter: every point of every part of a landmark_frame.
 // Both keep their state in fixed-size arrays (no allocation, ever), take the time step from
 // the frames' timestamps `t` (seconds), and are meant to be fed one stream in time order.
@@ -43,8 +44,9 @@ inline float frame_dt(bool has_last, double last_t, double t) noexcept {
 ///   it, and a turn at 3 rad/s that stops dead is overshot by ~4 degrees for ~0.3 s.
 /// - position (hips, metres): 1 Hz at rest (the root is the noisiest, most visible signal),
 ///   beta 2 s/m: ~4 Hz at walking speed (1.5 m/s), ~7 Hz for a jump.
-/// - expression (weights 0..1): 3 Hz at rest, beta 1 s: a blink (0 -> 1 in ~0.1 s, ~10/s)
-///   gets ~13 Hz, i.e. passes almost unfiltered while flicker of a still face is damped.
+/// - expression (weights 0..1, the expressions and the 52 blendshapes alike): 3 Hz at rest,
+///   beta 1 s: a blink (0 -> 1 in ~0.1 s, ~10/s) gets ~13 Hz, i.e. passes almost unfiltered
+///   while flicker of a still face is damped.
 /// - d_cutoff 1 Hz for position and expressions, as the paper recommends.
 struct pose_filter_options {
   one_euro_params rotation{0.7f, 0.3f, 1.0f};
@@ -72,6 +74,7 @@ class pose_filter {
     }
     position_.set_params(options.position);
     for (auto& f : expressions_) f.set_params(options.expression);
+    for (auto& f : blendshapes_) f.set_params(options.expression);
     if (!options.enabled) reset();
   }
   const pose_filter_options& options() const noexcept { return options_; }
@@ -81,6 +84,7 @@ class pose_filter {
     for (auto& f : rotations_) f.reset();
     position_.reset();
     for (auto& f : expressions_) f.reset();
+    for (auto& f : blendshapes_) f.reset();
     has_last_ = false;
   }
 
@@ -102,6 +106,8 @@ class pose_filter {
     if (!position_.initialized()) out.hips_position = glm::vec3(0.f, k_default_hips_height, 0.f);
     for (int e = 0; e < k_expression_count; ++e)
       out.expressions[e] = expressions_[e](in.expressions[e], dt);
+    for (int s = 0; s < k_blendshape_count; ++s)
+      out.blendshapes[s] = blendshapes_[s](in.blendshapes[s], dt);
   }
 
  private:
@@ -109,6 +115,7 @@ class pose_filter {
   std::array<one_euro_filter_quat, k_bone_count> rotations_;
   one_euro_filter_vec3 position_;
   std::array<one_euro_filter, k_expression_count> expressions_;
+  std::array<one_euro_filter, k_blendshape_count> blendshapes_;
   double last_t_ = 0.0;
   bool has_last_ = false;
 };

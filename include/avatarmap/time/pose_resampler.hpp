@@ -1,6 +1,6 @@
 // Resampling a stream of proxy poses captured at an irregular, low rate (the paper: capture
 // ~20-30 fps) to any render time (display 60+ fps): shortest-arc slerp of every bone rotation
-// and linear interpolation of the hips position and expression weights between the two
+// and linear interpolation of the hips position, expression and blendshape weights between the two
 // captured frames around the render time, with bounded extrapolation past the newest frame.
 //
 // Fixed memory: the last k_pose_resampler_capacity (4) captured frames in a ring; push() and
@@ -54,9 +54,10 @@ class pose_resampler {
   /// - t earlier than the newest frame's: the stream is taken as restarted: everything kept is
   ///   dropped and the frame becomes the only one.
   /// The stored copy is sanitised so that sample() can never produce non-finite values:
-  /// rotations are normalised; a non-finite (or zero) rotation, position or expression weight
-  /// is replaced by the previous kept frame's (identity, default hips, 0 when there is none);
-  /// expression weights, confidences and foot contacts are clamped to [0, 1] (NaN: 0).
+  /// rotations are normalised; a non-finite (or zero) rotation, position, expression or
+  /// blendshape weight is replaced by the previous kept frame's (identity, default hips, 0 when
+  /// there is none); expression and blendshape weights, confidences and foot contacts are
+  /// clamped to [0, 1] (NaN: 0).
   bool push(const proxy_pose& frame) noexcept {
     if (!std::isfinite(frame.t)) return false;
     if (count_ > 0 && frame.t <= newest().t) {
@@ -97,6 +98,10 @@ class pose_resampler {
       const float w = frame.expressions[e];
       dst.expressions[e] = std::isfinite(w) ? clamp01(w) : (prev ? prev->expressions[e] : 0.f);
     }
+    for (int s = 0; s < k_blendshape_count; ++s) {
+      const float w = frame.blendshapes[s];
+      dst.blendshapes[s] = std::isfinite(w) ? clamp01(w) : (prev ? prev->blendshapes[s] : 0.f);
+    }
     for (int f = 0; f < 2; ++f) dst.foot_contact[f] = clamp01(frame.foot_contact[f]);
     return true;
   }
@@ -105,13 +110,14 @@ class pose_resampler {
   /// untouched, when no frame was pushed or `t` is not finite. Otherwise:
   /// - t at or before the oldest kept frame: that frame;
   /// - between two kept frames a (t_a <= t <= t_b) and b, with u = (t - t_a) / (t_b - t_a):
-  ///   rotations slerp_shortest(a, b, u), hips position, expressions and foot contacts
-  ///   lerped, confidence min(a, b); exactly at a kept frame's time: that frame (same quaternion
-  ///   signs);
+  ///   rotations slerp_shortest(a, b, u), hips position, expressions, blendshapes and foot
+  ///   contacts lerped, confidence min(a, b); exactly at a kept frame's time: that frame (same
+  ///   quaternion signs);
   /// - after the newest frame b (previous frame a): extrapolation at constant angular and
   ///   linear velocity, slerp_shortest(a, b, 1 + h / (t_b - t_a)) with h = min(t - t_b,
-  ///   max_extrapolation_seconds), hips position likewise, expressions and foot contacts
-  ///   likewise but clamped to [0, 1], confidence min(a, b); with only one frame kept: that frame.
+  ///   max_extrapolation_seconds), hips position likewise, expressions, blendshapes and foot
+  ///   contacts likewise but clamped to [0, 1], confidence min(a, b); with only one frame kept:
+  ///   that frame.
   /// Whatever was pushed, the result is finite: a value the blend cannot give finite (frames
   /// too close in time to divide by, values near the float limits) is the later frame's.
   bool sample(double t, proxy_pose& out) const noexcept {
@@ -204,6 +210,8 @@ class pose_resampler {
     }
     for (int e = 0; e < k_expression_count; ++e)  // clamp01 also turns NaN into 0
       out.expressions[e] = clamp01(v * a.expressions[e] + u * b.expressions[e]);
+    for (int s = 0; s < k_blendshape_count; ++s)
+      out.blendshapes[s] = clamp01(v * a.blendshapes[s] + u * b.blendshapes[s]);
     for (int f = 0; f < 2; ++f)
       out.foot_contact[f] = clamp01(v * a.foot_contact[f] + u * b.foot_contact[f]);
   }

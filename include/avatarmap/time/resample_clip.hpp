@@ -1,6 +1,7 @@
 // Resampling a whole clip of proxy poses at a fixed frame rate (batch work for exporters and
 // converters; live streams use pose_resampler). Rotations are slerped along the shorter arc,
-// hips position, expression weights and foot contacts interpolated linearly, confidence the
+// hips position, expression and blendshape weights and foot contacts interpolated linearly,
+// confidence the
 // lower of the two frames around each sample.
 //
 // Clips come from files a user may not trust, so the times are checked before anything is
@@ -158,6 +159,8 @@ inline status resample_clip(const std::vector<proxy_pose>& frames, double fps, b
       o.hips_position = v * a.hips_position + u * b.hips_position;
       for (int e = 0; e < k_expression_count; ++e)
         o.expressions[e] = v * a.expressions[e] + u * b.expressions[e];
+      for (int s = 0; s < k_blendshape_count; ++s)
+        o.blendshapes[s] = v * a.blendshapes[s] + u * b.blendshapes[s];
       for (int f = 0; f < 2; ++f) o.foot_contact[f] = v * a.foot_contact[f] + u * b.foot_contact[f];
     }
     o.t = rebase ? resampled_frame_time(0.0, t_last - t0, k, fps) : t;

@@ -1,7 +1,8 @@
 // face_pipeline: MediaPipe's face mesh graph around face_detection_short_range and
-// face_landmark under ONNX Runtime. Mirrors face_landmark_front_cpu.pbtxt (FaceDetection ->
-// FaceDetectionFrontDetectionToRoi -> FaceLandmarkCpu -> FaceLandmarkLandmarksToRoi) and, with
-// a body, Holistic's face_landmarks_from_pose_cpu.pbtxt (FaceLandmarksFromPoseToRecropRoi ->
+// face_landmark_with_attention (or face_landmark) under ONNX Runtime. Mirrors
+// face_landmark_front_cpu.pbtxt (FaceDetection -> FaceDetectionFrontDetectionToRoi ->
+// FaceLandmarkCpu -> FaceLandmarkLandmarksToRoi) and, with a body, Holistic's
+// face_landmarks_from_pose_cpu.pbtxt (FaceLandmarksFromPoseToRecropRoi ->
 // FaceDetectionShortRangeByRoi -> FaceDetectionFrontDetectionsToRoi), without the smoothing
 // filters. Holistic re-runs the detector in the body's region on every frame and keeps the
 // tracked region while it agrees (RoiTrackingCalculator); here the detector runs only to
@@ -10,6 +11,7 @@
 
 #include <onnxruntime_cxx_api.h>
 
+#include <array>
 #include <chrono>
 #include <fstream>
 #include <functional>
@@ -24,13 +26,20 @@ namespace {
 
 constexpr int k_detector_boxes = 896;
 constexpr int k_detector_coords = 16;
+// face_landmark_with_attention's outputs, in the model's order: mesh 468 x 3, lips 80 x 2,
+// left eye 71 x 2, right eye 71 x 2, left iris 5 x 2, right iris 5 x 2, face flag.
+constexpr int k_attention_flag_output = 6;
 
 }  // namespace
 
 struct face_pipeline::impl {
   face_pipeline_options options;
   bound_model detector;  // outputs: boxes [896 x 16], scores [896]
-  bound_model mesh;      // outputs: landmarks [468 x 3], face flag [1]
+  bound_model mesh;      // outputs: landmarks [468 x 3], face flag [1]; or the attention ones
+  face_mesh_model model = face_mesh_model::attention;
+  int points = k_face_mesh_iris_count;
+  std::string note;
+  std::array<float, k_face_mesh_iris_count * 3> refined{};  // attention outputs assembled
   std::vector<ssd_anchor> anchors;
   detection_decode_options decode;
   std::vector<detection> decoded;
@@ -96,13 +105,19 @@ struct face_pipeline::impl {
     mesh.run();
     timings.mesh_inference_ms = ms_since(ti);
     // TensorsToFloats with SIGMOID, then ThresholdingCalculator (face_landmark_cpu.pbtxt).
-    presence = sigmoid(mesh.outputs[1][0]);
+    const bool attention = model == face_mesh_model::attention;
+    presence = sigmoid(mesh.outputs[attention ? k_attention_flag_output : 1][0]);
     if (!(presence >= options.min_presence)) {
       timings.mesh_ms = ms_since(t0);
       return false;
     }
     const float* raw = mesh.outputs[0].data();
-    for (int i = 0; i < k_face_mesh_count; ++i) {
+    if (attention) {
+      refine_face_mesh(raw, mesh.outputs[1].data(), mesh.outputs[2].data(), mesh.outputs[3].data(),
+                       mesh.outputs[4].data(), mesh.outputs[5].data(), refined.data());
+      raw = refined.data();
+    }
+    for (int i = 0; i < points; ++i) {
       const float* p = raw + i * 3;
       const crop_point q = project_to_image(tr, {p[0], p[1], p[2]});
       avatarmap::landmark& l = out.face[i];
@@ -112,8 +127,7 @@ struct face_pipeline::impl {
       l.visibility = 1.f;
       l.presence = 1.f;
     }
-    has_roi =
-        face_landmarks_to_roi(out.face.data(), k_face_mesh_count, image.width, image.height, roi);
+    has_roi = face_landmarks_to_roi(out.face.data(), points, image.width, image.height, roi);
     timings.mesh_ms = ms_since(t0);
     return true;
   }
@@ -130,6 +144,8 @@ status face_pipeline::create(const face_pipeline_options& options,
                                                    options.nms_iou_threshold, options.min_presence);
       !e.empty())
     return status::error(e);
+  if (options.model != face_mesh_model::attention && options.model != face_mesh_model::mesh)
+    return status::error("face_pipeline: model must be attention or mesh");
   if (!(options.pose_region_scale > 0.f && options.pose_region_scale <= 100.f))
     return status::error("face_pipeline: pose_region_scale must be in (0, 100]");
   if (!(options.retry_after_miss_seconds >= 0.0) ||
@@ -138,14 +154,32 @@ status face_pipeline::create(const face_pipeline_options& options,
   const std::string dir = options.models_dir.empty() ? "." : options.models_dir;
   const std::string det_path =
       dir + "/" + model_file_name("face_detection_short_range", options.precision);
-  const std::string mesh_path = dir + "/" + model_file_name("face_landmark", options.precision);
+  std::unique_ptr<impl> m(new impl());
+  m->options = options;
+  m->model = options.model;
+  std::string mesh_path;
+  if (options.model == face_mesh_model::attention) {
+    mesh_path = dir + "/" + model_file_name("face_landmark_with_attention", options.precision);
+    // The face mesh stays float in the int8 set (docs/capture.md "int8 models"), and the
+    // attention model has no int8 file: int8 runs its float one.
+    if (options.precision != model_precision::float32 && !std::ifstream(mesh_path).good())
+      mesh_path =
+          dir + "/" + model_file_name("face_landmark_with_attention", model_precision::float32);
+    if (!std::ifstream(mesh_path).good()) {
+      m->note = "face: " + mesh_path +
+                " not found, using the 468-point mesh without irises (scripts/"
+                "prepare_capture.sh converts the attention model)";
+      m->model = face_mesh_model::mesh;
+    }
+  }
+  if (m->model == face_mesh_model::mesh)
+    mesh_path = dir + "/" + model_file_name("face_landmark", options.precision);
+  m->points = m->model == face_mesh_model::attention ? k_face_mesh_iris_count : k_face_mesh_count;
   for (const std::string& p : {det_path, mesh_path})
     if (!std::ifstream(p).good())
       return status::io_error("face_pipeline: cannot open " + p +
                               missing_model_hint(options.precision));
 
-  std::unique_ptr<impl> m(new impl());
-  m->options = options;
   // Both sessions at once (start-up, model_cache.hpp); an ORT error names its model.
   std::string e;
   try {
@@ -161,6 +195,11 @@ status face_pipeline::create(const face_pipeline_options& options,
         },
         [&] {
           return with_model_name(mesh_path, [&] {
+            if (m->model == face_mesh_model::attention)
+              return m->mesh.load_in_order(
+                  mesh_path, so, {1, k_face_mesh_size, k_face_mesh_size, 3},
+                  {k_face_mesh_count * 3, k_face_refined_lips * 2, k_face_refined_eye * 2,
+                   k_face_refined_eye * 2, k_face_refined_iris * 2, k_face_refined_iris * 2, 1});
             return m->mesh.load(mesh_path, so, {1, k_face_mesh_size, k_face_mesh_size, 3},
                                 {k_face_mesh_count * 3, 1});
           });
@@ -264,7 +303,7 @@ face_result face_pipeline::process(const image_view& image, const landmark_frame
     return face_result::error;
   }
   m.missed_at = -1.0;
-  out.face_count = k_face_mesh_count;
+  out.face_count = m.points;
   out.set(frame_part::face, true);
   return face_result::found;
 }
@@ -274,6 +313,9 @@ void face_pipeline::reset() {
   impl_->has_body_center = false;
   impl_->missed_at = -1.0;
 }
+face_mesh_model face_pipeline::mesh_model() const { return impl_->model; }
+int face_pipeline::mesh_points() const { return impl_->points; }
+const std::string& face_pipeline::note() const { return impl_->note; }
 const normalized_rect& face_pipeline::last_roi() const { return impl_->used_roi; }
 bool face_pipeline::tracking() const { return impl_->has_roi; }
 const normalized_rect& face_pipeline::last_search_region() const { return impl_->search_region; }

@@ -282,8 +282,12 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
     fo.intra_op_threads = threads;
     fo.allow_spinning = po.allow_spinning;
     fo.static_images = options.static_images;
+    if (options.face_model < 0 || options.face_model > 1)
+      return status::error("face model must be 0 (attention) or 1 (mesh)");
+    fo.model = static_cast<face_mesh_model>(options.face_model);
     s = face_pipeline::create(fo, face);
     if (!s.ok()) return s;
+    if (!face->note().empty()) description += "; " + face->note();
   }
   out.reset(new onnx_estimator(std::move(pose), std::move(hands), std::move(face), two_lanes,
                                std::move(description)));

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/skeleton/blendshape.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
 #include "avatarmap/time/seconds_text.hpp"
 
@@ -27,6 +28,7 @@ const glm::vec3 k_lid_colour{0.74f, 0.50f, 0.39f};
 const glm::vec3 k_eye_white{0.90f, 0.90f, 0.88f};
 const glm::vec3 k_iris_colour{0.03f, 0.05f, 0.10f};
 const glm::vec3 k_mouth_colour{0.32f, 0.05f, 0.06f};
+const glm::vec3 k_tongue_colour{0.80f, 0.36f, 0.38f};
 
 // Influence of up to two bones on a vertex.
 struct skin2 {
@@ -474,14 +476,26 @@ void add_limbs(body_parts& b, const builtin_avatar& a, float side) {
 // colours; built from parameters so that each expression is the same vertices moved.
 
 struct face_params {
-  float upper_lid[2] = {55.f, 55.f};    // degrees from the top of the eye to the upper lid's edge
-  float lower_lid[2] = {125.f, 125.f};  // degrees from the top to the lower lid's edge
-  float brow_raise[2] = {0.f, 0.f};     // metres (1.70 m design) up
-  float brow_tilt[2] = {0.f, 0.f};      // metres the inner end goes down (the outer end up)
-  float mouth_width = 1.f;              // times the neutral width
-  float mouth_open = 0.004f;            // half-height (metres)
-  float mouth_forward = 0.f;            // lips pushed forward (metres)
-  float smile = 0.f;                    // corners up (metres; negative: down)
+  // Index 0 is the avatar's (= the person's) left, +X; 1 its right.
+  float upper_lid[2] = {55.f, 55.f};     // degrees from the top of the eye to the upper lid's edge
+  float lower_lid[2] = {125.f, 125.f};   // degrees from the top to the lower lid's edge
+  float brow_raise[2] = {0.f, 0.f};      // metres (1.70 m design) up
+  float brow_tilt[2] = {0.f, 0.f};       // metres the inner end goes down (the outer end up)
+  float mouth_width = 1.f;               // times the neutral width
+  float mouth_open = 0.004f;             // half-height (metres)
+  float mouth_forward = 0.f;             // lips pushed forward (metres)
+  float mouth_shift = 0.f;               // whole mouth toward +X (metres)
+  float smile[2] = {0.f, 0.f};           // each corner up (metres; negative: down)
+  float corner_out[2] = {0.f, 0.f};      // each corner outward (metres)
+  float upper_lip_up[2] = {0.f, 0.f};    // each half of the upper lip up (metres)
+  float lower_lip_down[2] = {0.f, 0.f};  // each half of the lower lip down (metres)
+  float jaw_open = 0.f;                  // lower lip down, the chin half as much (metres)
+  float jaw_side = 0.f;                  // lower lip and chin toward +X (metres)
+  float jaw_forward = 0.f;               // lower lip and chin forward (metres)
+  float cheek_puff = 0.f;                // cheeks outward (metres)
+  float cheek_raise[2] = {0.f, 0.f};     // each cheek up (metres)
+  float sneer[2] = {0.f, 0.f};           // each side of the nose up (metres)
+  float tongue_out = 0.f;                // tongue forward out of the head (metres)
 };
 
 // Closed eyelids meet at this angle from the top of the eye (degrees).
@@ -500,18 +514,45 @@ mesh_builder build_face(const builtin_avatar& a, const face_params& fp) {
     return hc.z + hr.z * std::sqrt(std::max(0.f, 1.f - dx * dx - dy * dy));
   };
   const skin2 on_head = rigid(bone::head);
+  const float mouth_y = head.y + 0.045f * s;
+  const float eye_y = a.joints[idx(bone::left_eye)].y;
+  // The head's skin moves with the jaw (below the mouth), the cheeks (puffed, raised). Only
+  // the front of the head moves.
+  auto head_shape = [&](const glm::vec3& p, const glm::vec3&) {
+    glm::vec3 q = p;
+    const float front = smoothstep(0.1f, 0.5f, (p.z - hc.z) / hr.z);
+    if (front <= 0.f) return q;
+    const float chin = front * smoothstep(mouth_y - 0.01f * s, mouth_y - 0.045f * s, p.y);
+    q += chin * s * glm::vec3(fp.jaw_side, -0.5f * fp.jaw_open, fp.jaw_forward);
+    for (int e = 0; e < 2; ++e) {
+      const float side = e == 0 ? 1.f : -1.f;
+      auto bump = [&](float cy, float r) {
+        const float dx = p.x - (hc.x + side * 0.045f * s), dy = p.y - cy;
+        return front * std::exp(-(dx * dx + dy * dy) / (r * r * s * s));
+      };
+      q += bump(mouth_y + 0.015f * s, 0.022f) * fp.cheek_puff * s * glm::normalize(p - hc);
+      q.y += bump(eye_y - 0.03f * s, 0.018f) * fp.cheek_raise[e] * s;
+    }
+    return q;
+  };
   // Axes (u, v, t) = (X, -Z, Y): the poles on the Y axis, so the rings are horizontal.
-  add_ellipsoid(m, hc, X, -Z, Y, glm::vec3(hr.x, hr.z, hr.y), 24, 32, on_head, k_no_shape,
+  add_ellipsoid(m, hc, X, -Z, Y, glm::vec3(hr.x, hr.z, hr.y), 24, 32, on_head, head_shape,
                 [](const glm::vec3& n) {
                   // n = (x, -z, y) on the unit sphere: hair on the top and the back.
                   const float y = n.z, z = -n.y;
                   return (y > 0.45f || (z < -0.25f && y > -0.35f)) ? k_hair_colour : k_skin_colour;
                 });
-  // Nose.
+  // Nose: each side (n.x > 0 is +X, the avatar's left) lifts with its sneer.
   const float nose_y = head.y + 0.085f * s;
-  add_ellipsoid(m, glm::vec3(hc.x, nose_y, surface_z(hc.x, nose_y) + 0.002f * s), X, -Z, Y,
-                s * glm::vec3(0.011f, 0.012f, 0.016f), 8, 12, on_head, k_no_shape,
-                [](const glm::vec3&) { return k_skin_colour; });
+  add_ellipsoid(
+      m, glm::vec3(hc.x, nose_y, surface_z(hc.x, nose_y) + 0.002f * s), X, -Z, Y,
+      s * glm::vec3(0.011f, 0.012f, 0.016f), 8, 12, on_head,
+      [&](const glm::vec3& p, const glm::vec3& n) {
+        glm::vec3 q = p;
+        q.y += s * (fp.sneer[0] * std::max(0.f, n.x) + fp.sneer[1] * std::max(0.f, -n.x));
+        return q;
+      },
+      [](const glm::vec3&) { return k_skin_colour; });
   // Eyes (on the eye bones), lids and brows (on the head); e = 0 left, 1 right.
   for (int e = 0; e < 2; ++e) {
     const float side = e == 0 ? 1.f : -1.f;
@@ -570,109 +611,179 @@ mesh_builder build_face(const builtin_avatar& a, const face_params& fp) {
         [](const glm::vec3&) { return k_hair_colour; });
   }
   // Mouth: a dark flat ellipsoid in the face, opened, widened, rounded and curved by the
-  // parameters, bent onto the head's surface.
-  const float mouth_y = head.y + 0.045f * s;
+  // parameters, bent onto the head's surface. On the unit sphere n.x is up (the upper lip),
+  // n.z toward +X (the avatar's left corner).
   const glm::vec3 mc(hc.x, mouth_y, surface_z(hc.x, mouth_y) - 0.002f * s + fp.mouth_forward * s);
   const float mrx = 0.021f * fp.mouth_width * s;
   add_ellipsoid(
       m, mc, Y, Z, X, glm::vec3(fp.mouth_open * s, 0.008f * s, mrx), 8, 16, on_head,
       [&](const glm::vec3& p, const glm::vec3& n) {
         glm::vec3 q = p;
-        q.y += fp.smile * s * n.z * n.z;
-        q.z += surface_z(p.x, mouth_y) - surface_z(mc.x, mouth_y);
+        const float left = std::max(0.f, n.z), right = std::max(0.f, -n.z);
+        const float upper = std::max(0.f, n.x), lower = std::max(0.f, -n.x);
+        const float to_left = 0.5f + 0.5f * n.z, to_right = 0.5f - 0.5f * n.z;
+        q.y += s * (fp.smile[0] * left * left + fp.smile[1] * right * right);
+        q.x += s * (fp.corner_out[0] * left * left - fp.corner_out[1] * right * right);
+        q.y += s * upper * (fp.upper_lip_up[0] * to_left + fp.upper_lip_up[1] * to_right);
+        q.y -= s * lower * (fp.lower_lip_down[0] * to_left + fp.lower_lip_down[1] * to_right);
+        q += s * lower * glm::vec3(fp.jaw_side, -fp.jaw_open, fp.jaw_forward);
+        q.x += s * fp.mouth_shift;
+        q.z += surface_z(q.x, mouth_y) - surface_z(mc.x, mouth_y);
         return q;
       },
       [](const glm::vec3&) { return k_mouth_colour; });
+  // Tongue: hidden inside the head behind the mouth until tongue_out pushes it out, forward
+  // and a little down.
+  add_ellipsoid(m,
+                glm::vec3(hc.x, mouth_y - (0.001f + 0.3f * fp.tongue_out) * s,
+                          surface_z(hc.x, mouth_y) - 0.016f * s + fp.tongue_out * s),
+                Y, Z, X, s * glm::vec3(0.004f, 0.012f, 0.011f), 6, 12, on_head, k_no_shape,
+                [](const glm::vec3&) { return k_tongue_colour; });
   return m;
 }
 
-struct expression_shape {
+// ARKit's 52 blendshapes (skeleton/blendshape.hpp) as face parameters, in that order: each a
+// morph target named by ARKit's name. The eyeLook* ones leave the face as it is (the gaze turns
+// the eye bones: lookAt is of type bone).
+std::array<face_params, k_blendshape_count> arkit_shapes() {
+  std::array<face_params, k_blendshape_count> out{};
+  using B = blendshape;
+  auto at = [&](B b) -> face_params& { return out[static_cast<std::size_t>(idx(b))]; };
+  for (int e = 0; e < 2; ++e) {
+    const bool l = e == 0;
+    at(l ? B::brow_down_left : B::brow_down_right).brow_raise[e] = -0.004f;
+    at(l ? B::brow_down_left : B::brow_down_right).brow_tilt[e] = 0.003f;
+    at(l ? B::brow_outer_up_left : B::brow_outer_up_right).brow_raise[e] = 0.004f;
+    at(l ? B::brow_outer_up_left : B::brow_outer_up_right).brow_tilt[e] = 0.003f;
+    at(l ? B::cheek_squint_left : B::cheek_squint_right).cheek_raise[e] = 0.004f;
+    at(l ? B::cheek_squint_left : B::cheek_squint_right).lower_lid[e] = 114.f;
+    face_params& blink = at(l ? B::eye_blink_left : B::eye_blink_right);
+    blink.upper_lid[e] = blink.lower_lid[e] = k_lids_closed;
+    at(l ? B::eye_squint_left : B::eye_squint_right).lower_lid[e] = 110.f;
+    at(l ? B::eye_squint_left : B::eye_squint_right).upper_lid[e] = 62.f;
+    at(l ? B::eye_wide_left : B::eye_wide_right).upper_lid[e] = 36.f;
+    at(l ? B::eye_wide_left : B::eye_wide_right).lower_lid[e] = 132.f;
+    at(l ? B::mouth_dimple_left : B::mouth_dimple_right).corner_out[e] = 0.004f;
+    at(l ? B::mouth_frown_left : B::mouth_frown_right).smile[e] = -0.006f;
+    at(l ? B::mouth_lower_down_left : B::mouth_lower_down_right).lower_lip_down[e] = 0.006f;
+    at(l ? B::mouth_press_left : B::mouth_press_right).upper_lip_up[e] = -0.003f;
+    at(l ? B::mouth_press_left : B::mouth_press_right).lower_lip_down[e] = -0.003f;
+    at(l ? B::mouth_smile_left : B::mouth_smile_right).smile[e] = 0.008f;
+    at(l ? B::mouth_smile_left : B::mouth_smile_right).corner_out[e] = 0.002f;
+    at(l ? B::mouth_stretch_left : B::mouth_stretch_right).corner_out[e] = 0.005f;
+    at(l ? B::mouth_stretch_left : B::mouth_stretch_right).smile[e] = -0.002f;
+    at(l ? B::mouth_upper_up_left : B::mouth_upper_up_right).upper_lip_up[e] = 0.005f;
+    at(l ? B::nose_sneer_left : B::nose_sneer_right).sneer[e] = 0.004f;
+    at(l ? B::nose_sneer_left : B::nose_sneer_right).brow_raise[e] = -0.001f;
+  }
+  face_params& inner_up = at(B::brow_inner_up);
+  inner_up.brow_tilt[0] = inner_up.brow_tilt[1] = -0.004f;
+  inner_up.brow_raise[0] = inner_up.brow_raise[1] = 0.002f;
+  at(B::cheek_puff).cheek_puff = 0.008f;
+  at(B::jaw_forward).jaw_forward = 0.006f;
+  at(B::jaw_left).jaw_side = 0.006f;  // the person's left = the avatar's = +X
+  at(B::jaw_right).jaw_side = -0.006f;
+  at(B::jaw_open).jaw_open = 0.022f;
+  // mouthClose: the lips closing over an open jaw (ARKit's meaning: with jawOpen).
+  at(B::mouth_close).lower_lip_down[0] = at(B::mouth_close).lower_lip_down[1] = -0.012f;
+  at(B::mouth_close).upper_lip_up[0] = at(B::mouth_close).upper_lip_up[1] = -0.002f;
+  face_params& funnel = at(B::mouth_funnel);
+  funnel.mouth_forward = 0.006f;
+  funnel.mouth_width = 0.75f;
+  funnel.mouth_open = 0.009f;
+  at(B::mouth_left).mouth_shift = 0.008f;
+  at(B::mouth_right).mouth_shift = -0.008f;
+  face_params& pucker = at(B::mouth_pucker);
+  pucker.mouth_forward = 0.008f;
+  pucker.mouth_width = 0.55f;
+  pucker.mouth_open = 0.003f;
+  for (int e = 0; e < 2; ++e) {
+    at(B::mouth_roll_lower).lower_lip_down[e] = -0.003f;
+    at(B::mouth_roll_upper).upper_lip_up[e] = -0.003f;
+    at(B::mouth_shrug_lower).lower_lip_down[e] = -0.004f;
+    at(B::mouth_shrug_upper).upper_lip_up[e] = 0.003f;
+  }
+  at(B::mouth_roll_lower).mouth_forward = at(B::mouth_roll_upper).mouth_forward = -0.002f;
+  at(B::mouth_shrug_lower).mouth_forward = at(B::mouth_shrug_upper).mouth_forward = 0.002f;
+  at(B::tongue_out).tongue_out = 0.02f;
+  at(B::tongue_out).lower_lip_down[0] = at(B::tongue_out).lower_lip_down[1] = 0.008f;
+  return out;
+}
+
+// The VRM expressions as combinations of the ARKit targets (target t = blendshape t).
+struct expression_recipe {
   const char* name;
   bool preset;
-  face_params params;
+  std::vector<std::pair<blendshape, float>> parts;
 };
 
-// The face's morph targets: one per entry (blink is blinkLeft + blinkRight, see below).
-std::vector<expression_shape> expression_shapes() {
-  std::vector<expression_shape> out;
-  auto add = [&](const char* name, bool preset, auto edit) {
-    face_params p;
-    edit(p);
-    out.push_back({name, preset, p});
+std::vector<expression_recipe> expression_recipes() {
+  using B = blendshape;
+  return {
+      {"blink", true, {{B::eye_blink_left, 1.f}, {B::eye_blink_right, 1.f}}},
+      {"blinkLeft", true, {{B::eye_blink_left, 1.f}}},
+      {"blinkRight", true, {{B::eye_blink_right, 1.f}}},
+      {"aa", true, {{B::jaw_open, 0.75f}}},
+      {"ih",
+       true,
+       {{B::jaw_open, 0.15f}, {B::mouth_stretch_left, 0.6f}, {B::mouth_stretch_right, 0.6f}}},
+      {"ou", true, {{B::jaw_open, 0.15f}, {B::mouth_pucker, 0.8f}, {B::mouth_funnel, 0.3f}}},
+      {"ee",
+       true,
+       {{B::jaw_open, 0.35f},
+        {B::mouth_stretch_left, 0.4f},
+        {B::mouth_stretch_right, 0.4f},
+        {B::mouth_upper_up_left, 0.3f},
+        {B::mouth_upper_up_right, 0.3f}}},
+      {"oh", true, {{B::jaw_open, 0.45f}, {B::mouth_funnel, 0.8f}}},
+      {"happy",
+       true,
+       {{B::mouth_smile_left, 1.f},
+        {B::mouth_smile_right, 1.f},
+        {B::cheek_squint_left, 0.6f},
+        {B::cheek_squint_right, 0.6f},
+        {B::eye_squint_left, 0.4f},
+        {B::eye_squint_right, 0.4f},
+        {B::brow_inner_up, 0.2f}}},
+      {"angry",
+       true,
+       {{B::brow_down_left, 1.f},
+        {B::brow_down_right, 1.f},
+        {B::mouth_frown_left, 0.6f},
+        {B::mouth_frown_right, 0.6f},
+        {B::nose_sneer_left, 0.4f},
+        {B::nose_sneer_right, 0.4f},
+        {B::eye_squint_left, 0.3f},
+        {B::eye_squint_right, 0.3f}}},
+      {"sad",
+       true,
+       {{B::brow_inner_up, 1.f},
+        {B::mouth_frown_left, 0.8f},
+        {B::mouth_frown_right, 0.8f},
+        {B::mouth_shrug_lower, 0.4f},
+        {B::eye_blink_left, 0.15f},
+        {B::eye_blink_right, 0.15f}}},
+      {"relaxed",
+       true,
+       {{B::mouth_smile_left, 0.5f},
+        {B::mouth_smile_right, 0.5f},
+        {B::eye_blink_left, 0.35f},
+        {B::eye_blink_right, 0.35f}}},
+      {"surprised",
+       true,
+       {{B::eye_wide_left, 1.f},
+        {B::eye_wide_right, 1.f},
+        {B::brow_inner_up, 0.8f},
+        {B::brow_outer_up_left, 0.8f},
+        {B::brow_outer_up_right, 0.8f},
+        {B::jaw_open, 0.5f},
+        {B::mouth_funnel, 0.3f}}},
+      // The proxy pose's custom brow expressions (expression.hpp).
+      {"browUpLeft", false, {{B::brow_outer_up_left, 1.f}, {B::brow_inner_up, 0.3f}}},
+      {"browUpRight", false, {{B::brow_outer_up_right, 1.f}, {B::brow_inner_up, 0.3f}}},
+      {"browDownLeft", false, {{B::brow_down_left, 1.f}}},
+      {"browDownRight", false, {{B::brow_down_right, 1.f}}},
   };
-  add("blinkLeft", true, [](face_params& p) { p.upper_lid[0] = p.lower_lid[0] = k_lids_closed; });
-  add("blinkRight", true, [](face_params& p) { p.upper_lid[1] = p.lower_lid[1] = k_lids_closed; });
-  add("aa", true, [](face_params& p) {
-    p.mouth_open = 0.017f;
-    p.mouth_width = 0.9f;
-  });
-  add("ih", true, [](face_params& p) {
-    p.mouth_open = 0.006f;
-    p.mouth_width = 1.25f;
-  });
-  add("ou", true, [](face_params& p) {
-    p.mouth_open = 0.009f;
-    p.mouth_width = 0.55f;
-    p.mouth_forward = 0.006f;
-  });
-  add("ee", true, [](face_params& p) {
-    p.mouth_open = 0.01f;
-    p.mouth_width = 1.15f;
-  });
-  add("oh", true, [](face_params& p) {
-    p.mouth_open = 0.014f;
-    p.mouth_width = 0.75f;
-    p.mouth_forward = 0.003f;
-  });
-  add("happy", true, [](face_params& p) {
-    p.smile = 0.007f;
-    p.mouth_width = 1.1f;
-    for (int e = 0; e < 2; ++e) {
-      p.upper_lid[e] = 70.f;
-      p.lower_lid[e] = 108.f;
-      p.brow_raise[e] = 0.002f;
-    }
-  });
-  add("angry", true, [](face_params& p) {
-    p.smile = -0.004f;
-    for (int e = 0; e < 2; ++e) {
-      p.upper_lid[e] = 68.f;
-      p.brow_raise[e] = -0.003f;
-      p.brow_tilt[e] = 0.004f;
-    }
-  });
-  add("sad", true, [](face_params& p) {
-    p.smile = -0.006f;
-    for (int e = 0; e < 2; ++e) {
-      p.upper_lid[e] = 68.f;
-      p.brow_tilt[e] = -0.004f;
-    }
-  });
-  add("relaxed", true, [](face_params& p) {
-    p.smile = 0.003f;
-    for (int e = 0; e < 2; ++e) p.upper_lid[e] = 82.f;
-  });
-  add("surprised", true, [](face_params& p) {
-    p.mouth_open = 0.012f;
-    p.mouth_width = 0.8f;
-    for (int e = 0; e < 2; ++e) {
-      p.upper_lid[e] = 42.f;
-      p.lower_lid[e] = 135.f;
-      p.brow_raise[e] = 0.007f;
-    }
-  });
-  // The proxy pose's custom brow expressions (expression.hpp); index 0 is the avatar's left.
-  add("browUpLeft", false, [](face_params& p) { p.brow_raise[0] = 0.006f; });
-  add("browUpRight", false, [](face_params& p) { p.brow_raise[1] = 0.006f; });
-  add("browDownLeft", false, [](face_params& p) {
-    p.brow_raise[0] = -0.003f;
-    p.brow_tilt[0] = 0.003f;
-  });
-  add("browDownRight", false, [](face_params& p) {
-    p.brow_raise[1] = -0.003f;
-    p.brow_tilt[1] = 0.003f;
-  });
-  return out;
 }
 
 status make_impl(const builtin_avatar_options& options, builtin_avatar& out) {
@@ -704,23 +815,24 @@ status make_impl(const builtin_avatar_options& options, builtin_avatar& out) {
   face_mesh.name = "Face";
   const mesh_builder neutral = build_face(out, face_params{});
   avatar_primitive face = neutral.finish(k_face, true);
-  const std::vector<expression_shape> shapes = expression_shapes();
-  for (const expression_shape& e : shapes) {
-    mesh_builder moved = build_face(out, e.params);
+  const std::array<face_params, k_blendshape_count> shapes = arkit_shapes();
+  for (int t = 0; t < k_blendshape_count; ++t) {
+    mesh_builder moved = build_face(out, shapes[static_cast<std::size_t>(t)]);
     std::vector<glm::vec3> delta(face.positions.size());
     for (std::size_t v = 0; v < delta.size(); ++v)
       delta[v] = moved.positions()[v] - face.positions[v];
     face.targets.push_back(std::move(delta));
-    face_mesh.target_names.push_back(e.name);
+    face_mesh.target_names.emplace_back(blendshape_name(static_cast<blendshape>(t)));
   }
   face_mesh.primitives = {std::move(face)};
   out.meshes = {std::move(body_mesh), std::move(face_mesh)};
 
-  // Expressions: blink closes both eyes (the two one-eye targets; the proxy's blink + blinkLeft
-  // is the left eye's closure, which the sum of the binds reproduces), the rest one target each.
-  out.expressions.push_back({"blink", true, {{1, 0, 1.f}, {1, 1, 1.f}}});
-  for (std::size_t t = 0; t < shapes.size(); ++t)
-    out.expressions.push_back({shapes[t].name, shapes[t].preset, {{1, static_cast<int>(t), 1.f}}});
+  // The VRM expressions bind combinations of the ARKit targets (docs/avatar.md).
+  for (const expression_recipe& r : expression_recipes()) {
+    avatar_expression e{r.name, r.preset, {}};
+    for (const auto& [shape, weight] : r.parts) e.binds.push_back({1, idx(shape), weight});
+    out.expressions.push_back(std::move(e));
+  }
   return {};
 }
 

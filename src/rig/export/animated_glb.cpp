@@ -18,6 +18,7 @@
 
 #include "avatarmap/core/limits.hpp"
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/skeleton/blendshape.hpp"
 #include "avatarmap/skeleton/expression.hpp"
 #include "common/atomic_file.hpp"
 #include "rig/export/glb_builder.hpp"
@@ -146,9 +147,12 @@ status gather_images(const gltf_detail::gltf_document& doc, json& j, glb_builder
 
 // ---- The face: the avatar's expression definitions as morph-target binds ----
 
-// One bind of a proxy expression to a morph target of a node's mesh.
+// One bind of a proxy channel to a morph target of a node's mesh: an expression
+// (skeleton/expression.hpp), an ARKit blendshape (skeleton/blendshape.hpp), or both when the
+// name is both (browDownLeft, browDownRight: the blendshape when the ARKit layer drives).
 struct morph_bind {
-  int expression = 0;  // skeleton/expression.hpp index
+  int expression = -1;
+  int shape = -1;
   int node = 0;
   int target = 0;
   float weight = 1.f;
@@ -158,6 +162,8 @@ struct face_binds {
   std::vector<morph_bind> binds;
   std::array<bool, k_expression_count> binary{};   // isBinary of the definition used
   std::array<bool, k_expression_count> defined{};  // the first definition of a name wins
+  std::array<bool, k_blendshape_count> shape_binary{};
+  std::array<bool, k_blendshape_count> shape_defined{};
 };
 
 bool equal_nocase(std::string_view a, std::string_view b) {
@@ -172,6 +178,17 @@ bool equal_nocase(std::string_view a, std::string_view b) {
 int expression_nocase(std::string_view name) {
   for (int e = 0; e < k_expression_count; ++e)
     if (equal_nocase(name, expression_name(static_cast<expression>(e)))) return e;
+  return -1;
+}
+
+// ARKit's name in any case, after the prefixes exporters put before it: anything up to the
+// last '.' (Maya and FBX: "blendShape1.jawOpen"), then "ARKit_" ("ARKit_jawOpen").
+int blendshape_nocase(std::string_view name) {
+  if (const std::size_t dot = name.rfind('.'); dot != std::string_view::npos)
+    name.remove_prefix(dot + 1);
+  if (name.size() > 6 && equal_nocase(name.substr(0, 6), "arkit_")) name.remove_prefix(6);
+  for (int b = 0; b < k_blendshape_count; ++b)
+    if (equal_nocase(name, blendshape_name(static_cast<blendshape>(b)))) return b;
   return -1;
 }
 
@@ -199,9 +216,40 @@ int node_target_count(const json& j, int node) {
   return targets && targets->is_array() ? static_cast<int>(targets->size()) : 0;
 }
 
+// The channel a definition's name drives: {expression, shape}, -1 where none. An expression's
+// name is matched exactly (VRM 1.0) or in any case (VRM 0.x names, target names); an ARKit
+// name in any case, prefixes allowed.
+std::pair<int, int> channel_of(std::string_view name, bool exact_expression) {
+  int e = -1;
+  if (exact_expression) {
+    if (const std::optional<expression> x = expression_from_name(name)) e = idx(*x);
+  } else {
+    e = expression_nocase(name);
+  }
+  return {e, blendshape_nocase(name)};
+}
+
+// Claims the channel for this definition (the first definition of an expression or a shape
+// wins); false when both its channels are taken already.
+bool claim(face_binds& out, std::pair<int, int>& ch, bool binary) {
+  auto& [e, b] = ch;
+  if (e >= 0 && out.defined[static_cast<std::size_t>(e)]) e = -1;
+  if (b >= 0 && out.shape_defined[static_cast<std::size_t>(b)]) b = -1;
+  if (e < 0 && b < 0) return false;
+  if (e >= 0) {
+    out.defined[static_cast<std::size_t>(e)] = true;
+    out.binary[static_cast<std::size_t>(e)] = binary;
+  }
+  if (b >= 0) {
+    out.shape_defined[static_cast<std::size_t>(b)] = true;
+    out.shape_binary[static_cast<std::size_t>(b)] = binary;
+  }
+  return true;
+}
+
 // Adds a bind when its node's mesh has the target and the weight is a number; else ignores it.
-void add_bind(const json& j, face_binds& out, int e, const json* node, const json* index,
-              const json* weight, float weight_scale) {
+void add_bind(const json& j, face_binds& out, std::pair<int, int> ch, const json* node,
+              const json* index, const json* weight, float weight_scale) {
   if (!node || !index || !node->is_number_integer() || !index->is_number_integer()) return;
   const std::int64_t n = node->get<std::int64_t>(), t = index->get<std::int64_t>();
   if (n < 0 || n > 0x7fffffff || t < 0 || t >= node_target_count(j, static_cast<int>(n))) return;
@@ -211,7 +259,7 @@ void add_bind(const json& j, face_binds& out, int e, const json* node, const jso
     w = weight->get<float>() * weight_scale;
     if (!std::isfinite(w)) return;
   }
-  out.binds.push_back({e, static_cast<int>(n), static_cast<int>(t), w});
+  out.binds.push_back({ch.first, ch.second, static_cast<int>(n), static_cast<int>(t), w});
 }
 
 bool is_binary(const json& def) {
@@ -225,14 +273,12 @@ void read_vrm1_binds(const json& j, const json& expressions, face_binds& out) {
     const json* g = member(expressions, group);
     if (!g || !g->is_object()) continue;
     for (auto it = g->begin(); it != g->end(); ++it) {
-      const std::optional<expression> e = expression_from_name(it.key());
-      if (!e || out.defined[idx(*e)]) continue;
-      out.defined[idx(*e)] = true;
-      out.binary[idx(*e)] = is_binary(it.value());
+      std::pair<int, int> ch = channel_of(it.key(), true);
+      if (!claim(out, ch, is_binary(it.value()))) continue;
       const json* binds = member(it.value(), "morphTargetBinds");
       if (!binds || !binds->is_array()) continue;
       for (const json& b : *binds)
-        add_bind(j, out, idx(*e), member(b, "node"), member(b, "index"), member(b, "weight"), 1.f);
+        add_bind(j, out, ch, member(b, "node"), member(b, "index"), member(b, "weight"), 1.f);
     }
   }
 }
@@ -240,7 +286,7 @@ void read_vrm1_binds(const json& j, const json& expressions, face_binds& out) {
 // VRM 0.x: VRM.blendShapeMaster.blendShapeGroups[{presetName, name, binds[{mesh, index,
 // weight 0-100}], isBinary}]; a bind reaches every node that shows its mesh.
 void read_vrm0_binds(const json& j, const json& groups, face_binds& out) {
-  static constexpr std::array<std::pair<std::string_view, expression>, 12> k_presets = {{
+  static constexpr std::array<std::pair<std::string_view, expression>, 16> k_presets = {{
       {"a", expression::aa},
       {"i", expression::ih},
       {"u", expression::ou},
@@ -253,21 +299,23 @@ void read_vrm0_binds(const json& j, const json& groups, face_binds& out) {
       {"lookdown", expression::look_down},
       {"lookleft", expression::look_left},
       {"lookright", expression::look_right},
+      {"joy", expression::happy},
+      {"angry", expression::angry},
+      {"sorrow", expression::sad},
+      {"fun", expression::relaxed},
   }};
   const json* nodes = member(j, "nodes");
   for (const json& g : groups) {
-    int e = -1;
+    std::pair<int, int> ch{-1, -1};
     const json* preset = member(g, "presetName");
     if (preset && preset->is_string()) {
       for (const auto& [name, ex] : k_presets)
-        if (equal_nocase(preset->get_ref<const std::string&>(), name)) e = idx(ex);
+        if (equal_nocase(preset->get_ref<const std::string&>(), name)) ch.first = idx(ex);
     }
     const json* name = member(g, "name");
-    if (e < 0 && name && name->is_string())
-      e = expression_nocase(name->get_ref<const std::string&>());
-    if (e < 0 || out.defined[static_cast<std::size_t>(e)]) continue;
-    out.defined[static_cast<std::size_t>(e)] = true;
-    out.binary[static_cast<std::size_t>(e)] = is_binary(g);
+    if (ch.first < 0 && name && name->is_string())
+      ch = channel_of(name->get_ref<const std::string&>(), false);
+    if (!claim(out, ch, is_binary(g))) continue;
     const json* binds = member(g, "binds");
     if (!binds || !binds->is_array() || !nodes || !nodes->is_array()) continue;
     for (const json& b : *binds) {
@@ -278,37 +326,57 @@ void read_vrm0_binds(const json& j, const json& groups, face_binds& out) {
         if (!m || !m->is_number_integer() || m->get<std::int64_t>() != mesh->get<std::int64_t>())
           continue;
         const json node = static_cast<std::int64_t>(n);
-        add_bind(j, out, e, &node, member(b, "index"), member(b, "weight"), 0.01f);
+        add_bind(j, out, ch, &node, member(b, "index"), member(b, "weight"), 0.01f);
       }
     }
   }
 }
 
-// Plain glTF: morph targets named (mesh.extras.targetNames) after an expression, any case.
-void read_named_targets(const json& j, face_binds& out) {
+// A mesh's morph target names: mesh.extras.targetNames (three.js, Blender), else its first
+// primitive's extras.targetNames (UniVRM 0.x); null when neither is an array.
+const json* target_names(const json& mesh) {
+  const json* extras = member(mesh, "extras");
+  const json* names = extras ? member(*extras, "targetNames") : nullptr;
+  if (names && names->is_array()) return names;
+  const json* prims = member(mesh, "primitives");
+  if (!prims || !prims->is_array() || prims->empty()) return nullptr;
+  extras = member((*prims)[0], "extras");
+  names = extras ? member(*extras, "targetNames") : nullptr;
+  return names && names->is_array() ? names : nullptr;
+}
+
+// Plain glTF: morph targets named after an expression (when `expressions`) or an ARKit shape,
+// any case, weight 1; a channel some definition claimed already is left to it.
+void read_named_targets(const json& j, face_binds& out, bool expressions) {
   const json* nodes = member(j, "nodes");
   const json* meshes = member(j, "meshes");
   if (!nodes || !meshes || !nodes->is_array() || !meshes->is_array()) return;
+  const face_binds before = out;  // what the avatar's definitions claimed
   for (std::size_t n = 0; n < nodes->size(); ++n) {
     const json* m = member((*nodes)[n], "mesh");
     if (!m || !m->is_number_integer() || m->get<std::int64_t>() < 0 ||
         static_cast<std::size_t>(m->get<std::int64_t>()) >= meshes->size())
       continue;
-    const json* extras =
-        member((*meshes)[static_cast<std::size_t>(m->get<std::int64_t>())], "extras");
-    const json* names = extras ? member(*extras, "targetNames") : nullptr;
-    if (!names || !names->is_array()) continue;
+    const json* names = target_names((*meshes)[static_cast<std::size_t>(m->get<std::int64_t>())]);
+    if (!names) continue;
     for (std::size_t t = 0; t < names->size(); ++t) {
       if (!(*names)[t].is_string()) continue;
-      const int e = expression_nocase((*names)[t].get_ref<const std::string&>());
-      if (e < 0) continue;
+      std::pair<int, int> ch = channel_of((*names)[t].get_ref<const std::string&>(), false);
+      if (!expressions) ch.first = -1;
+      if (ch.first >= 0 && before.defined[static_cast<std::size_t>(ch.first)]) ch.first = -1;
+      if (ch.second >= 0 && before.shape_defined[static_cast<std::size_t>(ch.second)])
+        ch.second = -1;
+      if (ch.first < 0 && ch.second < 0) continue;
+      if (ch.first >= 0) out.defined[static_cast<std::size_t>(ch.first)] = true;
+      if (ch.second >= 0) out.shape_defined[static_cast<std::size_t>(ch.second)] = true;
       const json node = static_cast<std::int64_t>(n), index = static_cast<std::int64_t>(t);
-      add_bind(j, out, e, &node, &index, nullptr, 1.f);
+      add_bind(j, out, ch, &node, &index, nullptr, 1.f);
     }
   }
 }
 
-// The avatar's definitions, the first kind the file has (VRM 1.0, VRM 0.x, target names).
+// The avatar's definitions, the first kind the file has (VRM 1.0, VRM 0.x, target names),
+// then morph targets named after ARKit shapes that no definition claimed (any file).
 face_binds read_face_binds(const json& j) {
   face_binds out;
   const json* ext = member(j, "extensions");
@@ -321,8 +389,11 @@ face_binds read_face_binds(const json& j) {
     read_vrm1_binds(j, *expressions, out);
   else if (groups && groups->is_array())
     read_vrm0_binds(j, *groups, out);
-  else
-    read_named_targets(j, out);
+  else {
+    read_named_targets(j, out, true);
+    return out;
+  }
+  read_named_targets(j, out, false);
   return out;
 }
 
@@ -373,6 +444,12 @@ status add_animation(const rig& r, const std::vector<rig_pose>& frames,
           return status::error(out_path + ": frame " + std::to_string(f) + " expression '" +
                                std::string(expression_name(static_cast<expression>(e))) +
                                "' is not finite; nothing written");
+    for (std::size_t f = 0; f < n; ++f)
+      for (int b = 0; b < k_blendshape_count; ++b)
+        if (!std::isfinite((*faces)[f].blendshapes[static_cast<std::size_t>(b)]))
+          return status::error(out_path + ": frame " + std::to_string(f) + " blendshape '" +
+                               std::string(blendshape_name(static_cast<blendshape>(b))) +
+                               "' is not finite; nothing written");
   }
   std::vector<float> times(n);
   for (std::size_t i = 0; i < n; ++i) times[i] = static_cast<float>(double(i) / options.fps);
@@ -418,6 +495,34 @@ status add_animation(const rig& r, const std::vector<rig_pose>& frames,
   }
   if (faces != nullptr) {
     face_binds face = read_face_binds(j);
+    // The ARKit layer drives when the avatar has ARKit binds and the clip carries blendshapes
+    // (a clip from before them has all zeros: the expressions then drive every bind). Where it
+    // drives, a morph target that an ARKit bind reaches is driven by the ARKit shapes alone:
+    // expression binds onto it are dropped, so nothing is driven twice.
+    bool carries_shapes = false;
+    for (const proxy_pose& p : *faces)
+      for (float v : p.blendshapes) carries_shapes = carries_shapes || v != 0.f;
+    bool arkit = false;
+    for (const morph_bind& m : face.binds) arkit = arkit || m.shape >= 0;
+    arkit = arkit && carries_shapes;
+    std::vector<std::pair<int, int>> by_shape;  // (node, target) an ARKit bind reaches
+    if (arkit)
+      for (const morph_bind& m : face.binds)
+        if (m.shape >= 0) by_shape.emplace_back(m.node, m.target);
+    std::sort(by_shape.begin(), by_shape.end());
+    std::vector<morph_bind> kept;
+    for (morph_bind m : face.binds) {
+      if (arkit && m.shape >= 0) {
+        m.expression = -1;
+      } else {
+        m.shape = -1;
+        if (m.expression < 0) continue;
+        if (std::binary_search(by_shape.begin(), by_shape.end(), std::make_pair(m.node, m.target)))
+          continue;
+      }
+      kept.push_back(m);
+    }
+    face.binds = std::move(kept);
     std::stable_sort(face.binds.begin(), face.binds.end(),
                      [](const morph_bind& a, const morph_bind& b) { return a.node < b.node; });
     for (std::size_t i = 0; i < face.binds.size();) {
@@ -432,9 +537,11 @@ status add_animation(const rig& r, const std::vector<rig_pose>& frames,
         std::copy(base.begin(), base.end(), w);
         for (std::size_t b = i; b < end; ++b) {
           const morph_bind& m = face.binds[b];
+          const bool shape = m.shape >= 0;
+          const auto c = static_cast<std::size_t>(shape ? m.shape : m.expression);
           float v =
-              std::clamp((*faces)[f].expressions[static_cast<std::size_t>(m.expression)], 0.f, 1.f);
-          if (face.binary[static_cast<std::size_t>(m.expression)]) v = v > 0.5f ? 1.f : 0.f;
+              std::clamp(shape ? (*faces)[f].blendshapes[c] : (*faces)[f].expressions[c], 0.f, 1.f);
+          if (shape ? face.shape_binary[c] : face.binary[c]) v = v > 0.5f ? 1.f : 0.f;
           w[m.target] += v * m.weight;
         }
         for (int t = 0; t < count; ++t) w[t] = std::clamp(w[t], 0.f, 1.f);

@@ -62,6 +62,10 @@ inline void clean_frame(const proxy_pose& in, const proxy_pose* prev, proxy_pose
     float w = in.expressions[e];
     out.expressions[e] = std::isfinite(w) ? std::clamp(w, 0.f, 1.f) : fallback.expressions[e];
   }
+  for (int s = 0; s < k_blendshape_count; ++s) {
+    float w = in.blendshapes[s];
+    out.blendshapes[s] = std::isfinite(w) ? std::clamp(w, 0.f, 1.f) : fallback.blendshapes[s];
+  }
 }
 
 /// The frames to write, into `out`: cleaned copies at the frames' own times (fps == 0) or

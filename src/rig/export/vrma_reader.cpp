@@ -274,6 +274,8 @@ status read_impl(const std::string& path, vrma_clip& out, const vrma_read_option
 
   std::array<int, k_expression_count> expr_node;
   expr_node.fill(-1);
+  std::array<int, k_blendshape_count> shape_node;
+  shape_node.fill(-1);
   if (const json* exprs = member(ext, "expressions"); exprs && exprs->is_object()) {
     for (const char* group : {"preset", "custom"}) {
       const json* g = member(*exprs, group);
@@ -285,12 +287,24 @@ status read_impl(const std::string& path, vrma_clip& out, const vrma_read_option
           return fail(std::string("expressions.") + group + "." + name +
                       " does not name a valid node");
         clip.expression_names.push_back(name);
+        // browDownLeft/Right are both a proxy expression and an ARKit shape: both are set.
+        if (auto sh = blendshape_from_name(name)) {
+          shape_node[idx(*sh)] = node;
+          clip.has_blendshape[idx(*sh)] = true;
+        }
         auto e = expression_from_name(name);
         if (!e || !is_vrma_expression(*e)) continue;
         expr_node[idx(*e)] = node;
         clip.has_expression[idx(*e)] = true;
       }
     }
+  }
+  int look_node = -1;
+  if (const json* look = member(ext, "lookAt"); look && look->is_object()) {
+    look_node = node_of(*look, node_count);
+    if (look_node < 0)
+      return fail("lookAt does not name a valid node (a whole number below the file's " +
+                  std::to_string(node_count) + " nodes)");
   }
 
   // ---- the node tree ----
@@ -503,6 +517,45 @@ status read_impl(const std::string& path, vrma_clip& out, const vrma_read_option
       int n = expr_node[e];
       if (n < 0) continue;
       pose.expressions[e] = static_cast<float>(std::clamp(local[n].t.x, 0.0, 1.0));
+    }
+    for (int sh = 0; sh < k_blendshape_count; ++sh) {
+      int n = shape_node[sh];
+      if (n < 0) continue;
+      pose.blendshapes[sh] = static_cast<float>(std::clamp(local[n].t.x, 0.0, 1.0));
+    }
+    if (look_node >= 0) {
+      glm::dquat gaze(1, 0, 0, 0);
+      bool have = false;
+      if (node_anim[look_node].rotation >= 0) {
+        gaze = local[look_node].r;  // three-vrm's reading (and write_vrma's)
+        have = true;
+      } else if (const int head = bone_node[idx(bone::head)]; head >= 0) {
+        // The spec's: the target's model-space position seen from the head, in the head's
+        // normalised frame (forward +Z); the rotation from +Z to it, without roll.
+        const glm::dvec3 d = glm::inverse(norm_world[idx(bone::head)]) *
+                             (glm::dvec3(world[look_node][3]) - glm::dvec3(world[head][3]));
+        const double len = glm::length(d);
+        have = true;  // a target on the head itself (or unreadable): looking ahead
+        if (len > 1e-9 && std::isfinite(len)) {
+          const glm::dvec3 dir = d / len;
+          const glm::dvec3 fwd(0.0, 0.0, 1.0);
+          const glm::dvec3 axis = glm::cross(fwd, dir);
+          const double c = glm::dot(fwd, dir);
+          // Half-angle form: q = (1 + c, axis) normalised; straight behind: a turn about Y.
+          gaze = c > -1.0 + 1e-12 ? glm::normalize(glm::dquat(1.0 + c, axis.x, axis.y, axis.z))
+                                  : glm::dquat(0, 0, 1, 0);
+        }
+      }
+      if (have) {
+        if (gaze.w < 0.0) gaze = -gaze;
+        const glm::quat q(static_cast<float>(gaze.w), static_cast<float>(gaze.x),
+                          static_cast<float>(gaze.y), static_cast<float>(gaze.z));
+        for (bone eye : {bone::left_eye, bone::right_eye}) {
+          pose[eye] = q;
+          pose.confidence[idx(eye)] = 1.f;
+        }
+        clip.has_look_at = true;
+      }
     }
   }
   out = std::move(clip);

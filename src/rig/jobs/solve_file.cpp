@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 
 #include "avatarmap/io/landmark_file.hpp"
@@ -47,6 +48,9 @@ struct solve_state {
   landmark_frame frame;              // the direct source's storage (threads == 1)
   std::vector<landmark_frame> warm;  // the warm-up's frames, replayed once it ends
   bool warming = true;
+  // A source's first frames held back (the live and no filters) until the face is calibrated
+  // over them, then solved in order; a file's face is calibrated over all of it first.
+  bool holding_face = false;
 };
 
 // Reads straight from the reader on this thread (threads == 1); the same interface as
@@ -77,6 +81,30 @@ struct callback_source {
   status_code error_code() const { return failed.code(); }
   void release() {}
 };
+
+// The stream's solver, to calibrate its face before any frame is solved.
+frame_solver& stream_solver(pose_stream& stream) { return stream.solver(); }
+
+// The face calibrated over the whole file before it is solved (docs/expressions.md,
+// "Calibration over a take"): a first pass reads every frame's face measurements (a few
+// hundred bytes a frame). Lines the reader cannot parse are passed over here (the solving pass
+// reports them); a file that cannot be opened is left to the solving pass too.
+void calibrate_face_over_file(const std::string& path, frame_solver& solver) {
+  landmark_reader reader;
+  if (!reader.open(path).ok()) return;
+  auto frame = std::make_unique<landmark_frame>();
+  solver.begin_face_take();
+  for (;;) {
+    const read_result r = reader.next(*frame);
+    if (r == read_result::end) break;
+    if (r == read_result::error) {
+      if (reader.error_code() == status_code::io) break;
+      continue;
+    }
+    solver.add_face_take(*frame);
+  }
+  solver.end_face_take();
+}
 
 }  // namespace
 
@@ -160,12 +188,32 @@ status solve_file_job::run(solve_file_summary& s) const {
   // exactly: no warm-up.
   state->warming = filter_mode == pose_filter_mode::offline;
   pose_stream& stream = state->stream;
+  // Whatever the filter, a regular file's face is calibrated over all its frames first; a
+  // source's, a pipe's or standard input's (read once) over the first k_warm_up_frames (the
+  // warm-up's with the offline filter, else held back for it): these give a file's poses when
+  // it is no longer.
+  std::error_code fs_error;
+  const bool read_twice = !source && std::filesystem::is_regular_file(input, fs_error);
+  const bool face = solve_options.parts.face;
+  if (face && read_twice) calibrate_face_over_file(input, stream_solver(stream));
+  state->holding_face = face && !read_twice && !state->warming;
+  auto end_holding_face = [&]() -> status {
+    solve_state& ws = *state;
+    ws.holding_face = false;
+    stream_solver(ws.stream).calibrate_face(ws.warm.data(), ws.warm.size());
+    for (const landmark_frame& f : ws.warm)
+      if (status st = ws.stream.push(f, emit); !st.ok()) return st;
+    ws.warm.clear();
+    return {};
+  };
   // The warm-up's end: a second pass over its frames learns the camera's pitch and roll, the
   // floor and the world points' lean again with the field of view the first pass found; then
   // the pose state is forgotten, the camera kept and held, and the frames solved for output.
   auto end_warm_up = [&]() -> status {
     solve_state& ws = *state;
     ws.warming = false;
+    if (face && !read_twice)
+      stream_solver(ws.stream).calibrate_face(ws.warm.data(), ws.warm.size());
     ws.stream.restart_take(false);
     for (const landmark_frame& f : ws.warm) ws.stream.learn_camera(f);
     ws.stream.restart_take();
@@ -237,6 +285,9 @@ status solve_file_job::run(solve_file_summary& s) const {
         stream.learn_camera(frame);
         state->warm.push_back(frame);  // reserved: no reallocation
         if (state->warm.size() == k_warm_up_frames) pushed = end_warm_up();
+      } else if (state->holding_face) {
+        state->warm.push_back(frame);  // reserved: no reallocation
+        if (state->warm.size() == k_warm_up_frames) pushed = end_holding_face();
       } else {
         pushed = stream.push(frame, emit);
       }
@@ -266,6 +317,10 @@ status solve_file_job::run(solve_file_summary& s) const {
   if (state->warming) {
     const status warmed = end_warm_up();
     if (st.ok()) st = warmed;
+  }
+  if (state->holding_face) {
+    const status held = end_holding_face();
+    if (st.ok()) st = held;
   }
   if (st.ok()) st = stream.finish(emit);  // the poses the offline filter still holds
   s.poses_written = stream.stats().emitted;

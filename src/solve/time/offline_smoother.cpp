@@ -893,13 +893,15 @@ void offline_smoother::emit(proxy_pose& out) noexcept {
     last_good_segment_[b] = c.segment;
   }
 
-  // Hips position and expressions: plain Gaussian means over the segment.
+  // Hips position, expressions and blendshapes: plain Gaussian means over the segment (the
+  // blendshapes with the expressions' sigma: both are face weights of the same signal).
   const double sigma_pos = std::max(k * options_.position_sigma_seconds, floor);
   const double sigma_expr = std::max(k * options_.expression_sigma_seconds, floor);
   const double reach = k_kernel_reach * std::max(sigma_pos, sigma_expr);
   glm::vec3 pos_sum(0.f);
   float pos_w = 0.f;
   std::array<float, k_expression_count> expr_sum{}, expr_w{};
+  std::array<float, k_blendshape_count> shape_sum{}, shape_w{};
   auto add = [&](int j) {
     const slot& s = at(j);
     if (s.segment != c.segment) return false;
@@ -923,6 +925,12 @@ void offline_smoother::emit(proxy_pose& out) noexcept {
           expr_sum[e] += we * s.pose.expressions[e];
           expr_w[e] += we;
         }
+    if (we > 0.f)
+      for (int b = 0; b < k_blendshape_count; ++b)
+        if (std::isfinite(s.pose.blendshapes[b])) {
+          shape_sum[b] += we * s.pose.blendshapes[b];
+          shape_w[b] += we;
+        }
     return true;
   };
   add(ci);
@@ -933,6 +941,8 @@ void offline_smoother::emit(proxy_pose& out) noexcept {
   out.hips_position = pos_w > 0.f ? pos_sum / pos_w : glm::vec3(0.f, k_default_hips_height, 0.f);
   for (int e = 0; e < k_expression_count; ++e)
     out.expressions[e] = expr_w[e] > 0.f ? expr_sum[e] / expr_w[e] : 0.f;
+  for (int b = 0; b < k_blendshape_count; ++b)
+    out.blendshapes[b] = shape_w[b] > 0.f ? shape_sum[b] / shape_w[b] : 0.f;
 }
 
 }  // namespace avatarmap

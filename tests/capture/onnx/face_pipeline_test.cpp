@@ -183,11 +183,15 @@ TEST(face_pipeline, empty_black_and_bodiless_images) {
 
 // ---- portrait.jpg against Google's face mesh -----------------------------------------------
 
-// portrait.jpg against the golden, float or int8 models (docs/capture.md "int8 models").
-void check_portrait(model_precision precision) {
+// portrait.jpg against the golden, float or int8 models (docs/capture.md "int8 models"), with
+// the attention model (478 points) or the plain mesh (468).
+void check_portrait(model_precision precision, face_mesh_model model) {
   REQUIRE_MODELS_AND_DATA();
   if (!test::has_model("face_landmark", precision))
     GTEST_SKIP() << "no int8 models (scripts/prepare_capture.sh builds them)";
+  const bool attention = model == face_mesh_model::attention;
+  if (attention && !test::has_model("face_landmark_with_attention", model_precision::float32))
+    GTEST_SKIP() << "no face_landmark_with_attention.onnx (scripts/prepare_capture.sh converts it)";
   loaded_image img;
   ASSERT_TRUE(load_image(test::test_data_path("motion/tfjs-models/portrait.jpg"), img));
   const nlohmann::json golden = load_json(test::test_data_path("golden/portrait_facemesh.json"));
@@ -204,15 +208,20 @@ void check_portrait(model_precision precision) {
   o.models_dir = models_dir();
   o.roi_source = face_roi_source::detector;
   o.precision = precision;
+  o.model = model;
   std::unique_ptr<face_pipeline> p;
   const status s = face_pipeline::create(o, p);
   ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(p->mesh_model(), model);
+  EXPECT_TRUE(p->note().empty()) << p->note();
+  const int n = attention ? k_face_mesh_iris_count : k_face_mesh_count;
+  EXPECT_EQ(p->mesh_points(), n);
   landmark_frame f;
   ASSERT_EQ(p->process(img.view(), nullptr, f), face_result::found) << p->last_error();
   EXPECT_TRUE(p->last_ran_detector());
   EXPECT_EQ(p->last_acquisition(), face_acquisition::detector_image);
   EXPECT_TRUE(f.has(frame_part::face));
-  EXPECT_EQ(f.face_count, 468);
+  EXPECT_EQ(f.face_count, n);
   EXPECT_GT(p->last_presence(), 0.9f);
 
   // The detector against tfjs-models' short-range expectations (their EPSILON_IMAGE). Those
@@ -268,8 +277,10 @@ void check_portrait(model_precision precision) {
         sdy / e.size());
     return st;
   };
-  std::vector<int> all(k_face_mesh_count);
-  for (int i = 0; i < k_face_mesh_count; ++i) all[i] = i;
+  std::vector<int> all(n);
+  for (int i = 0; i < n; ++i) all[i] = i;
+  std::vector<int> irises;
+  for (int i = k_face_mesh_count; i < n; ++i) irises.push_back(i);
   std::vector<int> eyes(std::begin(k_right_eye), std::end(k_right_eye));
   eyes.insert(eyes.end(), std::begin(k_left_eye), std::end(k_left_eye));
   const std::vector<int> lips(std::begin(k_lips), std::end(k_lips));
@@ -284,10 +295,12 @@ void check_portrait(model_precision precision) {
   const double face_h = std::hypot(g[152][0].get<double>() - g[10][0].get<double>(),
                                    g[152][1].get<double>() - g[10][1].get<double>());
   std::printf("golden face: eye corners %.1f px apart, forehead-chin %.1f px\n", eye_span, face_h);
-  const error_stats st_all = compare("frame 1, all 468", f, all);
+  std::printf("model: %s\n", attention ? "face_landmark_with_attention" : "face_landmark");
+  const error_stats st_all = compare(attention ? "frame 1, all 478" : "frame 1, all 468", f, all);
   const error_stats st_eyes = compare("frame 1, eye contours", f, eyes);
   const error_stats st_lips = compare("frame 1, lips", f, lips);
   const error_stats st_rest = compare("frame 1, other points", f, rest);
+  const error_stats st_iris = attention ? compare("frame 1, irises", f, irises) : error_stats{};
 
   // Frame 2 is tracked from frame 1's mesh (MediaPipe's video mode would do the same).
   landmark_frame f2;
@@ -296,32 +309,108 @@ void check_portrait(model_precision precision) {
   EXPECT_EQ(p->last_acquisition(), face_acquisition::tracked);
   const error_stats st_tracked = compare("frame 2 (tracked), all", f2, all);
 
-  // Tolerance. tfjs-models assert their attention-model keypoints within EPSILON_IMAGE (5 px)
-  // of what that same model gave. Ours come from the non-attention mesh, a different network,
-  // measured against the attention model's points on a face about 200 x 250 px (eye corners
-  // ~120 px apart). Measured (ORT 1.30, x86-64): mean 3.2 px with a common offset of about
-  // (2.0, 1.6) px over the non-refined points, while the eye contours the attention model
-  // refines agree to 1.2 px -- the crop geometry matches; the offset is the networks'. Bounds:
-  // the epsilon for the typical point (mean, median, and each refined region's mean), 1.5x for
-  // the 95th percentile, 2x (8% of the eye span) for the worst point; the eyes at half of it.
-  EXPECT_LT(st_all.mean, eps_mesh);
-  EXPECT_LT(st_all.median, eps_mesh);
-  EXPECT_LT(st_all.p95, 1.5 * eps_mesh);
-  EXPECT_LT(st_all.max, 2 * eps_mesh);
-  EXPECT_LT(st_rest.mean, eps_mesh);
-  EXPECT_LT(st_eyes.mean, 0.5 * eps_mesh);
-  EXPECT_LT(st_eyes.max, eps_mesh);
-  EXPECT_LT(st_lips.mean, eps_mesh);
-  EXPECT_LT(st_tracked.mean, eps_mesh);
-  EXPECT_LT(st_tracked.p95, 1.5 * eps_mesh);
-  EXPECT_LT(st_tracked.max, 2 * eps_mesh);
+  if (attention) {
+    // The same network as the golden's (MediaPipe Face Mesh with refine_landmarks, static image
+    // mode: the detector's region): tfjs-models assert every keypoint of that model within
+    // EPSILON_IMAGE (5 px) of what it gave. So do we, for all 478 points, irises included.
+    // Measured (ORT 1.29, x86-64): max 0.30 px, mean 0.07 px -- the same network on the same
+    // crop; the mean bound (10% of the epsilon) catches a wrong crop or refinement that the max
+    // would let through. Frame 2 runs on the region tracked from frame 1's mesh, which the
+    // golden (static images) never used: measured max 5.3 px, mean 1.3 px; bounds as the 468-point
+    // model's tracked frame below.
+    EXPECT_LT(st_all.max, eps_mesh);
+    EXPECT_LT(st_iris.max, eps_mesh);
+    EXPECT_LT(st_all.mean, 0.1 * eps_mesh);
+    EXPECT_LT(st_iris.mean, 0.1 * eps_mesh);
+    EXPECT_LT(st_tracked.mean, eps_mesh);
+    EXPECT_LT(st_tracked.p95, 1.5 * eps_mesh);
+    EXPECT_LT(st_tracked.max, 2 * eps_mesh);
+    // Irises in their eyes: each centre inside the box of its eye's contour, the right eye's
+    // (mesh point 33 side) at 468, the left's at 473; depth = the contour's mean depth.
+    for (const auto& [first, contour] : {std::pair<int, const int*>{468, k_right_eye},
+                                         std::pair<int, const int*>{473, k_left_eye}}) {
+      float x0 = 1, x1 = 0, y0 = 1, y1 = 0, z = 0;
+      for (int k = 0; k < 16; ++k) {
+        const landmark& q = f.face[contour[k]];
+        x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y);
+        y1 = std::max(y1, q.y), z += q.z / 16;
+      }
+      for (int k = 0; k < 5; ++k) EXPECT_NEAR(f.face[first + k].z, z, 1e-6f);
+      EXPECT_GT(f.face[first].x, x0);
+      EXPECT_LT(f.face[first].x, x1);
+      EXPECT_GT(f.face[first].y, y0);
+      EXPECT_LT(f.face[first].y, y1);
+    }
+  } else {
+    // Tolerance. tfjs-models assert their attention-model keypoints within EPSILON_IMAGE (5 px)
+    // of what that same model gave. Ours come from the non-attention mesh, a different network,
+    // measured against the attention model's points on a face about 200 x 250 px (eye corners
+    // ~120 px apart). Measured (ORT 1.30, x86-64): mean 3.2 px with a common offset of about
+    // (2.0, 1.6) px over the non-refined points, while the eye contours the attention model
+    // refines agree to 1.2 px -- the crop geometry matches; the offset is the networks'. Bounds:
+    // the epsilon for the typical point (mean, median, and each refined region's mean), 1.5x for
+    // the 95th percentile, 2x (8% of the eye span) for the worst point; the eyes at half of it.
+    EXPECT_LT(st_all.mean, eps_mesh);
+    EXPECT_LT(st_all.median, eps_mesh);
+    EXPECT_LT(st_all.p95, 1.5 * eps_mesh);
+    EXPECT_LT(st_all.max, 2 * eps_mesh);
+    EXPECT_LT(st_rest.mean, eps_mesh);
+    EXPECT_LT(st_eyes.mean, 0.5 * eps_mesh);
+    EXPECT_LT(st_eyes.max, eps_mesh);
+    EXPECT_LT(st_lips.mean, eps_mesh);
+    EXPECT_LT(st_tracked.mean, eps_mesh);
+    EXPECT_LT(st_tracked.p95, 1.5 * eps_mesh);
+    EXPECT_LT(st_tracked.max, 2 * eps_mesh);
+  }
   // z: same scale as x (image widths), the nose tip in front of the ears.
   EXPECT_LT(f.face[1].z, f.face[234].z);
   EXPECT_LT(f.face[1].z, f.face[454].z);
 }
 
-TEST(face_pipeline, portrait_vs_mediapipe_face_mesh) { check_portrait(model_precision::float32); }
-TEST(face_pipeline, portrait_vs_mediapipe_face_mesh_int8) { check_portrait(model_precision::int8); }
+TEST(face_pipeline, portrait_vs_mediapipe_face_mesh) {
+  check_portrait(model_precision::float32, face_mesh_model::attention);
+}
+TEST(face_pipeline, portrait_vs_mediapipe_face_mesh_int8) {
+  check_portrait(model_precision::int8, face_mesh_model::attention);
+}
+TEST(face_pipeline, portrait_vs_mediapipe_face_mesh_468) {
+  check_portrait(model_precision::float32, face_mesh_model::mesh);
+}
+TEST(face_pipeline, portrait_vs_mediapipe_face_mesh_468_int8) {
+  check_portrait(model_precision::int8, face_mesh_model::mesh);
+}
+
+// A models folder without the attention model: the 468-point mesh, with a one-line note.
+TEST(face_pipeline, falls_back_to_468_without_the_attention_model) {
+  REQUIRE_MODELS_AND_DATA();
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "avatarmap_face_fallback";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const char* name : {"face_detection_short_range.onnx", "face_landmark.onnx"})
+    fs::copy_file(fs::path(models_dir()) / name, dir / name);
+  face_pipeline_options o;
+  o.models_dir = dir.string();
+  o.roi_source = face_roi_source::detector;
+  std::unique_ptr<face_pipeline> p;
+  const status s = face_pipeline::create(o, p);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(p->mesh_model(), face_mesh_model::mesh);
+  EXPECT_EQ(p->mesh_points(), k_face_mesh_count);
+  EXPECT_NE(p->note().find("face_landmark_with_attention"), std::string::npos) << p->note();
+  EXPECT_EQ(p->note().find('\n'), std::string::npos);
+  loaded_image img;
+  ASSERT_TRUE(load_image(test::test_data_path("motion/tfjs-models/portrait.jpg"), img));
+  landmark_frame f;
+  ASSERT_EQ(p->process(img.view(), nullptr, f), face_result::found) << p->last_error();
+  EXPECT_EQ(f.face_count, k_face_mesh_count);
+  // Neither model at all is still an error naming the file, never a crash.
+  fs::remove(dir / "face_landmark.onnx");
+  const status s2 = face_pipeline::create(o, p);
+  EXPECT_FALSE(s2.ok());
+  EXPECT_NE(s2.message().find("face_landmark.onnx"), std::string::npos) << s2.message();
+  fs::remove_all(dir);
+}
 
 // ---- video with the body's face points as the hint -----------------------------------------
 
@@ -454,46 +543,54 @@ TEST(face_pipeline, squats_video_with_body_hint) {
 
 // ---- latency (printed, never asserted) ------------------------------------------------------
 
+// Per-frame cost of the face stage with each mesh model (printed for docs/capture-face.md,
+// never asserted): detector + mesh on every frame, then tracking frames (mesh only), the two
+// models' frames interleaved so that both see the same machine load.
 TEST(face_pipeline, latency) {
   REQUIRE_MODELS_AND_DATA();
   loaded_image img;
   ASSERT_TRUE(load_image(test::test_data_path("motion/tfjs-models/portrait.jpg"), img));
+  const face_mesh_model models[] = {face_mesh_model::mesh, face_mesh_model::attention};
   for (int threads : {1, 2}) {
-    face_pipeline_options o;
-    o.models_dir = models_dir();
-    o.roi_source = face_roi_source::detector;
-    o.intra_op_threads = threads;
-    o.static_images = true;  // detector + mesh on every frame
-    std::unique_ptr<face_pipeline> p;
-    ASSERT_TRUE(face_pipeline::create(o, p).ok());
-    landmark_frame f;
-    std::vector<double> det, det_inf, mesh, mesh_inf, track;
+    std::unique_ptr<face_pipeline> still[2], tracked[2];
+    for (int k = 0; k < 2; ++k) {
+      face_pipeline_options o;
+      o.models_dir = models_dir();
+      o.roi_source = face_roi_source::detector;
+      o.intra_op_threads = threads;
+      o.model = models[k];
+      o.static_images = true;  // detector + mesh on every frame
+      ASSERT_TRUE(face_pipeline::create(o, still[k]).ok());
+      o.static_images = false;  // the whole process() call per frame, the detector not running
+      ASSERT_TRUE(face_pipeline::create(o, tracked[k]).ok());
+    }
+    std::vector<double> det[2], det_inf[2], mesh[2], mesh_inf[2], track[2];
     const int runs = 40;
+    landmark_frame f;
     for (int i = 0; i < runs + 3; ++i) {
-      ASSERT_EQ(p->process(img.view(), nullptr, f), face_result::found);
-      if (i < 3) continue;
-      const face_timings& t = p->last_timings();
-      det.push_back(t.detector_ms);
-      det_inf.push_back(t.detector_inference_ms);
-      mesh.push_back(t.mesh_ms);
-      mesh_inf.push_back(t.mesh_inference_ms);
+      for (int k = 0; k < 2; ++k) {
+        ASSERT_EQ(still[k]->process(img.view(), nullptr, f), face_result::found);
+        const auto t0 = std::chrono::steady_clock::now();
+        ASSERT_EQ(tracked[k]->process(img.view(), nullptr, f), face_result::found);
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count();
+        if (i < 3) continue;
+        const face_timings& t = still[k]->last_timings();
+        det[k].push_back(t.detector_ms);
+        det_inf[k].push_back(t.detector_inference_ms);
+        mesh[k].push_back(t.mesh_ms);
+        mesh_inf[k].push_back(t.mesh_inference_ms);
+        EXPECT_FALSE(tracked[k]->last_ran_detector());
+        track[k].push_back(ms);
+      }
     }
-    // Tracking mode: the whole process() call per frame, the detector not running.
-    o.static_images = false;
-    ASSERT_TRUE(face_pipeline::create(o, p).ok());
-    for (int i = 0; i < runs + 3; ++i) {
-      const auto t0 = std::chrono::steady_clock::now();
-      ASSERT_EQ(p->process(img.view(), nullptr, f), face_result::found);
-      const double ms =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      if (i < 3) continue;
-      EXPECT_FALSE(p->last_ran_detector());
-      track.push_back(ms);
-    }
-    std::printf(
-        "threads %d: detector %.2f ms (inference %.2f), mesh %.2f ms (inference %.2f), "
-        "tracking frame %.2f ms; medians of %d\n",
-        threads, median(det), median(det_inf), median(mesh), median(mesh_inf), median(track), runs);
+    for (int k = 0; k < 2; ++k)
+      std::printf(
+          "threads %d, %s (%d points): detector %.2f ms (inference %.2f), mesh %.2f ms "
+          "(inference %.2f), tracking frame %.2f ms; medians of %d\n",
+          threads, k ? "attention" : "mesh", still[k]->mesh_points(), median(det[k]),
+          median(det_inf[k]), median(mesh[k]), median(mesh_inf[k]), median(track[k]), runs);
   }
 }
 

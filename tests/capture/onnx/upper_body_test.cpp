@@ -275,7 +275,7 @@ struct face_errors {
 
 face_errors compare_face(const landmark_frame& f, const nlohmann::json& g, int w, int h) {
   std::vector<double> d;
-  for (int i = 0; i < k_face_mesh_count; ++i)  // the first 468 of MediaPipe's 478
+  for (int i = 0; i < f.face_count; ++i)  // all 478 (with the 468-point model: the first 468)
     d.push_back(std::hypot(f.face[i].x * w - g[i][0].get<double>(),
                            f.face[i].y * h - g[i][1].get<double>()));
   face_errors e;
@@ -287,11 +287,14 @@ face_errors compare_face(const landmark_frame& f, const nlohmann::json& g, int w
   return e;
 }
 
-// MediaPipe Face Mesh's graph: the short-range detector on the whole image. Our mesh is the
-// non-attention model, MediaPipe's the attention one (refineLandmarks): the bounds of
-// face_pipeline_test's portrait check apply (mean and median within EPSILON_IMAGE, p95 1.5x,
-// max 2x). pose_upper55: the face is too small for the short-range detector; MediaPipe finds
-// none and neither must we.
+// MediaPipe Face Mesh's graph: the short-range detector on the whole image. With the attention
+// model (the default, the golden's own network: refineLandmarks) every one of the 478 points,
+// irises included, must be within EPSILON_IMAGE and the mean within a tenth of it (measured:
+// max 0.21 / 0.18 px, mean 0.06 / 0.04 px on portrait / squats_upper). Without its file the
+// pipeline falls back to the 468-point model, a different network: then the bounds of
+// face_pipeline_test's 468-point check (mean and median within EPSILON_IMAGE, p95 1.5x, max
+// 2x). pose_upper55: the face is too small for the short-range detector; MediaPipe finds none
+// and neither must we.
 TEST(upper_body, face_vs_mediapipe) {
   UPPER_SKIP_WITHOUT_DATA();
   const tolerances tol = load_tolerances();
@@ -324,12 +327,19 @@ TEST(upper_body, face_vs_mediapipe) {
     ASSERT_EQ(r, face_result::found);
     ASSERT_EQ(g["faces_px"][0].size(), 478u);
     const face_errors e = compare_face(f, g["faces_px"][0], img.width, img.height);
-    std::printf("[figures] %s face: mean %.2f, median %.2f, p95 %.2f, max %.2f px\n", name.c_str(),
-                e.mean, e.median, e.p95, e.max);
-    EXPECT_LT(e.mean, tol.face_px);
-    EXPECT_LT(e.median, tol.face_px);
-    EXPECT_LT(e.p95, 1.5 * tol.face_px);
-    EXPECT_LT(e.max, 2 * tol.face_px);
+    std::printf("[figures] %s face (%d points): mean %.2f, median %.2f, p95 %.2f, max %.2f px\n",
+                name.c_str(), f.face_count, e.mean, e.median, e.p95, e.max);
+    if (p->mesh_model() == face_mesh_model::attention) {
+      EXPECT_EQ(f.face_count, k_face_mesh_iris_count);
+      EXPECT_LT(e.max, tol.face_px);
+      EXPECT_LT(e.mean, 0.1 * tol.face_px);
+    } else {
+      std::printf("[figures] %s\n", p->note().c_str());
+      EXPECT_LT(e.mean, tol.face_px);
+      EXPECT_LT(e.median, tol.face_px);
+      EXPECT_LT(e.p95, 1.5 * tol.face_px);
+      EXPECT_LT(e.max, 2 * tol.face_px);
+    }
   }
   EXPECT_EQ(checked, 3);
 }
@@ -492,10 +502,18 @@ TEST(upper_body, cpu_sampling_disagrees_more) {
       (sampling == crop_sampling::gl ? hand_gl : hand_cpu) += hand_mean;
       const nlohmann::json gf = load_json(golden_path(name, "face"));
       std::string face_line = "none";
-      if (!gf["faces_px"].empty() && face->process(img.view(), nullptr, f) == face_result::found) {
-        char buf[64];
-        std::snprintf(buf, sizeof buf, "mean %.2f px",
-                      compare_face(f, gf["faces_px"][0], img.width, img.height).mean);
+      if (!gf["faces_px"].empty()) {
+        char buf[96];
+        if (face->process(img.view(), nullptr, f) == face_result::found)
+          std::snprintf(buf, sizeof buf, "mean %.2f px",
+                        compare_face(f, gf["faces_px"][0], img.width, img.height).mean);
+        else
+          std::snprintf(
+              buf, sizeof buf, "none (%s, mesh presence %.3f)",
+              face->last_ran_detector() && face->last_acquisition() == face_acquisition::none
+                  ? "no detection"
+                  : "mesh rejected",
+              face->last_presence());
         face_line = buf;
       }
       std::printf(

@@ -222,8 +222,8 @@ TEST(BuiltinAvatar, SkinWeightsNormalsAndWindingAreSane) {
       }
     }
   // Torso 2, neck, 2 x (arm, palm, 5 fingers, leg, foot), head, nose, 2 x (eye, iris, brow),
-  // mouth: every part but the eyelids (open sheets) is closed.
-  EXPECT_EQ(closed_parts, 3 + 2 * 9 + 2 + 2 * 3 + 1);
+  // mouth, tongue: every part but the eyelids (open sheets) is closed.
+  EXPECT_EQ(closed_parts, 3 + 2 * 9 + 2 + 2 * 3 + 2);
 }
 
 // What the file holds: tinygltf reads it without errors or warnings and gives back exactly the
@@ -331,55 +331,183 @@ TEST(BuiltinAvatar, FileReadsBackToWhatWasBuilt) {
   EXPECT_EQ(model.nodes[static_cast<std::size_t>(face_node)].skin, 0);
 }
 
-// The expressions: each named one exists and moves vertices, only those bound to the head or
-// the eyes; the one-eye ones only their side (the avatar's left is +X); the body has no morph
-// targets; blink = blinkLeft + blinkRight.
-TEST(BuiltinAvatar, ExpressionsMoveOnlyTheHead) {
+// The face's morph targets are ARKit's 52 (Perfect Sync), named as Apple names them, in ARKit's
+// order; each moves only vertices bound to the head or the eyes, by millimetres to centimetres,
+// a one-sided shape mostly on its side (the person's left = the avatar's left = +X); the
+// eyeLook* ones move nothing (the gaze turns the eye bones); the body has no morph targets.
+TEST(BuiltinAvatar, FaceHasArkitsBlendshapesAsMorphTargets) {
   const builtin_avatar a = make();
   for (const avatar_primitive& p : a.meshes[0].primitives) EXPECT_TRUE(p.targets.empty());
   const avatar_mesh& face = a.meshes[1];
   ASSERT_EQ(face.primitives.size(), 1u);
   const avatar_primitive& p = face.primitives[0];
-  ASSERT_EQ(p.targets.size(), face.target_names.size());
+  ASSERT_EQ(face.target_names.size(), 52u);
+  ASSERT_EQ(p.targets.size(), 52u);
+  // Spot checks against Apple's list (ARFaceAnchor.BlendShapeLocation, alphabetical).
+  EXPECT_EQ(face.target_names[0], "browDownLeft");
+  EXPECT_EQ(face.target_names[8], "eyeBlinkLeft");
+  EXPECT_EQ(face.target_names[24], "jawOpen");
+  EXPECT_EQ(face.target_names[43], "mouthSmileLeft");
+  EXPECT_EQ(face.target_names[51], "tongueOut");
+  EXPECT_TRUE(std::is_sorted(face.target_names.begin(), face.target_names.end()));
   const std::set<int> head_bones = {idx(bone::head), idx(bone::left_eye), idx(bone::right_eye),
                                     idx(bone::jaw)};
-  std::map<std::string, const avatar_expression*> by_name;
-  for (const avatar_expression& e : a.expressions) by_name[e.name] = &e;
+  for (std::size_t t = 0; t < 52; ++t) {
+    const std::string& name = face.target_names[t];
+    ASSERT_EQ(p.targets[t].size(), p.positions.size()) << name;
+    int moved = 0;
+    float largest = 0.f, side = 0.f;
+    for (std::size_t v = 0; v < p.positions.size(); ++v) {
+      const float d = glm::length(p.targets[t][v]);
+      if (d == 0.f) continue;
+      ++moved;
+      largest = std::max(largest, d);
+      side += d * p.positions[v].x;
+      for (int k = 0; k < 4; ++k)
+        if (p.weights[v][k] > 0.f) EXPECT_TRUE(head_bones.count(p.joints[v][k])) << name;
+    }
+    if (name.rfind("eyeLook", 0) == 0) {
+      EXPECT_EQ(moved, 0) << name;
+      continue;
+    }
+    EXPECT_GT(moved, 10) << name;
+    EXPECT_GT(largest, 0.0015f) << name;  // visibly: millimetres
+    EXPECT_LT(largest, 0.05f) << name;    // and within the face
+    const bool one_sided =
+        name != "jawLeft" && name != "jawRight" && name != "mouthLeft" && name != "mouthRight";
+    if (one_sided && name.find("Left") != std::string::npos) EXPECT_GT(side, 0.f) << name;
+    if (one_sided && name.find("Right") != std::string::npos) EXPECT_LT(side, 0.f) << name;
+  }
+}
+
+// Each shape moves the face the way Apple's reference describes it: the parts are told apart by
+// their vertex colours (mouth, tongue, lids, hair = brows) and the displacement of the part is
+// measured (mean, or at its extreme vertex).
+TEST(BuiltinAvatar, ArkitShapesMoveAsApplesDefinitionsSay) {
+  const builtin_avatar a = make();
+  const avatar_mesh& face = a.meshes[1];
+  const avatar_primitive& p = face.primitives[0];
+  ASSERT_EQ(p.colors.size(), p.positions.size());
+  auto target = [&](const char* name) -> const std::vector<glm::vec3>& {
+    const auto it = std::find(face.target_names.begin(), face.target_names.end(), name);
+    EXPECT_NE(it, face.target_names.end()) << name;
+    return p.targets[static_cast<std::size_t>(it - face.target_names.begin())];
+  };
+  auto is = [&](std::size_t v, glm::vec3 c) { return glm::length(p.colors[v] - c) < 1e-3f; };
+  const glm::vec3 mouth(0.32f, 0.05f, 0.06f), tongue(0.80f, 0.36f, 0.38f), lid(0.74f, 0.50f, 0.39f),
+      hair(0.07f, 0.04f, 0.025f);
+  const float eye_y = a.joints[idx(bone::left_eye)].y;
+  // Mean displacement of the vertices of one colour that pass `where`.
+  auto mean = [&](const char* name, glm::vec3 colour, auto where) {
+    const std::vector<glm::vec3>& d = target(name);
+    glm::vec3 sum(0.f);
+    int n = 0;
+    for (std::size_t v = 0; v < d.size(); ++v)
+      if (is(v, colour) && where(p.positions[v])) {
+        sum += d[v];
+        ++n;
+      }
+    EXPECT_GT(n, 0) << name;
+    return n ? sum / float(n) : sum;
+  };
+  auto any = [](const glm::vec3&) { return true; };
+  auto left = [](const glm::vec3& q) { return q.x > 0.01f; };
+  auto right = [](const glm::vec3& q) { return q.x < -0.01f; };
+  auto brows = [&](const glm::vec3& q) { return q.y > eye_y && q.y < eye_y + 0.05f && q.z > 0.f; };
+  auto inner = [&](const glm::vec3& q) { return brows(q) && std::fabs(q.x) < 0.03f; };
+  // The lower half of the mouth (below its centre) and its corners.
+  float mouth_y = 0.f, mouth_x = 0.f;
+  int mouth_n = 0;
+  for (std::size_t v = 0; v < p.positions.size(); ++v)
+    if (is(v, mouth)) {
+      mouth_y += p.positions[v].y;
+      mouth_x = std::max(mouth_x, p.positions[v].x);
+      ++mouth_n;
+    }
+  ASSERT_GT(mouth_n, 0);
+  mouth_y /= float(mouth_n);
+  auto lower = [&](const glm::vec3& q) { return q.y < mouth_y - 0.002f; };
+  auto upper = [&](const glm::vec3& q) { return q.y > mouth_y + 0.002f; };
+  auto left_corner = [&](const glm::vec3& q) { return q.x > 0.8f * mouth_x; };
+  auto right_corner = [&](const glm::vec3& q) { return q.x < -0.8f * mouth_x; };
+  const float mm = 0.001f;
+
+  EXPECT_LT(mean("jawOpen", mouth, lower).y, -10 * mm);   // the jaw drops the lower lip
+  EXPECT_GT(mean("jawForward", mouth, lower).z, 3 * mm);  // and pushes it forward
+  EXPECT_GT(mean("jawLeft", mouth, lower).x, 3 * mm);     // to the person's left, +X
+  EXPECT_LT(mean("jawRight", mouth, lower).x, -3 * mm);
+  EXPECT_GT(mean("mouthClose", mouth, lower).y, 5 * mm);            // lips close over an open jaw
+  EXPECT_GT(mean("mouthSmileLeft", mouth, left_corner).y, 4 * mm);  // left corner up
+  EXPECT_NEAR(mean("mouthSmileLeft", mouth, right_corner).y, 0.f, 0.5f * mm);
+  EXPECT_GT(mean("mouthSmileRight", mouth, right_corner).y, 4 * mm);
+  EXPECT_LT(mean("mouthFrownLeft", mouth, left_corner).y, -3 * mm);  // left corner down
+  EXPECT_LT(mean("mouthFrownRight", mouth, right_corner).y, -3 * mm);
+  EXPECT_GT(mean("mouthStretchLeft", mouth, left_corner).x, 3 * mm);  // pulled outward
+  EXPECT_LT(mean("mouthStretchRight", mouth, right_corner).x, -3 * mm);
+  EXPECT_GT(mean("mouthLeft", mouth, any).x, 5 * mm);  // the whole mouth to the left
+  EXPECT_LT(mean("mouthRight", mouth, any).x, -5 * mm);
+  EXPECT_LT(mean("mouthPucker", mouth, left_corner).x, -5 * mm);  // narrower
+  EXPECT_GT(mean("mouthPucker", mouth, any).z, 4 * mm);           // and forward
+  EXPECT_GT(mean("mouthFunnel", mouth, any).z, 3 * mm);
+  EXPECT_GT(mean("mouthUpperUpLeft", mouth, upper).y, 1 * mm);
+  EXPECT_LT(mean("mouthLowerDownLeft", mouth, lower).y, -1 * mm);
+  EXPECT_GT(mean("mouthShrugLower", mouth, lower).y, 1 * mm);
+  EXPECT_LT(mean("mouthRollUpper", mouth, upper).y, -1 * mm);
+  EXPECT_GT(mean("tongueOut", tongue, any).z, 15 * mm);      // the tongue comes out
+  EXPECT_LT(mean("eyeBlinkLeft", lid, left).y, -1.5f * mm);  // lids close (down on average)
+  EXPECT_NEAR(glm::length(mean("eyeBlinkLeft", lid, right)), 0.f, 1e-6f);
+  EXPECT_LT(mean("eyeBlinkRight", lid, right).y, -1.5f * mm);
+  EXPECT_GT(mean("eyeWideLeft", lid, [&](const glm::vec3& q) { return left(q) && q.y > eye_y; }).y,
+            0.5f * mm);  // the upper lid goes up
+  EXPECT_GT(mean("browInnerUp", hair, inner).y, 2 * mm);
+  EXPECT_LT(mean("browDownLeft", hair, [&](const glm::vec3& q) { return brows(q) && left(q); }).y,
+            -2 * mm);
+  EXPECT_GT(
+      mean("browOuterUpRight", hair, [&](const glm::vec3& q) { return brows(q) && right(q); }).y,
+      1 * mm);
+  // cheekPuff: the skin of the cheeks goes outward from the head's centre.
+  const std::vector<glm::vec3>& puff = target("cheekPuff");
+  const glm::vec3 head = a.joints[idx(bone::head)];
+  float outward = 0.f;
+  for (std::size_t v = 0; v < puff.size(); ++v)
+    if (glm::length(puff[v]) > 0.f) outward += glm::dot(puff[v], p.positions[v] - head);
+  EXPECT_GT(outward, 0.f);
+}
+
+// The VRM expressions bind combinations of the ARKit targets (nothing else), with weights in
+// (0, 1]: blink = eyeBlinkLeft + eyeBlinkRight; the five emotions are presets built from the
+// shapes their faces show.
+TEST(BuiltinAvatar, ExpressionsBindArkitTargets) {
+  const builtin_avatar a = make();
+  const avatar_mesh& face = a.meshes[1];
+  std::map<std::string, std::set<std::string>> binds;
+  std::map<std::string, bool> preset;
+  for (const avatar_expression& e : a.expressions) {
+    preset[e.name] = e.preset;
+    for (const avatar_expression::bind& b : e.binds) {
+      ASSERT_EQ(b.mesh, 1) << e.name;
+      ASSERT_GE(b.target, 0);
+      ASSERT_LT(b.target, 52);
+      EXPECT_GT(b.weight, 0.f) << e.name;
+      EXPECT_LE(b.weight, 1.f) << e.name;
+      binds[e.name].insert(face.target_names[static_cast<std::size_t>(b.target)]);
+    }
+  }
   for (const char* name :
        {"blink", "blinkLeft", "blinkRight", "aa", "ih", "ou", "ee", "oh", "happy", "angry", "sad",
         "relaxed", "surprised", "browUpLeft", "browUpRight", "browDownLeft", "browDownRight"}) {
-    ASSERT_TRUE(by_name.count(name)) << name;
-    const avatar_expression& e = *by_name[name];
-    EXPECT_EQ(e.preset, std::string(name).rfind("brow", 0) != 0) << name;
-    ASSERT_FALSE(e.binds.empty());
-    for (const avatar_expression::bind& b : e.binds) {
-      ASSERT_EQ(b.mesh, 1);
-      ASSERT_GE(b.target, 0);
-      ASSERT_LT(b.target, static_cast<int>(p.targets.size()));
-      EXPECT_EQ(b.weight, 1.f);
-      int moved = 0;
-      float largest = 0.f;
-      for (std::size_t v = 0; v < p.positions.size(); ++v) {
-        const float d = glm::length(p.targets[b.target][v]);
-        if (d == 0.f) continue;
-        ++moved;
-        largest = std::max(largest, d);
-        for (int k = 0; k < 4; ++k)
-          if (p.weights[v][k] > 0.f) EXPECT_TRUE(head_bones.count(p.joints[v][k])) << name;
-        const std::string target = face.target_names[b.target];
-        if (target.find("Left") != std::string::npos) EXPECT_GT(p.positions[v].x, 0.f) << name;
-        if (target.find("Right") != std::string::npos) EXPECT_LT(p.positions[v].x, 0.f) << name;
-      }
-      EXPECT_GT(moved, 10) << name;
-      EXPECT_GT(largest, 0.002f) << name;  // visibly: millimetres
-      EXPECT_LT(largest, 0.05f) << name;   // and within the face
-    }
+    ASSERT_TRUE(binds.count(name)) << name;
+    EXPECT_EQ(preset[name], std::string(name).rfind("brow", 0) != 0) << name;
   }
-  const avatar_expression& blink = *by_name["blink"];
-  std::set<std::string> blink_targets;
-  for (const avatar_expression::bind& b : blink.binds)
-    blink_targets.insert(face.target_names[b.target]);
-  EXPECT_EQ(blink_targets, (std::set<std::string>{"blinkLeft", "blinkRight"}));
+  EXPECT_EQ(binds["blink"], (std::set<std::string>{"eyeBlinkLeft", "eyeBlinkRight"}));
+  EXPECT_EQ(binds["blinkLeft"], (std::set<std::string>{"eyeBlinkLeft"}));
+  EXPECT_TRUE(binds["aa"].count("jawOpen"));
+  EXPECT_TRUE(binds["happy"].count("mouthSmileLeft") && binds["happy"].count("mouthSmileRight"));
+  EXPECT_TRUE(binds["angry"].count("browDownLeft") && binds["angry"].count("browDownRight"));
+  EXPECT_TRUE(binds["sad"].count("browInnerUp") && binds["sad"].count("mouthFrownLeft"));
+  EXPECT_TRUE(binds["relaxed"].count("mouthSmileLeft"));
+  EXPECT_TRUE(binds["surprised"].count("eyeWideLeft") && binds["surprised"].count("jawOpen"));
+  EXPECT_EQ(binds["browDownLeft"], (std::set<std::string>{"browDownLeft"}));
 }
 
 // Retargeting poses onto the loaded avatar and skinning every vertex with the rig's posed

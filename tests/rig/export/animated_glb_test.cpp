@@ -1,7 +1,8 @@
 // The animated .glb writer (include/avatarmap/export/animated_glb.hpp): a well-formed GLB with
 // everything in one BIN chunk, textures byte for byte, the animation readable back; hostile
 // avatars (URIs leaving the folder, symbolic links) refused with no output written and no
-// secret copied; non-finite poses refused; written atomically.
+// secret copied; non-finite poses refused; written atomically; the face's morph weights from
+// expressions and ARKit blendshapes (known weights, the precedence, hostile names).
 #include "avatarmap/export/animated_glb.hpp"
 
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -303,7 +305,8 @@ TEST_F(animated_glb_writer, the_face_drives_morph_weights_and_bad_faces_are_refu
   ASSERT_TRUE(write_animated_glb(avatar, r, frames, o, out).ok());
   const parsed_glb g = parse_glb(test::read_text(out));
   ASSERT_TRUE(g.error.empty()) << g.error;
-  // The built-in avatar binds aa to its face's target named "aa", weight 1.
+  // The built-in avatar binds aa to its face's ARKit target jawOpen, weight 0.75 (the clip has
+  // no blendshapes: the expressions drive).
   int channels = 0;
   for (const json& c : g.j["animations"][0]["channels"]) {
     if (c["target"]["path"] != "weights") continue;
@@ -321,7 +324,8 @@ TEST_F(animated_glb_writer, the_face_drives_morph_weights_and_bad_faces_are_refu
         std::memcpy(
             &v, bytes.data() + acc.value("byteOffset", std::size_t{0}) + 4 * (f * names.size() + t),
             4);
-        EXPECT_FLOAT_EQ(v, f == 1 && names[t] == "aa" ? 0.5f : 0.f) << names[t] << " frame " << f;
+        EXPECT_FLOAT_EQ(v, f == 1 && names[t] == "jawOpen" ? 0.375f : 0.f)
+            << names[t] << " frame " << f;
       }
   }
   EXPECT_EQ(channels, 1);
@@ -335,6 +339,12 @@ TEST_F(animated_glb_writer, the_face_drives_morph_weights_and_bad_faces_are_refu
   s = write_animated_glb(avatar, r, frames, o, dir.file("nan.glb"));
   EXPECT_TRUE(contains(s.message(), "frame 2 expression 'blink'")) << s.message();
   EXPECT_FALSE(std::filesystem::exists(dir.file("nan.glb")));
+  faces[2][expression::blink] = 0.f;
+  faces[1][blendshape::tongue_out] = INFINITY;
+  s = write_animated_glb(avatar, r, frames, o, dir.file("inf.glb"));
+  EXPECT_TRUE(contains(s.message(), "frame 1 blendshape 'tongueOut'")) << s.message();
+  EXPECT_FALSE(std::filesystem::exists(dir.file("inf.glb")));
+  faces[1][blendshape::tongue_out] = 0.f;
 
   // Hostile definitions: binds to a node without a mesh, out-of-range indices, wrong types.
   json j = test::minimal_vrm1();
@@ -355,6 +365,135 @@ TEST_F(animated_glb_writer, the_face_drives_morph_weights_and_bad_faces_are_refu
   const json written = parse_glb(test::read_text(out)).j;  // kept: the loop reads into it
   for (const json& c : written["animations"][0]["channels"])
     EXPECT_NE(c["target"]["path"], "weights");
+}
+
+// The weights channel of a written GLB: per frame, target name -> weight (the first channel on
+// a node whose mesh names its targets).
+std::vector<std::map<std::string, float>> face_weights(const parsed_glb& g) {
+  std::vector<std::map<std::string, float>> out;
+  for (const json& c : g.j["animations"][0]["channels"]) {
+    if (c["target"]["path"] != "weights") continue;
+    const json& node = g.j["nodes"][c["target"]["node"].get<std::size_t>()];
+    const json& names = g.j["meshes"][node["mesh"].get<std::size_t>()]["extras"]["targetNames"];
+    const json& acc =
+        g.j["accessors"][g.j["animations"][0]["samplers"][c["sampler"].get<std::size_t>()]["output"]
+                             .get<std::size_t>()];
+    const std::string bytes = view_bytes(g, acc["bufferView"].get<std::size_t>());
+    const std::size_t frames = acc["count"].get<std::size_t>() / names.size();
+    out.resize(frames);
+    for (std::size_t f = 0; f < frames; ++f)
+      for (std::size_t t = 0; t < names.size(); ++t) {
+        float v = 0.f;
+        std::memcpy(
+            &v, bytes.data() + acc.value("byteOffset", std::size_t{0}) + 4 * (f * names.size() + t),
+            4);
+        out[f][names[t].get<std::string>()] = v;
+      }
+    break;
+  }
+  return out;
+}
+
+// Perfect Sync: the proxy's ARKit blendshapes drive the morph targets named after them; where
+// the clip carries blendshapes, a target an ARKit shape drives is not driven again by the VRM
+// expressions bound to it (aa binds jawOpen x 0.75: jawOpen is the blendshape's value alone),
+// and the expressions drive nothing else here (every face target of the built-in avatar is an
+// ARKit shape).
+TEST_F(animated_glb_writer, arkit_blendshapes_drive_their_targets_without_double_driving) {
+  const std::string avatar = dir.file("builtin.vrm");
+  ASSERT_TRUE(write_builtin_avatar(avatar).ok());
+  const rig r = rig_of(avatar);
+  const std::vector<rig_pose> frames = bending_frames(r, 3);
+  std::vector<proxy_pose> faces(3);
+  faces[1][blendshape::eye_blink_left] = 0.8f;
+  faces[1][blendshape::mouth_smile_right] = 0.3f;
+  faces[1][blendshape::tongue_out] = 1.7f;  // clamped
+  faces[2][blendshape::jaw_open] = 0.2f;
+  faces[2][expression::aa] = 0.9f;    // would add 0.675 to jawOpen
+  faces[2][expression::happy] = 1.f;  // would add to mouthSmile*, cheekSquint*...
+  faces[2][expression::blink] = 1.f;  // would close both eyes
+  animated_glb_options o;
+  o.expressions = &faces;
+  ASSERT_TRUE(write_animated_glb(avatar, r, frames, o, out).ok());
+  const auto w = face_weights(parse_glb(test::read_text(out)));
+  ASSERT_EQ(w.size(), 3u);
+  ASSERT_EQ(w[0].size(), 52u);
+  for (const auto& [name, v] : w[0]) EXPECT_EQ(v, 0.f) << name;
+  EXPECT_FLOAT_EQ(w[1].at("eyeBlinkLeft"), 0.8f);
+  EXPECT_FLOAT_EQ(w[1].at("mouthSmileRight"), 0.3f);
+  EXPECT_FLOAT_EQ(w[1].at("tongueOut"), 1.f);
+  EXPECT_FLOAT_EQ(w[1].at("eyeBlinkRight"), 0.f);
+  EXPECT_FLOAT_EQ(w[2].at("jawOpen"), 0.2f);
+  for (const auto& [name, v] : w[2])
+    if (name != "jawOpen") EXPECT_EQ(v, 0.f) << name;
+}
+
+// Names that are no expression and no ARKit shape, prefixes with nothing after them, targets
+// named by non-strings, more names than targets: documented results, no crash. A custom
+// expression "ARKIT_JAWOPEN" (any case, prefix) claims jawOpen and drives the target it binds,
+// so the target named jawOpen is not driven again; targets without a string name are not
+// driven; mouthSmileLeft is driven by its target's name.
+TEST_F(animated_glb_writer, unknown_and_hostile_face_names_are_ignored) {
+  const std::string builtin = dir.file("builtin.vrm");
+  ASSERT_TRUE(write_builtin_avatar(builtin).ok());
+  const parsed_glb g = parse_glb(test::read_text(builtin));
+  ASSERT_TRUE(g.error.empty()) << g.error;
+  json j = g.j;
+  int face = -1;
+  for (std::size_t n = 0; n < j["nodes"].size(); ++n)
+    if (j["nodes"][n].value("name", "") == "Face") face = static_cast<int>(n);
+  ASSERT_GE(face, 0);
+  const json bind = {{{"node", face}, {"index", 0}, {"weight", 1.0}}};
+  json custom = json::object();
+  for (const std::string name :
+       {std::string(""), std::string("."), std::string("ARKit_"), std::string("blendShape1."),
+        std::string("x.y.z."), std::string("smirk"),
+        std::string("\xc3\xbc"
+                    "n\xc3\xaf"
+                    "c"),
+        std::string(10000, 'a')})
+    custom[name] = {{"morphTargetBinds", bind}};
+  custom["ARKIT_JAWOPEN"] = {
+      {"morphTargetBinds", {{{"node", face}, {"index", 24}, {"weight", 0.5}}}}};
+  j["extensions"]["VRMC_vrm"]["expressions"] = {{"preset", json::object()}, {"custom", custom}};
+  json& names = j["meshes"][j["nodes"][face]["mesh"].get<std::size_t>()]["extras"]["targetNames"];
+  ASSERT_EQ(names.size(), 52u);
+  names[8] = 42;  // eyeBlinkLeft
+  names[9] = nullptr;
+  names.push_back("tongueOut");  // a 53rd name for 52 targets
+  const std::string avatar = dir.file("hostile_names.glb");
+  test::write_text(avatar, test::make_glb(j, g.bin));
+  const rig r = rig_of(avatar);
+  const std::vector<rig_pose> frames = bending_frames(r, 2);
+  std::vector<proxy_pose> faces(2);
+  faces[1][blendshape::jaw_open] = 0.5f;
+  faces[1][blendshape::eye_blink_left] = 1.f;
+  faces[1][blendshape::eye_blink_right] = 1.f;
+  faces[1][blendshape::mouth_smile_left] = 0.4f;
+  faces[1][expression::blink] = 1.f;
+  animated_glb_options o;
+  o.expressions = &faces;
+  ASSERT_TRUE(write_animated_glb(avatar, r, frames, o, out).ok());
+  const parsed_glb w = parse_glb(test::read_text(out));
+  ASSERT_TRUE(w.error.empty()) << w.error;
+  int channels = 0;
+  for (const json& c : w.j["animations"][0]["channels"]) {
+    if (c["target"]["path"] != "weights") continue;
+    ++channels;
+    EXPECT_EQ(c["target"]["node"].get<int>(), face);
+    const json& acc =
+        w.j["accessors"][w.j["animations"][0]["samplers"][c["sampler"].get<std::size_t>()]["output"]
+                             .get<std::size_t>()];
+    ASSERT_EQ(acc["count"].get<std::size_t>(), 2u * 52u);
+    const std::string bytes = view_bytes(w, acc["bufferView"].get<std::size_t>());
+    for (std::size_t t = 0; t < 52; ++t) {
+      float v = 0.f;
+      std::memcpy(&v, bytes.data() + acc.value("byteOffset", std::size_t{0}) + 4 * (52 + t), 4);
+      const float want = t == 24 ? 0.25f : t == 43 ? 0.4f : 0.f;
+      EXPECT_FLOAT_EQ(v, want) << "target " << t;
+    }
+  }
+  EXPECT_EQ(channels, 1);
 }
 
 TEST_F(animated_glb_writer, keeps_the_mode_of_the_replaced_file_and_follows_no_symlink) {

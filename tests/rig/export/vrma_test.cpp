@@ -84,6 +84,7 @@ std::vector<proxy_pose> random_sequence(std::mt19937& rng, int n, double dt) {
     for (int b = 0; b < k_bone_count; ++b) p.rotations[b] = random_unit_quat(rng);
     p.hips_position = glm::vec3(u(rng) - 0.5f, 0.8f + 0.2f * u(rng), u(rng) - 0.5f);
     for (int e = 0; e < k_expression_count; ++e) p.expressions[e] = u(rng);
+    for (int sh = 0; sh < k_blendshape_count; ++sh) p.blendshapes[sh] = u(rng);
   }
   return frames;
 }
@@ -105,6 +106,11 @@ double compare_clips(const vrma_clip& a, const vrma_clip& b) {
       EXPECT_NEAR(pa.hips_position[c], pb.hips_position[c], 1e-5) << "frame " << f;
     for (int e = 0; e < k_expression_count; ++e)
       EXPECT_NEAR(pa.expressions[e], pb.expressions[e], 1e-6) << "frame " << f << " expr " << e;
+    for (int sh = 0; sh < k_blendshape_count; ++sh)
+      EXPECT_NEAR(pa.blendshapes[sh], pb.blendshapes[sh], 1e-6) << "frame " << f << " shape " << sh;
+    EXPECT_EQ(a.has_look_at, b.has_look_at);
+    if (a.has_look_at && b.has_look_at)
+      worst = std::max(worst, angle_deg(pa[bone::left_eye], pb[bone::left_eye]));
   }
   return worst;
 }
@@ -214,22 +220,43 @@ TEST(vrma_write, random_poses_round_trip) {
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(clip.frames[f].hips_position[c], frames[f].hips_position[c], 1e-6f);
     for (int e = 0; e < k_expression_count; ++e) {
-      if (is_vrma_expression(static_cast<expression>(e)))
+      const auto ex = static_cast<expression>(e);
+      if (ex == expression::brow_down_left || ex == expression::brow_down_right) {
+        // The name is ARKit's too: the node carries ARKit's weight, read into both.
+        const auto sh = *blendshape_from_name(expression_name(ex));
+        EXPECT_NEAR(clip.frames[f].expressions[e], frames[f][sh], 1e-6f);
+      } else if (is_vrma_expression(ex)) {
         EXPECT_NEAR(clip.frames[f].expressions[e], frames[f].expressions[e], 1e-6f);
-      else
+      } else {
         EXPECT_EQ(clip.frames[f].expressions[e], 0.f);  // gaze is lookAt's, not written
+      }
     }
+    for (int sh = 0; sh < k_blendshape_count; ++sh)
+      EXPECT_NEAR(clip.frames[f].blendshapes[sh], frames[f].blendshapes[sh], 1e-6f);
+    // The gaze: the mean of the two eyes, into both.
+    const glm::quat gaze =
+        slerp_shortest(frames[f][bone::left_eye], frames[f][bone::right_eye], 0.5f);
+    worst = std::max(worst, angle_deg(clip.frames[f][bone::left_eye], gaze));
+    worst = std::max(worst, angle_deg(clip.frames[f][bone::right_eye], gaze));
   }
   EXPECT_LT(worst, 0.01);
   std::printf("[ synthetic ] max rotation error %.3g degrees\n", worst);
-  EXPECT_EQ(clip.expression_names.size(), 12u);
+  // 17 .vrma-able expressions + 52 ARKit shapes, browDownLeft/Right shared.
+  EXPECT_EQ(clip.expression_names.size(), 17u + 52u - 2u);
+  EXPECT_TRUE(clip.has_look_at);
+  for (bool has : clip.has_blendshape) EXPECT_TRUE(has);
+  EXPECT_TRUE(clip.has_expression[idx(expression::surprised)]);
   EXPECT_NEAR(clip.rest_hips_height, standing_hips_height(make_proxy_skeleton()), 1e-5f);
 }
 
 TEST(vrma_write, file_structure_follows_the_spec) {
   std::mt19937 rng(3);
   std::vector<proxy_pose> frames = random_sequence(rng, 5, 0.1);
-  for (proxy_pose& p : frames) p.expressions.fill(0.f);
+  for (proxy_pose& p : frames) {
+    p.expressions.fill(0.f);
+    p.blendshapes.fill(0.f);  // no face, no gaze: no ARKit names, no lookAt
+    p[bone::left_eye] = p[bone::right_eye] = identity_quat();
+  }
   frames[2][expression::aa] = 0.5f;
   frames[3][expression::brow_up_left] = 0.25f;
   frames[1][expression::look_up] = 1.f;
@@ -250,6 +277,8 @@ TEST(vrma_write, file_structure_follows_the_spec) {
   EXPECT_FALSE(ext["expressions"]["preset"].contains("lookUp"));
   EXPECT_TRUE(ext["expressions"]["custom"].contains("browUpLeft"));
   EXPECT_EQ(ext["expressions"]["preset"].size(), 1u);
+  EXPECT_EQ(ext["expressions"]["custom"].size(), 1u);
+  EXPECT_FALSE(ext.contains("lookAt"));
   ASSERT_EQ(doc["animations"].size(), 1u);
   EXPECT_EQ(doc["animations"][0]["channels"].size(), 53u + 1u + 2u);
   for (const auto& node : doc["nodes"]) {
@@ -272,6 +301,144 @@ TEST(vrma_write, file_structure_follows_the_spec) {
     EXPECT_NEAR(q[2], sign * expect.z, 1e-6f);
     EXPECT_NEAR(q[3], sign * expect.w, 1e-6f);
   }
+}
+
+// Emotions as presets, ARKit's shapes as custom expressions by ARKit name, the gaze as a
+// lookAt node, laid out as docs/export.md says; read back (a second reader: the test's own
+// JSON walk).
+TEST(vrma_write, emotions_blendshapes_and_look_at_follow_the_spec) {
+  std::vector<proxy_pose> frames(3);
+  for (int k = 0; k < 3; ++k) frames[k].t = 0.1 * k;
+  frames[1][expression::happy] = 0.75f;
+  frames[2][expression::surprised] = 1.f;
+  frames[2][expression::brow_down_left] = 0.5f;  // the avatarmap brow...
+  frames[1][blendshape::jaw_open] = 0.25f;
+  frames[2][blendshape::brow_down_left] = 0.125f;  // ...and ARKit's shape of the same name
+  const glm::quat look_left = axis_angle(glm::vec3(0, 1, 0), glm::radians(20.f));
+  const glm::quat look_down = axis_angle(glm::vec3(1, 0, 0), glm::radians(10.f));
+  frames[1][bone::left_eye] = frames[1][bone::right_eye] = look_left;
+  frames[2][bone::left_eye] = frames[2][bone::right_eye] = look_down * look_left;
+  test::temp_dir dir("vrma");
+  const std::string path = dir.file("face.vrma");
+  ASSERT_TRUE(write_vrma(path, frames).ok());
+  nlohmann::json doc;
+  std::string bin;
+  ASSERT_TRUE(split_glb(test::read_text(path), doc, bin));
+  const auto& ext = doc["extensions"]["VRMC_vrm_animation"];
+  const auto& preset = ext["expressions"]["preset"];
+  const auto& custom = ext["expressions"]["custom"];
+  EXPECT_TRUE(preset.contains("happy"));
+  EXPECT_TRUE(preset.contains("surprised"));
+  EXPECT_FALSE(preset.contains("sad"));  // 0 in every frame: not written
+  EXPECT_EQ(preset.size(), 2u);
+  EXPECT_TRUE(custom.contains("jawOpen"));
+  EXPECT_TRUE(custom.contains("browDownLeft"));
+  EXPECT_EQ(custom.size(), 2u);  // only shapes some frame moves; browDownLeft once
+  ASSERT_TRUE(ext.contains("lookAt"));
+  const int look = ext["lookAt"]["node"];
+  // The lookAt node hangs under a pivot under the head; only rotations are animated on them
+  // (three-vrm rejects any other channel on the lookAt node).
+  const int head = ext["humanoid"]["humanBones"]["head"]["node"];
+  int pivot = -1;
+  for (std::size_t i = 0; i < doc["nodes"].size(); ++i)
+    for (const auto& c : doc["nodes"][i].value("children", nlohmann::json::array()))
+      if (c == look) pivot = static_cast<int>(i);
+  ASSERT_GE(pivot, 0);
+  bool pivot_under_head = false;
+  for (const auto& c : doc["nodes"][head]["children"]) pivot_under_head |= c == pivot;
+  EXPECT_TRUE(pivot_under_head);
+  int look_channels = 0;
+  for (const auto& ch : doc["animations"][0]["channels"])
+    if (ch["target"]["node"] == look || ch["target"]["node"] == pivot) {
+      EXPECT_EQ(ch["target"]["path"], "rotation");
+      ++look_channels;
+    }
+  EXPECT_EQ(look_channels, 2);
+
+  vrma_clip clip;
+  ASSERT_TRUE(read_vrma(path, clip).ok());
+  ASSERT_EQ(clip.frames.size(), 3u);
+  EXPECT_TRUE(clip.has_look_at);
+  EXPECT_NEAR(clip.frames[1][expression::happy], 0.75f, 1e-6f);
+  EXPECT_NEAR(clip.frames[2][expression::surprised], 1.f, 1e-6f);
+  EXPECT_NEAR(clip.frames[1][blendshape::jaw_open], 0.25f, 1e-6f);
+  EXPECT_NEAR(clip.frames[2][blendshape::brow_down_left], 0.125f, 1e-6f);
+  EXPECT_NEAR(clip.frames[2][expression::brow_down_left], 0.125f, 1e-6f);  // ARKit's weight
+  EXPECT_LT(angle_deg(clip.frames[0][bone::left_eye], identity_quat()), 1e-3);
+  EXPECT_LT(angle_deg(clip.frames[1][bone::right_eye], look_left), 1e-3);
+  EXPECT_LT(angle_deg(clip.frames[2][bone::left_eye], look_down * look_left), 1e-3);
+  EXPECT_EQ(clip.frames[2].confidence[idx(bone::left_eye)], 1.f);
+
+  // The spec's reading: without the lookAt node's rotation channel the gaze comes from the
+  // node's model-space position. With the pivot moved onto the head the target lies exactly
+  // along the gaze, 1 m ahead: the read eye looks the same way.
+  nlohmann::json edited = doc;
+  auto& channels = edited["animations"][0]["channels"];
+  for (std::size_t i = 0; i < channels.size(); ++i)
+    if (channels[i]["target"]["node"] == look) {
+      channels.erase(i);
+      break;
+    }
+  edited["nodes"][pivot]["translation"] = {0.0, 0.0, 0.0};
+  const std::string spec_path = dir.file("spec_look.vrma");
+  test::write_text(spec_path, make_glb(edited, bin));
+  vrma_clip by_position;
+  ASSERT_TRUE(read_vrma(spec_path, by_position).ok());
+  EXPECT_TRUE(by_position.has_look_at);
+  for (int k = 0; k < 3; ++k) {
+    const glm::vec3 want = frames[k][bone::left_eye] * glm::vec3(0, 0, 1);
+    const glm::vec3 got = by_position.frames[k][bone::left_eye] * glm::vec3(0, 0, 1);
+    EXPECT_GT(glm::dot(want, got), 0.f) << k;
+    // sin of the angle between them: < sin(0.01 degrees).
+    EXPECT_LT(glm::length(glm::cross(want, got)), 1.75e-4f) << k;
+  }
+
+  // blendshapes = false, look_at = false: neither ARKit names nor lookAt; the brow keeps
+  // avatarmap's own weight.
+  vrma_write_options plain;
+  plain.blendshapes = false;
+  plain.look_at = false;
+  ASSERT_TRUE(write_vrma(path, frames, plain).ok());
+  ASSERT_TRUE(read_vrma(path, clip).ok());
+  EXPECT_FALSE(clip.has_look_at);
+  EXPECT_FALSE(clip.has_blendshape[idx(blendshape::jaw_open)]);
+  EXPECT_EQ(clip.frames[1][blendshape::jaw_open], 0.f);
+  EXPECT_NEAR(clip.frames[2][expression::brow_down_left], 0.5f, 1e-6f);
+  EXPECT_EQ(clip.frames[1][bone::left_eye], identity_quat());
+}
+
+// A clip without a face writes no expression node at all: the file is no bigger than one of
+// the bones alone.
+TEST(vrma_write, a_clip_without_a_face_adds_nothing) {
+  std::mt19937 rng(9);
+  std::vector<proxy_pose> frames = random_sequence(rng, 30, 1.0 / 30.0);
+  for (proxy_pose& p : frames) {
+    p.expressions.fill(0.f);
+    p.blendshapes.fill(0.f);
+    p[bone::left_eye] = p[bone::right_eye] = identity_quat();
+  }
+  test::temp_dir dir("vrma");
+  const std::string path = dir.file("body.vrma");
+  ASSERT_TRUE(write_vrma(path, frames).ok());
+  nlohmann::json doc;
+  std::string bin;
+  ASSERT_TRUE(split_glb(test::read_text(path), doc, bin));
+  EXPECT_FALSE(doc["extensions"]["VRMC_vrm_animation"].contains("expressions"));
+  EXPECT_FALSE(doc["extensions"]["VRMC_vrm_animation"].contains("lookAt"));
+  EXPECT_EQ(doc["nodes"].size(), 53u);
+  // Times + hips + 53 rotations.
+  EXPECT_EQ(bin.size(), 30u * 4u + 30u * 12u + 53u * 30u * 16u);
+  // Non-finite shapes are cleaned like every weight (previous key's; 0 for the first).
+  frames[0][blendshape::cheek_puff] = NAN;
+  frames[1][blendshape::cheek_puff] = 0.5f;
+  frames[2][blendshape::cheek_puff] = INFINITY;
+  frames[3][blendshape::cheek_puff] = 7.f;
+  ASSERT_TRUE(write_vrma(path, frames).ok());
+  vrma_clip clip;
+  ASSERT_TRUE(read_vrma(path, clip).ok());
+  EXPECT_EQ(clip.frames[0][blendshape::cheek_puff], 0.f);
+  EXPECT_EQ(clip.frames[2][blendshape::cheek_puff], 0.5f);
+  EXPECT_EQ(clip.frames[3][blendshape::cheek_puff], 1.f);
 }
 
 TEST(vrma_write, resamples_at_fixed_fps) {

@@ -52,6 +52,18 @@ void write_synthetic(const std::string& path, int frames, bool header = true) {
   ASSERT_TRUE(writer.commit().ok());
 }
 
+// The job's first pass (src/rig/jobs/solve_file.cpp): the face calibrated over the whole file
+// (docs/expressions.md, "Calibration over a take"), whatever the filter.
+void calibrate_face(frame_solver& solver, const std::string& path) {
+  if (!solver.options().parts.face) return;
+  landmark_reader reader;
+  EXPECT_TRUE(reader.open(path).ok());
+  landmark_frame frame;
+  solver.begin_face_take();
+  while (reader.next(frame) == read_result::frame) solver.add_face_take(frame);
+  solver.end_face_take();
+}
+
 // The job's warm-up with the offline filter (src/rig/jobs/solve_file.cpp): the solver learns
 // the camera from the file's first 300 frames, forgets the view and learns it again with the
 // field of view known, then starts the take from the beginning with all of it known and held.
@@ -79,6 +91,7 @@ std::vector<proxy_pose> reference_poses(const std::string& path, const solver_op
   landmark_reader reader;
   EXPECT_TRUE(reader.open(path).ok());
   frame_solver solver(options);  // the live and no filters: no warm-up, as live
+  calibrate_face(solver, path);
   pose_filter filter(filter_options);
   foot_contact_stage contacts(contact_options, false);  // causal: one pose in, one out
   landmark_frame frame;
@@ -113,6 +126,7 @@ std::vector<proxy_pose> reference_offline_poses(const std::string& path, solver_
   landmark_reader reader;
   EXPECT_TRUE(reader.open(path).ok());
   frame_solver solver(options);
+  calibrate_face(solver, path);
   warm_up(solver, path);
   offline_smoother smoother(smooth);
   foot_contact_stage contacts(foot_contact_options{}, true);  // both-sided, as for files

@@ -103,6 +103,7 @@ TEST(OfflineSmoother, ConstantStaysExact) {
       p.rotations[b] = about(glm::vec3(1.f, 0.3f * b, -0.5f), 0.05f * b - 1.f);
     p.hips_position = glm::vec3(0.1f, 0.9f, -0.2f);
     for (int e = 0; e < k_expression_count; ++e) p.expressions[e] = 0.05f * e;
+    for (int s = 0; s < k_blendshape_count; ++s) p.blendshapes[s] = 0.015f * s;
     in.push_back(p);
   }
   const auto out = run(in);
@@ -115,6 +116,8 @@ TEST(OfflineSmoother, ConstantStaysExact) {
     EXPECT_NEAR(out[i].hips_position.z, -0.2f, 1e-6f);
     for (int e = 0; e < k_expression_count; ++e)
       EXPECT_NEAR(out[i].expressions[e], 0.05f * e, 1e-6f);
+    for (int s = 0; s < k_blendshape_count; ++s)
+      EXPECT_NEAR(out[i].blendshapes[s], 0.015f * s, 1e-6f);
     EXPECT_EQ(out[i].confidence, in[i].confidence);
   }
 }
@@ -550,6 +553,7 @@ TEST(OfflineSmoother, NonFiniteInputGivesFiniteOutput) {
     if (i % 7 == 0) p.rotations[k_arm] = glm::quat(NAN, 0.f, 0.f, 1.f);
     if (i % 5 == 0) p.hips_position.y = INFINITY;
     if (i % 3 == 0) p.expressions[2] = NAN;
+    if (i % 4 == 0) p.blendshapes[24] = INFINITY;
     if (i % 11 == 0) p.confidence[3] = NAN;
     in.push_back(p);
   }
@@ -560,7 +564,34 @@ TEST(OfflineSmoother, NonFiniteInputGivesFiniteOutput) {
     for (int b = 0; b < k_bone_count; ++b) ASSERT_TRUE(is_finite(p.rotations[b]));
     ASSERT_TRUE(is_finite(p.hips_position));
     for (float e : p.expressions) ASSERT_TRUE(std::isfinite(e));
+    for (float w : p.blendshapes) ASSERT_TRUE(std::isfinite(w));
   }
+}
+
+// Blendshapes are smoothed exactly like expressions (same kernel): a blendshape fed the same
+// noisy signal as an expression comes out the same, and the noise is damped.
+TEST(OfflineSmoother, BlendshapesAreSmoothedLikeExpressions) {
+  std::vector<proxy_pose> in;
+  std::uint32_t state = 7;
+  for (int i = 0; i < 90; ++i) {
+    proxy_pose p = frame_at(i);
+    state = state * 1664525u + 1013904223u;
+    const float w = 0.5f + 0.2f * (float(state >> 8) / float(1u << 24) - 0.5f);
+    p[expression::aa] = w;
+    p[blendshape::jaw_open] = w;
+    in.push_back(p);
+  }
+  const auto out = run(in);
+  ASSERT_EQ(out.size(), in.size());
+  double jitter_in = 0, jitter_out = 0;
+  for (size_t i = 0; i < out.size(); ++i) {
+    EXPECT_EQ(out[i][blendshape::jaw_open], out[i][expression::aa]) << i;
+    if (i > 0) {
+      jitter_in += std::abs(in[i][blendshape::jaw_open] - in[i - 1][blendshape::jaw_open]);
+      jitter_out += std::abs(out[i][blendshape::jaw_open] - out[i - 1][blendshape::jaw_open]);
+    }
+  }
+  EXPECT_LT(jitter_out, 0.7 * jitter_in);
 }
 
 TEST(OfflineSmoother, WindowIsBoundedAndNothingIsAllocatedPerFrame) {

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "avatarmap/core/rotation.hpp"
+#include "avatarmap/time/filter_rules.hpp"
 
 namespace avatarmap {
 namespace {
@@ -22,6 +23,7 @@ proxy_pose random_pose(std::mt19937& rng, double t) {
   for (auto& q : p.rotations) q = glm::normalize(glm::quat(u(rng) + 2.f, u(rng), u(rng), u(rng)));
   for (auto& c : p.confidence) c = 0.5f * (u(rng) + 1.f);
   for (auto& e : p.expressions) e = 0.5f * (u(rng) + 1.f);
+  for (auto& w : p.blendshapes) w = 0.5f * (u(rng) + 1.f);
   p.hips_position = glm::vec3(u(rng), 0.9f + 0.1f * u(rng), u(rng));
   return p;
 }
@@ -36,6 +38,8 @@ void expect_same_pose(const proxy_pose& a, const proxy_pose& b, float tol,
   }
   EXPECT_LE(glm::length(a.hips_position - b.hips_position), tol);
   for (int e = 0; e < k_expression_count; ++e) EXPECT_NEAR(a.expressions[e], b.expressions[e], tol);
+  for (int s = 0; s < k_blendshape_count; ++s)
+    EXPECT_NEAR(a.blendshapes[s], b.blendshapes[s], tol) << blendshape_name(blendshape(s));
 }
 
 bool pose_is_finite(const proxy_pose& p) {
@@ -43,6 +47,8 @@ bool pose_is_finite(const proxy_pose& p) {
     if (!is_finite(q)) return false;
   for (float e : p.expressions)
     if (!std::isfinite(e)) return false;
+  for (float w : p.blendshapes)
+    if (!std::isfinite(w)) return false;
   return is_finite(p.hips_position);
 }
 
@@ -83,6 +89,7 @@ TEST(pose_filter, channels_match_individual_filters) {
   one_euro_filter_quat rot(o.rotation, o.rotation_options);
   one_euro_filter_vec3 pos(o.position);
   one_euro_filter expr(o.expression);
+  one_euro_filter shape(o.expression);  // blendshapes take the expressions' parameters
   proxy_pose out;
   double t = 0.0, prev_t = 0.0;
   for (int i = 0; i < 30; ++i) {
@@ -97,6 +104,7 @@ TEST(pose_filter, channels_match_individual_filters) {
     EXPECT_LT(angle_between(out[bone::left_upper_arm], r), 1e-4f) << i;
     EXPECT_LT(glm::length(out.hips_position - p), 1e-4f) << i;
     EXPECT_NEAR(out[expression::aa], e, 1e-4f) << i;
+    EXPECT_NEAR(out[blendshape::jaw_open], shape(in[blendshape::jaw_open], fdt), 1e-4f) << i;
     EXPECT_EQ(out.confidence, in.confidence);
     for (float w : out.expressions) {
       EXPECT_GE(w, 0.f);
@@ -137,9 +145,11 @@ TEST(pose_filter, non_finite_values_are_held) {
   proxy_pose first = random_pose(rng, 0.0);
   first[bone::head] = glm::quat(k_nan, 0.f, 0.f, 0.f);  // missing from the start: identity
   first[expression::blink] = k_nan;
+  first[blendshape::eye_blink_left] = k_nan;
   f.apply(first, out);
   EXPECT_EQ(out[bone::head], identity_quat());
   EXPECT_EQ(out[expression::blink], 0.f);
+  EXPECT_EQ(out[blendshape::eye_blink_left], 0.f);
   const glm::quat arm = out[bone::left_upper_arm];
   const glm::vec3 hips = out.hips_position;
   proxy_pose bad = random_pose(rng, 1 / 30.0);
@@ -417,6 +427,26 @@ TEST(landmark_filter, disabled_copies) {
   auto b = make_frame(1 / 30.0, 0.3f);
   filter.apply(*b, *out);
   EXPECT_EQ(out->pose[2].x, b->pose[2].x);
+}
+
+// The expressions channel covers the blendshapes: off, both keep the raw values; on, a
+// blendshape and an expression fed the same signal come out the same.
+TEST(pose_filter, expression_channel_covers_blendshapes) {
+  std::mt19937 rng(12);
+  pose_filter on, off;
+  pose_filter_channels keep;
+  keep.expressions = false;
+  proxy_pose out_on, out_off;
+  for (int i = 0; i < 20; ++i) {
+    proxy_pose in = random_pose(rng, i / 30.0);
+    in[blendshape::mouth_smile_left] = in[expression::happy];
+    filter_pose_channels(on, {}, in, out_on);
+    filter_pose_channels(off, keep, in, out_off);
+    EXPECT_EQ(out_off.blendshapes, in.blendshapes);
+    EXPECT_EQ(out_off.expressions, in.expressions);
+    EXPECT_EQ(out_on[blendshape::mouth_smile_left], out_on[expression::happy]) << i;
+    if (i > 0) EXPECT_NE(out_on.blendshapes, in.blendshapes) << i;
+  }
 }
 
 }  // namespace

@@ -125,6 +125,8 @@ TEST(pose_resampler, lerps_position_expressions_and_takes_lower_confidence) {
   b.hips_position = glm::vec3(1.f, 0.f, 4.f);
   a[expression::aa] = 0.2f;
   b[expression::aa] = 0.6f;
+  a[blendshape::mouth_pucker] = 0.8f;
+  b[blendshape::mouth_pucker] = 0.4f;
   a.confidence[3] = 0.9f;
   b.confidence[3] = 0.4f;
   a.confidence[4] = 0.1f;
@@ -138,6 +140,8 @@ TEST(pose_resampler, lerps_position_expressions_and_takes_lower_confidence) {
   EXPECT_NEAR(out.hips_position.y, 0.75f, 1e-6f);
   EXPECT_NEAR(out.hips_position.z, 2.5f, 1e-6f);
   EXPECT_NEAR(out[expression::aa], 0.3f, 1e-6f);
+  EXPECT_NEAR(out[blendshape::mouth_pucker], 0.7f, 1e-6f);
+  EXPECT_EQ(out[blendshape::mouth_funnel], 0.f);
   EXPECT_EQ(out.confidence[3], 0.4f);
   EXPECT_EQ(out.confidence[4], 0.1f);
 }
@@ -291,6 +295,7 @@ TEST(pose_resampler, push_sanitises_non_finite_values) {
   a[bone::spine] = axis_angle(glm::vec3(1.f, 0.f, 0.f), 0.4f);
   a.hips_position = glm::vec3(0.1f, 0.9f, 0.f);
   a[expression::oh] = 0.5f;
+  a[blendshape::cheek_puff] = 0.25f;
   proxy_pose b = a;
   b.t = 0.04;
   b[bone::spine] = glm::quat(nan, 0.f, 0.f, 0.f);
@@ -299,6 +304,9 @@ TEST(pose_resampler, push_sanitises_non_finite_values) {
   b.hips_position.z = nan;
   b[expression::oh] = nan;
   b[expression::aa] = 3.f;
+  b[blendshape::cheek_puff] = nan;
+  b[blendshape::tongue_out] = -2.f;
+  b[blendshape::jaw_open] = std::numeric_limits<float>::infinity();
   b.confidence[0] = -1.f;
   pose_resampler r;
   r.push(a);
@@ -316,7 +324,14 @@ TEST(pose_resampler, push_sanitises_non_finite_values) {
       EXPECT_LE(e, 1.f);
     }
     EXPECT_LT(angle_between(out[bone::spine], a[bone::spine]), 1e-6f);
+    for (float w : out.blendshapes) {
+      EXPECT_GE(w, 0.f);
+      EXPECT_LE(w, 1.f);
+    }
     EXPECT_EQ(out[expression::oh], 0.5f);
+    EXPECT_EQ(out[blendshape::cheek_puff], 0.25f);  // held from a
+    EXPECT_EQ(out[blendshape::jaw_open], 0.f);      // held from a (0)
+    EXPECT_EQ(out[blendshape::tongue_out], 0.f);    // clamped
     EXPECT_GE(out.confidence[0], 0.f);
   }
 }

@@ -70,6 +70,26 @@ TEST(ResampleClip, FootContactIsInterpolatedLinearly) {
   }
 }
 
+TEST(ResampleClip, ExpressionsAndBlendshapesAreInterpolatedLinearly) {
+  std::vector<proxy_pose> clip(2);
+  clip[0].t = 0.0;
+  clip[1].t = 0.1;
+  clip[0][expression::surprised] = 1.f;
+  clip[1][blendshape::eye_wide_left] = 1.f;
+  clip[0][blendshape::jaw_open] = 0.2f;
+  clip[1][blendshape::jaw_open] = 0.6f;
+  std::vector<proxy_pose> out;
+  ASSERT_TRUE(resample_clip(clip, 40.0, true, out).ok());
+  ASSERT_EQ(out.size(), 5u);
+  for (size_t k = 0; k < out.size(); ++k) {
+    const float u = 0.25f * float(k);
+    EXPECT_NEAR(out[k][expression::surprised], 1.f - u, 1e-6f) << k;
+    EXPECT_NEAR(out[k][blendshape::eye_wide_left], u, 1e-6f) << k;
+    EXPECT_NEAR(out[k][blendshape::jaw_open], 0.2f + 0.4f * u, 1e-6f) << k;
+    EXPECT_EQ(out[k][blendshape::eye_wide_right], 0.f) << k;
+  }
+}
+
 TEST(ResampleClip, FloatTimesDoNotLoseTheLastFrameAndEdgeCases) {
   std::vector<proxy_pose> clip = spin_clip(30.0, 300, 0.0);
   clip.back().t = static_cast<float>(clip.back().t);  // 9.9666662 instead of 9.9666667

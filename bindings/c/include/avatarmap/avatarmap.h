@@ -49,9 +49,9 @@ extern "C" {
 /* Version of this header. avm_version() gives the version of the library actually loaded;
  * they differ only when a program runs against another build of the shared library. */
 #define AVM_VERSION_MAJOR 0
-#define AVM_VERSION_MINOR 1
+#define AVM_VERSION_MINOR 2
 #define AVM_VERSION_PATCH 0
-#define AVM_VERSION_STRING "0.1.0"
+#define AVM_VERSION_STRING "0.2.0"
 /* Single number for compile-time comparisons: MAJOR * 10000 + MINOR * 100 + PATCH. */
 #define AVM_VERSION_NUMBER (AVM_VERSION_MAJOR * 10000 + AVM_VERSION_MINOR * 100 + AVM_VERSION_PATCH)
 
@@ -92,7 +92,8 @@ AVATARMAP_C_API const char* avm_status_string(avm_status status);
 /* ---- skeleton vocabulary ------------------------------------------------------------- */
 
 #define AVM_BONE_COUNT 55
-#define AVM_EXPRESSION_COUNT 16
+#define AVM_EXPRESSION_COUNT 21 /* 16 before 0.2.0 */
+#define AVM_BLENDSHAPE_COUNT 52 /* ARKit's face blendshapes (added in 0.2.0) */
 
 /* Bones in the order of avm_pose's arrays: every parent comes before its children. */
 typedef enum avm_bone {
@@ -154,7 +155,8 @@ typedef enum avm_bone {
 } avm_bone;
 
 /* Expressions in the order of avm_pose's expressions array (VRM 1.0 preset names plus four
- * custom brow expressions). "Left" is the person's and the avatar's left. */
+ * custom brow expressions; the five emotions were appended in 0.2.0). "Left" is the person's
+ * and the avatar's left. */
 typedef enum avm_expression {
   AVM_EXPRESSION_BLINK = 0,
   AVM_EXPRESSION_BLINK_LEFT,
@@ -171,8 +173,72 @@ typedef enum avm_expression {
   AVM_EXPRESSION_BROW_UP_LEFT,
   AVM_EXPRESSION_BROW_UP_RIGHT,
   AVM_EXPRESSION_BROW_DOWN_LEFT,
-  AVM_EXPRESSION_BROW_DOWN_RIGHT
+  AVM_EXPRESSION_BROW_DOWN_RIGHT,
+  AVM_EXPRESSION_HAPPY, /* VRM 1.0 emotion presets (0.2.0) */
+  AVM_EXPRESSION_ANGRY,
+  AVM_EXPRESSION_SAD,
+  AVM_EXPRESSION_RELAXED,
+  AVM_EXPRESSION_SURPRISED
 } avm_expression;
+
+/* ARKit's 52 face blendshapes in the order of avm_pose's blendshapes array: Apple's
+ * ARFaceAnchor.BlendShapeLocation names and meanings, in Apple's alphabetical order (also
+ * MediaPipe's face landmarker's). "Left" is the person's own left. Weights 0 .. 1.
+ * docs/expressions.md defines how each is measured. Added in 0.2.0. */
+typedef enum avm_blendshape {
+  AVM_BLENDSHAPE_BROW_DOWN_LEFT = 0,
+  AVM_BLENDSHAPE_BROW_DOWN_RIGHT,
+  AVM_BLENDSHAPE_BROW_INNER_UP,
+  AVM_BLENDSHAPE_BROW_OUTER_UP_LEFT,
+  AVM_BLENDSHAPE_BROW_OUTER_UP_RIGHT,
+  AVM_BLENDSHAPE_CHEEK_PUFF,
+  AVM_BLENDSHAPE_CHEEK_SQUINT_LEFT,
+  AVM_BLENDSHAPE_CHEEK_SQUINT_RIGHT,
+  AVM_BLENDSHAPE_EYE_BLINK_LEFT,
+  AVM_BLENDSHAPE_EYE_BLINK_RIGHT,
+  AVM_BLENDSHAPE_EYE_LOOK_DOWN_LEFT,
+  AVM_BLENDSHAPE_EYE_LOOK_DOWN_RIGHT,
+  AVM_BLENDSHAPE_EYE_LOOK_IN_LEFT,
+  AVM_BLENDSHAPE_EYE_LOOK_IN_RIGHT,
+  AVM_BLENDSHAPE_EYE_LOOK_OUT_LEFT,
+  AVM_BLENDSHAPE_EYE_LOOK_OUT_RIGHT,
+  AVM_BLENDSHAPE_EYE_LOOK_UP_LEFT,
+  AVM_BLENDSHAPE_EYE_LOOK_UP_RIGHT,
+  AVM_BLENDSHAPE_EYE_SQUINT_LEFT,
+  AVM_BLENDSHAPE_EYE_SQUINT_RIGHT,
+  AVM_BLENDSHAPE_EYE_WIDE_LEFT,
+  AVM_BLENDSHAPE_EYE_WIDE_RIGHT,
+  AVM_BLENDSHAPE_JAW_FORWARD,
+  AVM_BLENDSHAPE_JAW_LEFT,
+  AVM_BLENDSHAPE_JAW_OPEN,
+  AVM_BLENDSHAPE_JAW_RIGHT,
+  AVM_BLENDSHAPE_MOUTH_CLOSE,
+  AVM_BLENDSHAPE_MOUTH_DIMPLE_LEFT,
+  AVM_BLENDSHAPE_MOUTH_DIMPLE_RIGHT,
+  AVM_BLENDSHAPE_MOUTH_FROWN_LEFT,
+  AVM_BLENDSHAPE_MOUTH_FROWN_RIGHT,
+  AVM_BLENDSHAPE_MOUTH_FUNNEL,
+  AVM_BLENDSHAPE_MOUTH_LEFT,
+  AVM_BLENDSHAPE_MOUTH_LOWER_DOWN_LEFT,
+  AVM_BLENDSHAPE_MOUTH_LOWER_DOWN_RIGHT,
+  AVM_BLENDSHAPE_MOUTH_PRESS_LEFT,
+  AVM_BLENDSHAPE_MOUTH_PRESS_RIGHT,
+  AVM_BLENDSHAPE_MOUTH_PUCKER,
+  AVM_BLENDSHAPE_MOUTH_RIGHT,
+  AVM_BLENDSHAPE_MOUTH_ROLL_LOWER,
+  AVM_BLENDSHAPE_MOUTH_ROLL_UPPER,
+  AVM_BLENDSHAPE_MOUTH_SHRUG_LOWER,
+  AVM_BLENDSHAPE_MOUTH_SHRUG_UPPER,
+  AVM_BLENDSHAPE_MOUTH_SMILE_LEFT,
+  AVM_BLENDSHAPE_MOUTH_SMILE_RIGHT,
+  AVM_BLENDSHAPE_MOUTH_STRETCH_LEFT,
+  AVM_BLENDSHAPE_MOUTH_STRETCH_RIGHT,
+  AVM_BLENDSHAPE_MOUTH_UPPER_UP_LEFT,
+  AVM_BLENDSHAPE_MOUTH_UPPER_UP_RIGHT,
+  AVM_BLENDSHAPE_NOSE_SNEER_LEFT,
+  AVM_BLENDSHAPE_NOSE_SNEER_RIGHT,
+  AVM_BLENDSHAPE_TONGUE_OUT
+} avm_blendshape;
 
 /* VRM 1.0 name of a bone ("hips", "leftUpperArm", ...); NULL when `bone` is outside
  * [0, AVM_BONE_COUNT). Static string; thread-safe. */
@@ -192,6 +258,15 @@ AVATARMAP_C_API const char* avm_expression_name(int expression);
 
 /* Expression index from its exact name; -1 when unknown or `name` is NULL. Thread-safe. */
 AVATARMAP_C_API int avm_expression_from_name(const char* name);
+
+/* ARKit name of a blendshape as written in *.pose.jsonl ("browDownLeft", "jawOpen", ...);
+ * NULL when `blendshape` is outside [0, AVM_BLENDSHAPE_COUNT). Static string; thread-safe.
+ * Added in 0.2.0. */
+AVATARMAP_C_API const char* avm_blendshape_name(int blendshape);
+
+/* Blendshape index from its exact, case-sensitive ARKit name; -1 when unknown or `name` is
+ * NULL. Thread-safe. Added in 0.2.0. */
+AVATARMAP_C_API int avm_blendshape_from_name(const char* name);
 
 /* ---- input: one frame of landmarks --------------------------------------------------- */
 
@@ -236,13 +311,22 @@ typedef struct avm_pose {
   float hips_position[3];             /* metres, VRM space: Y = hips height above the soles */
   float rotations[AVM_BONE_COUNT][4]; /* local rotation {x, y, z, w}, unit length */
   float confidence[AVM_BONE_COUNT];   /* 0 = not observed .. 1 = observed */
-  float expressions[AVM_EXPRESSION_COUNT]; /* weights 0 .. 1, see avm_expression */
+  /* Weights 0 .. 1, see avm_expression. Changed in 0.2.0: 21 instead of 16 (the five
+   * emotions appended), which moves every member after it: rebuild against this header. */
+  float expressions[AVM_EXPRESSION_COUNT];
   /* Added in 0.1.0 at the end (the struct grew by 8 bytes: arrays of avm_pose built against
    * an older header have another stride; rebuild against this one). Per foot, [0] left
    * [1] right: 0 = the foot moves freely .. 1 = planted on the floor (docs/contacts.md);
    * values between blend foot locking in and out. Read by avm_clip_write (clamped to
    * [0, 1], NaN = 0). */
   float foot_contact[2];
+  /* Added in 0.2.0 at the end (with the 5 new expressions the struct grew by 228 bytes:
+   * changed in 0.2.0: rebuild). ARKit's 52 blendshape weights 0 .. 1, see avm_blendshape;
+   * all 0 when the face was not solved. Taken like expressions wherever a pose goes in
+   * (a non-finite weight is missing: the previous frame's, 0 for the first). */
+  float blendshapes[AVM_BLENDSHAPE_COUNT];
+  /* (On the usual ABIs 4 bytes of padding follow, sizeof(avm_pose) = 1424; the library writes
+   * them as 0 in every pose it gives out.) */
 } avm_pose;
 
 /* ---- solver options ------------------------------------------------------------------ */
@@ -292,7 +376,7 @@ typedef struct avm_solver_options {
   float position_min_cutoff;   /* 1.0 */
   float position_beta;         /* 2.0 */
   float position_d_cutoff;     /* 1.0 */
-  int32_t filter_expressions;  /* filter the expression weights; 1 */
+  int32_t filter_expressions;  /* filter the expression and blendshape weights; 1 */
   float expression_min_cutoff; /* 3.0 */
   float expression_beta;       /* 1.0 */
   float expression_d_cutoff;   /* 1.0 */
@@ -421,7 +505,7 @@ AVATARMAP_C_API avm_status avm_solver_get_pose(const avm_solver* solver, avm_pos
 
 /* Writes the pose at render time t (seconds, on the frames' clock) into *out_pose. The solver
  * keeps the last 4 pushed (filtered) poses: between two of them the pose is interpolated
- * (rotations by shortest-arc slerp, position and expressions linearly, confidence the
+ * (rotations by shortest-arc slerp, position, expressions and blendshapes linearly, confidence the
  * minimum); before the oldest kept it is the oldest; past the newest it is extrapolated at
  * constant velocity for at most max_extrapolation_seconds, then held. Before the first push
  * (or after a reset) it is the rest pose. out_pose->t = t. Allocates nothing; does not
@@ -629,8 +713,8 @@ AVATARMAP_C_API void avm_clip_destroy(avm_clip* clip);
  * than the previous frame's. Non-finite values are taken as missing: a rotation with a
  * non-finite component (or of zero length) becomes the previous frame's (identity for the
  * first frame) with confidence 0, a non-finite hips position the previous one (0, 0.95, 0 for
- * the first), a non-finite expression weight the previous one (0); rotations are normalised,
- * weights and confidences clamped to [0, 1].
+ * the first), a non-finite expression or blendshape weight the previous one (0); rotations
+ * are normalised, weights and confidences clamped to [0, 1].
  * Failures (the clip is unchanged): AVM_ERROR_INVALID_ARGUMENT (clip or pose NULL, t not
  *   finite or not after the previous frame's), AVM_ERROR_OUT_OF_MEMORY.
  *   avm_clip_last_error() says which. */
