@@ -46,3 +46,7 @@ fi
 # registry the viewer's tests skip and `avatarmap view` says what to run.
 "$(dirname "${BASH_SOURCE[0]}")/fetch_viewer_modules.sh" ||
   echo "setup: warning: the viewer's modules could not be fetched (scripts/fetch_viewer_modules.sh)" >&2
+# Khronos's glTF validator from npm, for the tests that validate the files we write; without
+# it those checks skip.
+"$(dirname "${BASH_SOURCE[0]}")/fetch_gltf_validator.sh" ||
+  echo "setup: warning: the glTF validator could not be fetched (scripts/fetch_gltf_validator.sh)" >&2

@@ -60,7 +60,8 @@ void expressions_from_blendshapes(const blendshape_weights& b, expression_weight
   out[idx(expression::blink_left)] = bl - both;
   out[idx(expression::blink_right)] = br - both;
 
-  const float o = w(bs::jaw_open);
+  // The mouth's opening: the jaw's, less what mouthClose keeps the lips together.
+  const float o = clamp01(w(bs::jaw_open) - w(bs::mouth_close));
   const float r = std::max(w(bs::mouth_funnel), w(bs::mouth_pucker));
   const float smile = mean(bs::mouth_smile_left, bs::mouth_smile_right);
   const float wide = std::max(mean(bs::mouth_stretch_left, bs::mouth_stretch_right), smile);

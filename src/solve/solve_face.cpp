@@ -29,6 +29,8 @@ struct feature_info {
   float quantile;    // which quantile of the face's own values is its neutral
   float full;        // a blendshape's full change (step size of the slow refinement)
   float lo, hi;      // plausible neutral values: a calibration is clamped to them
+  // The take's slope on the head's turn: at most this many full changes over a turn of 0.5.
+  float max_slope_fulls = 2.f;
 };
 // The population face is the synthetic generator's default face (landmark_synth.cpp: eye
 // 30 mm wide with a lid gap of 0.20 of it on average, brows 10-12 mm above the corners, mouth
@@ -38,25 +40,29 @@ struct feature_info {
 // (brief, below) do not pull it down; mouth gap: the 0.2 quantile (the mouth rests closed,
 // talking opens it most of the time); the others the median.
 constexpr feature_info k_features[k_face_feature_count] = {
-    {0.20f, 0.6f, 0.18f, 0.08f, 0.40f},    // eye gap l
-    {0.20f, 0.6f, 0.18f, 0.08f, 0.40f},    // eye gap r
-    {0.41f, 0.5f, 0.25f, 0.10f, 0.90f},    // brow inner l
-    {0.41f, 0.5f, 0.25f, 0.10f, 0.90f},    // brow inner r
-    {0.343f, 0.5f, 0.25f, 0.f, 0.90f},     // brow outer l
-    {0.343f, 0.5f, 0.25f, 0.f, 0.90f},     // brow outer r
-    {-0.333f, 0.5f, 0.117f, -0.9f, 0.1f},  // cheek l
-    {-0.333f, 0.5f, 0.117f, -0.9f, 0.1f},  // cheek r
-    {0.f, 0.2f, 0.315f, 0.f, 0.1f},        // mouth gap
-    {0.543f, 0.5f, 0.163f, 0.35f, 0.80f},  // mouth width
-    {0.011f, 0.5f, 0.10f, -0.12f, 0.12f},  // corner up l
-    {0.011f, 0.5f, 0.10f, -0.12f, 0.12f},  // corner up r
-    {0.272f, 0.5f, 0.076f, 0.17f, 0.40f},  // corner out l
-    {0.272f, 0.5f, 0.076f, 0.17f, 0.40f},  // corner out r
-    {0.f, 0.5f, 0.076f, -0.15f, 0.15f},    // mouth shift
-    {0.50f, 0.5f, 0.17f, 0.35f, 0.65f},    // iris u l
-    {0.50f, 0.5f, 0.17f, 0.35f, 0.65f},    // iris u r
-    {0.02f, 0.5f, 0.14f, -0.12f, 0.16f},   // iris v l
-    {0.02f, 0.5f, 0.14f, -0.12f, 0.16f},   // iris v r
+    {0.20f, 0.6f, 0.18f, 0.08f, 0.40f},      // eye gap l
+    {0.20f, 0.6f, 0.18f, 0.08f, 0.40f},      // eye gap r
+    {0.41f, 0.5f, 0.25f, 0.10f, 0.90f},      // brow inner l
+    {0.41f, 0.5f, 0.25f, 0.10f, 0.90f},      // brow inner r
+    {0.343f, 0.5f, 0.25f, 0.f, 0.90f},       // brow outer l
+    {0.343f, 0.5f, 0.25f, 0.f, 0.90f},       // brow outer r
+    {-0.333f, 0.5f, 0.117f, -0.9f, 0.1f},    // cheek l
+    {-0.333f, 0.5f, 0.117f, -0.9f, 0.1f},    // cheek r
+    {0.f, 0.2f, 0.315f, 0.f, 0.1f},          // mouth gap
+    {0.543f, 0.5f, 0.163f, 0.35f, 0.80f},    // mouth width
+    {0.011f, 0.5f, 0.10f, -0.12f, 0.12f},    // corner up l
+    {0.011f, 0.5f, 0.10f, -0.12f, 0.12f},    // corner up r
+    {0.272f, 0.5f, 0.076f, 0.17f, 0.40f},    // corner out l
+    {0.272f, 0.5f, 0.076f, 0.17f, 0.40f},    // corner out r
+    {0.f, 0.5f, 0.076f, -0.15f, 0.15f},      // mouth shift
+    {0.f, 0.5f, 0.10f, -0.4f, 0.4f, 4.f},    // jaw shift
+    {0.087f, 0.5f, 0.054f, 0.02f, 0.20f},    // upper lip height
+    {0.109f, 0.5f, 0.071f, 0.02f, 0.25f},    // lower lip height
+    {1.196f, 0.5f, 0.37f, 0.8f, 1.6f, 4.f},  // chin drop
+    {0.50f, 0.5f, 0.17f, 0.35f, 0.65f},      // iris u l
+    {0.50f, 0.5f, 0.17f, 0.35f, 0.65f},      // iris u r
+    {0.02f, 0.5f, 0.14f, -0.12f, 0.16f},     // iris v l
+    {0.02f, 0.5f, 0.14f, -0.12f, 0.16f},     // iris v r
 };
 // After the window: a stochastic quantile estimate (Robbins-Monro). Each frame the neutral
 // moves up by step * q when the value is above it, down by step * (1 - q) below, with
@@ -98,6 +104,20 @@ constexpr float k_smile_out = 0.6f;
 constexpr float k_frown_full = 0.054f;
 constexpr float k_stretch_full = 0.076f;
 constexpr float k_shift_full = 0.076f;
+// The chin moves 0.10 face widths (9 mm) sideways for jawLeft/Right (the lower lip rides on
+// the jaw: the mouth's sideways measurements are taken from the upper lip, 0, alone).
+// A lip rolled in (mouthRollUpper/Lower) shows 0.054 (5 mm) less of the upper lip's height,
+// 0.071 (6.5 mm) less of the lower's; its outer point moves toward the lip line, so half of
+// it moves the outer lips' middle the corners' height is measured from (taken back out).
+constexpr float k_jaw_side_full = 0.10f;
+// The chin drops 0.37 face widths (34 mm) at jawOpen 1 (more than the lower lip's 0.315: it
+// is further from the jaw's hinge). The jaw read from the chin beyond the one read from the
+// lips is mouthClose (the lips kept together); a difference within k_close_margin of a full
+// opening reads as none (the chin's drop per lip's drop differs between faces).
+constexpr float k_chin_full = 0.37f;
+constexpr float k_close_margin = 0.05f;
+constexpr float k_roll_upper_full = 0.054f;
+constexpr float k_roll_lower_full = 0.071f;
 // Eyeball radius in eye widths (12 mm for a 30 mm eye): the iris moves by the radius times
 // the sine of the eye's turn.
 constexpr float k_eyeball_radius = 0.4f;
@@ -162,15 +182,30 @@ void measure_features(const face_points& fp, const glm::quat& head_w, const glm:
   }
   const glm::vec3 up = normalize_or(orth(head_up, head_x), k_y);
   const glm::vec3 centre = 0.5f * (fp.lip_top + fp.lip_bottom);
-  v[ff_mouth_gap] = glm::length(fp.lip_upper - fp.lip_lower) * inv_face;
+  // The lips' opening, its sideways part left out (a jaw moved sideways carries the lower lip
+  // with it: that is not an opening).
+  const glm::vec3 lip_gap = fp.lip_upper - fp.lip_lower;
+  v[ff_mouth_gap] = glm::length(lip_gap - glm::dot(lip_gap, head_x) * head_x) * inv_face;
   v[ff_mouth_width] = glm::length(fp.mouth[0] - fp.mouth[1]) * inv_face;
   for (int s = 0; s < 2; ++s) {
     const glm::vec3 d = fp.mouth[s] - centre;
     v[ff_corner_up_l + s] = glm::dot(d, up) * inv_face;
     // The person's left corner lies toward +X, the right one toward -X.
-    v[ff_corner_out_l + s] = glm::dot(d, head_x) * (s == 0 ? inv_face : -inv_face);
+    v[ff_corner_out_l + s] =
+        glm::dot(fp.mouth[s] - fp.lip_top, head_x) * (s == 0 ? inv_face : -inv_face);
   }
-  v[ff_mouth_shift] = glm::dot(centre - fp.nose_base, head_x) * inv_face;
+  v[ff_mouth_shift] = glm::dot(fp.lip_top - fp.nose_base, head_x) * inv_face;
+  // The chin against the outer eye corners (at about its depth, so a turned head hardly
+  // moves it): the head's X axis comes from the eye corners and cheeks, which the jaw does
+  // not move, and its up axis is made perpendicular to X, so a sideways chin leaves both.
+  v[ff_jaw_shift] =
+      glm::dot(fp.chin - 0.5f * (fp.eye[0].outer + fp.eye[1].outer), head_x) * inv_face;
+  // The lips' visible (vermilion) heights along the head's up axis: a lip rolled in shows
+  // less of it.
+  v[ff_lip_upper_h] = glm::dot(fp.lip_top - fp.lip_upper, up) * inv_face;
+  v[ff_lip_lower_h] = glm::dot(fp.lip_lower - fp.lip_bottom, up) * inv_face;
+  // The chin below the eyes: the jaw's opening whether the lips part or not.
+  v[ff_chin_drop] = glm::dot(0.5f * (fp.eye[0].outer + fp.eye[1].outer) - fp.chin, up) * inv_face;
 }
 
 }  // namespace
@@ -267,8 +302,6 @@ namespace {
 constexpr int k_fit_iterations = 6;
 constexpr double k_huber = 1.345;
 constexpr double k_slope_prior_spread = 0.05;  // about 3 degrees
-// A slope moves the neutral at most this many full changes over a turn of 0.5 (30 degrees).
-constexpr float k_max_slope_fulls = 2.f;
 // The dead zone: this many standard deviations of the frame-to-frame noise (from the median
 // absolute change between consecutive read frames, what the fit leaves), at most this share
 // of a full change.
@@ -352,7 +385,7 @@ bool calibrate_take(const face_take& take, face_calibration& c) {
         w[k] = u > 1.0 ? 1.0 / u : 1.0;
       }
     }
-    const float max_slope = k_max_slope_fulls * fi.full / 0.5f;
+    const float max_slope = fi.max_slope_fulls * fi.full / 0.5f;
     const float sx = glm::clamp(static_cast<float>(beta[1]), -max_slope, max_slope);
     const float sy = glm::clamp(static_cast<float>(beta[2]), -max_slope, max_slope);
     // The neutral: the table's quantile of what the slopes leave, at a face looking straight
@@ -457,6 +490,11 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
   b.fill(0.f);
   using bs = blendshape;
   auto set_pair = [&](bs left, int s, float w) { b[idx(left) + s] = clamp01(w); };
+  // The lips' rolls move the outer lips' middle, (0 + 17) / 2, the corners' height is taken
+  // from: their share comes back out.
+  const float jaw_side = d(ff_jaw_shift);
+  const float d_upper_h = d(ff_lip_upper_h), d_lower_h = d(ff_lip_lower_h);
+  const float centre_up = 0.5f * (d_upper_h - d_lower_h);
   float blink[2];
   float inner_up = 0.f;
   for (int s = 0; s < 2; ++s) {
@@ -470,7 +508,7 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
     set_pair(bs::brow_outer_up_left, s, dout / k_brow_up_full);
     set_pair(bs::brow_down_left, s, -0.5f * (di + dout) / k_brow_down_full);
     set_pair(bs::cheek_squint_left, s, d(ff_cheek_l + s) / k_cheek_full);
-    const float up = d(ff_corner_up_l + s);
+    const float up = d(ff_corner_up_l + s) + centre_up;
     const float out = d(ff_corner_out_l + s);
     set_pair(bs::mouth_smile_left, s, up / k_smile_full);
     set_pair(bs::mouth_frown_left, s, -up / k_frown_full);
@@ -485,10 +523,18 @@ void measure_face(const prepared_frame& f, const solver_options& o, const glm::q
   const float funnel = std::min(narrow, clamp01(open / k_funnel_open));
   b[idx(bs::mouth_funnel)] = funnel;
   b[idx(bs::mouth_pucker)] = narrow - funnel;
-  b[idx(bs::jaw_open)] = clamp01((open - k_funnel_open * funnel) / k_jaw_full);
+  const float jaw_lips = clamp01((open - k_funnel_open * funnel) / k_jaw_full);
+  const float jaw_chin = d(ff_chin_drop) / k_chin_full;
+  const float close = clamp01((jaw_chin - jaw_lips - k_close_margin) / (1.f - k_close_margin));
+  b[idx(bs::jaw_open)] = clamp01(jaw_lips + close);
+  b[idx(bs::mouth_close)] = close;
   const float shift = d(ff_mouth_shift);
   b[idx(bs::mouth_left)] = clamp01(shift / k_shift_full);
   b[idx(bs::mouth_right)] = clamp01(-shift / k_shift_full);
+  b[idx(bs::jaw_left)] = clamp01(jaw_side / k_jaw_side_full);
+  b[idx(bs::jaw_right)] = clamp01(-jaw_side / k_jaw_side_full);
+  b[idx(bs::mouth_roll_upper)] = clamp01(-d_upper_h / k_roll_upper_full);
+  b[idx(bs::mouth_roll_lower)] = clamp01(-d_lower_h / k_roll_lower_full);
 
   // Gaze: the iris's move from its own neutral place, over the eyeball's radius, is the sine
   // of the eye's turn. The left eye's outer corner is on the person's left (+X): moving toward

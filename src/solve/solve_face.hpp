@@ -29,9 +29,13 @@ enum face_feature : int {
   ff_mouth_width,  // corner to corner / face width
   ff_corner_up_l,  // mouth corner above the outer lips' middle / face width
   ff_corner_up_r,
-  ff_corner_out_l,  // mouth corner out from the outer lips' middle / face width
+  ff_corner_out_l,  // mouth corner out from the upper lip's outer middle (0) / face width
   ff_corner_out_r,
-  ff_mouth_shift,  // outer lips' middle toward the person's left of the nose base / face width
+  ff_mouth_shift,  // upper lip's outer middle (0) toward the person's left of the nose base / F
+  ff_jaw_shift,    // chin toward the person's left of the outer eye corners' midpoint / face w.
+  ff_lip_upper_h,  // upper lip's height: outer (0) above inner (13) / face width
+  ff_lip_lower_h,  // lower lip's height: inner (14) above outer (17) / face width
+  ff_chin_drop,    // chin below the outer eye corners' midpoint / face width
   ff_iris_u_l,     // iris (centre and ring) from the inner corner along the corner line / w
   ff_iris_u_r,
   ff_iris_v_l,  // iris (centre and ring) above the corners' midpoint / eye width

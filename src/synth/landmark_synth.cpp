@@ -221,6 +221,10 @@ synth_face_shape draw_face_shape(std::uint32_t seed) {
   f.eyeball_radius = u(0.0112f, 0.0128f);
   f.iris_u = u(-0.03f, 0.03f);
   f.iris_v = u(-0.03f, 0.03f);
+  f.jaw_side = u(0.0085f, 0.0105f);
+  f.roll_upper = u(0.0045f, 0.0055f);
+  f.roll_lower = u(0.006f, 0.007f);
+  f.chin_ratio = u(1.12f, 1.22f);
   return f;
 }
 
@@ -529,7 +533,11 @@ void landmark_synth::build_face(const proxy_pose& pose) {
   // jaw; the lips' middles (13/14 inner, 0/17 outer) from the jaw and the funnel.
   const float round = std::max(B(blendshape::mouth_funnel), B(blendshape::mouth_pucker));
   const float half_w = 0.5f * fs.mouth_width * s * (1.f - fs.narrow * round);
-  const float drop = fs.jaw_drop * s * B(blendshape::jaw_open);
+  // The jaw drops the chin; the lips follow it but for what mouthClose keeps together (the
+  // lower lip rises back by that share of the jaw's drop).
+  const float jaw_open = B(blendshape::jaw_open);
+  const float closed = std::min(B(blendshape::mouth_close), jaw_open);
+  const float drop = fs.jaw_drop * s * (jaw_open - closed);
   const float part = fs.funnel_open * s * B(blendshape::mouth_funnel);
   const float shift = fs.shift * s * (B(blendshape::mouth_left) - B(blendshape::mouth_right));
   const float y = k_mouth_y * s, z = k_mouth_z * s;
@@ -544,11 +552,19 @@ void landmark_synth::build_face(const proxy_pose& pose) {
     f[side == 0 ? 291 : 61] = glm::vec3(shift + sx * out, y + up, z);
     f[side == 0 ? 308 : 78] = glm::vec3(shift + sx * 0.9f * out, y + up, z + 0.003f * s);
   }
+  // The jaw's sideways move carries the chin and the lower lip; a lip rolled in brings its
+  // outer edge (0 upper, 17 lower) toward the lip line.
+  const float jaw = fs.jaw_side * s * (B(blendshape::jaw_left) - B(blendshape::jaw_right));
+  const float roll_up = fs.roll_upper * s * B(blendshape::mouth_roll_upper);
+  const float roll_down = fs.roll_lower * s * B(blendshape::mouth_roll_lower);
   const float forward = 0.006f * s * round;
   f[13] = glm::vec3(shift, y + 0.5f * part, 0.095f * s + forward);
-  f[14] = glm::vec3(shift, y - 0.5f * part - drop, 0.095f * s + forward);
-  f[0] = glm::vec3(shift, y + 0.008f * s + 0.5f * part, 0.099f * s + forward);
-  f[17] = glm::vec3(shift, y - 0.010f * s - 0.5f * part - drop, 0.097f * s + forward);
+  f[14] = glm::vec3(shift + jaw, y - 0.5f * part - drop, 0.095f * s + forward);
+  f[0] = glm::vec3(shift, y + 0.008f * s + 0.5f * part - roll_up, 0.099f * s + forward);
+  f[17] =
+      glm::vec3(shift + jaw, y - 0.010f * s - 0.5f * part - drop + roll_down, 0.097f * s + forward);
+  f[152].x += jaw;
+  f[152].y -= fs.chin_ratio * fs.jaw_drop * s * jaw_open;
 
   const glm::quat& head = fk_.world[idx(bone::head)];
   const glm::vec3& origin = fk_.joints[idx(bone::head)];

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "avatarmap/core/rotation.hpp"
 #include "avatarmap/synth/landmark_synth.hpp"
@@ -221,6 +223,35 @@ proxy_pose random_pose(std::mt19937& rng, const random_pose_limits& L) {
       default:
         break;
     }
+    // The jaw sideways and the lips rolled in, drawn from a generator of their own seeded by
+    // this pose's draws (the shared sequence, and so every other draw of a seed, is kept): the
+    // jaw to one side in 10 % of the poses (with the mouth as drawn), the lips rolled in, one
+    // or both, in 10 % (pressed in thought: the jaw then closed).
+    std::uint32_t h = 2166136261u;
+    for (float v : bs) {
+      std::uint32_t bits;
+      std::memcpy(&bits, &v, sizeof bits);
+      h = (h ^ bits) * 16777619u;
+    }
+    for (int k = 0; k < 4; ++k) {
+      std::uint32_t bits;
+      std::memcpy(&bits, &eye[k], sizeof bits);
+      h = (h ^ bits) * 16777619u;
+    }
+    std::mt19937 own(h);
+    if (uniform(own, 0.f, 1.f) < 0.1f)
+      set(uniform(own, 0.f, 1.f) < 0.5f ? blendshape::jaw_left : blendshape::jaw_right,
+          uniform(own, 0.f, 0.8f));
+    if (uniform(own, 0.f, 1.f) < 0.1f) {
+      const float which = uniform(own, 0.f, 3.f);
+      if (which < 2.f) set(blendshape::mouth_roll_upper, uniform(own, 0.f, 1.f));
+      if (which >= 1.f) set(blendshape::mouth_roll_lower, uniform(own, 0.f, 1.f));
+      set(blendshape::jaw_open, std::min(bs[idx(blendshape::jaw_open)], 0.1f));
+    }
+    // Lips kept together with the jaw open (mumbling, an "m" or "b" on the way) in 20 % of the
+    // poses whose jaw is open.
+    if (bs[idx(blendshape::jaw_open)] > 0.2f && uniform(own, 0.f, 1.f) < 0.2f)
+      set(blendshape::mouth_close, bs[idx(blendshape::jaw_open)] * uniform(own, 0.3f, 1.f));
   }
   set_truth_expressions(p);
   return p;

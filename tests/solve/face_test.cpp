@@ -46,15 +46,33 @@ proxy_pose solve_one(landmark_synth& synth, const proxy_pose& truth) {
 }
 
 // The shapes the solver measures (docs/expressions.md); the others stay 0.
-constexpr blendshape k_measured[] = {
-    blendshape::brow_down_left,     blendshape::brow_down_right,     blendshape::brow_inner_up,
-    blendshape::brow_outer_up_left, blendshape::brow_outer_up_right, blendshape::cheek_squint_left,
-    blendshape::cheek_squint_right, blendshape::eye_blink_left,      blendshape::eye_blink_right,
-    blendshape::eye_wide_left,      blendshape::eye_wide_right,      blendshape::jaw_open,
-    blendshape::mouth_frown_left,   blendshape::mouth_frown_right,   blendshape::mouth_funnel,
-    blendshape::mouth_left,         blendshape::mouth_pucker,        blendshape::mouth_right,
-    blendshape::mouth_smile_left,   blendshape::mouth_smile_right,   blendshape::mouth_stretch_left,
-    blendshape::mouth_stretch_right};
+constexpr blendshape k_measured[] = {blendshape::brow_down_left,
+                                     blendshape::brow_down_right,
+                                     blendshape::brow_inner_up,
+                                     blendshape::brow_outer_up_left,
+                                     blendshape::brow_outer_up_right,
+                                     blendshape::cheek_squint_left,
+                                     blendshape::cheek_squint_right,
+                                     blendshape::eye_blink_left,
+                                     blendshape::eye_blink_right,
+                                     blendshape::eye_wide_left,
+                                     blendshape::eye_wide_right,
+                                     blendshape::jaw_open,
+                                     blendshape::mouth_frown_left,
+                                     blendshape::mouth_frown_right,
+                                     blendshape::mouth_funnel,
+                                     blendshape::mouth_left,
+                                     blendshape::mouth_pucker,
+                                     blendshape::mouth_right,
+                                     blendshape::mouth_smile_left,
+                                     blendshape::mouth_smile_right,
+                                     blendshape::mouth_stretch_left,
+                                     blendshape::mouth_stretch_right,
+                                     blendshape::jaw_left,
+                                     blendshape::jaw_right,
+                                     blendshape::mouth_roll_lower,
+                                     blendshape::mouth_roll_upper,
+                                     blendshape::mouth_close};
 
 TEST(Face, BlinkPerEyeWith468And478PointsAndAnyAspect) {
   for (synth_face mesh : {synth_face::mesh_468, synth_face::mesh_478}) {
@@ -168,10 +186,17 @@ TEST(Face, EachMeasuredShapeAtKnownAmounts) {
       p[shape] = amount;
       if (shape == blendshape::jaw_open || shape == blendshape::mouth_funnel)
         p[bone::head] = identity_quat();
+      // mouthClose keeps the lips together while the jaw opens (ARKit's use: with jawOpen).
+      const bool close = shape == blendshape::mouth_close;
+      if (close) p[blendshape::jaw_open] = amount;
       proxy_pose out = solve_one(synth, p);
       EXPECT_NEAR(out[shape], amount, 0.06f) << blendshape_name(shape) << " " << amount;
+      if (close) {
+        EXPECT_NEAR(out[blendshape::jaw_open], amount, 0.06f);
+        EXPECT_LT(out[expression::aa], 0.1f);  // the lips do not part: no viseme
+      }
       for (blendshape other : k_measured)
-        if (other != shape)
+        if (other != shape && !(close && other == blendshape::jaw_open))
           EXPECT_LT(out[other], 0.1f) << blendshape_name(shape) << " -> " << blendshape_name(other);
     }
   }

@@ -180,6 +180,12 @@ struct synth_face_shape {
   float shift = 0.007f;               // lips' sideways move at mouthLeft/Right 1 [6.5, 7.5] mm
   float eyeball_radius = 0.012f;      // iris move per sine of the eye's turn [11.2, 12.8] mm
   float iris_u = 0.f, iris_v = 0.f;   // iris rest offset (eye widths, out / up) [-0.03, 0.03]
+  float jaw_side = 0.0095f;           // chin's and lower lip's sideways move at jawLeft/Right 1
+                                      // [8.5, 10.5] mm
+  float roll_upper = 0.005f;          // upper lip's outer edge toward the lip line at
+                                      // mouthRollUpper 1 [4.5, 5.5] mm
+  float roll_lower = 0.0065f;         // lower lip's outer edge at mouthRollLower 1 [6, 7] mm
+  float chin_ratio = 1.17f;           // chin's drop / the lower lip's at jawOpen [1.12, 1.22]
 };
 
 /// Draws a face for `seed` (the ranges of synth_face_shape).
