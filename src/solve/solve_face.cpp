@@ -29,8 +29,6 @@ struct feature_info {
   float quantile;    // which quantile of the face's own values is its neutral
   float full;        // a blendshape's full change (step size of the slow refinement)
   float lo, hi;      // plausible neutral values: a calibration is clamped to them
-  // The take's slope on the head's turn: at most this many full changes over a turn of 0.5.
-  float max_slope_fulls = 2.f;
 };
 // The population face is the synthetic generator's default face (landmark_synth.cpp: eye
 // 30 mm wide with a lid gap of 0.20 of it on average, brows 10-12 mm above the corners, mouth
@@ -38,31 +36,32 @@ struct feature_info {
 // and 0.02 eye widths above it, as MediaPipe's meshes of two real faces looking at the
 // camera put it: 0.47-0.51 along, -0.02-0.03 above). Eye gap: the 0.6 quantile, so that blinks
 // (brief, below) do not pull it down; mouth gap: the 0.2 quantile (the mouth rests closed,
-// talking opens it most of the time); the others the median.
+// talking opens it most of the time), and so the chin's drop (the jaw's rest is closed); the
+// others the median.
 constexpr feature_info k_features[k_face_feature_count] = {
-    {0.20f, 0.6f, 0.18f, 0.08f, 0.40f},      // eye gap l
-    {0.20f, 0.6f, 0.18f, 0.08f, 0.40f},      // eye gap r
-    {0.41f, 0.5f, 0.25f, 0.10f, 0.90f},      // brow inner l
-    {0.41f, 0.5f, 0.25f, 0.10f, 0.90f},      // brow inner r
-    {0.343f, 0.5f, 0.25f, 0.f, 0.90f},       // brow outer l
-    {0.343f, 0.5f, 0.25f, 0.f, 0.90f},       // brow outer r
-    {-0.333f, 0.5f, 0.117f, -0.9f, 0.1f},    // cheek l
-    {-0.333f, 0.5f, 0.117f, -0.9f, 0.1f},    // cheek r
-    {0.f, 0.2f, 0.315f, 0.f, 0.1f},          // mouth gap
-    {0.543f, 0.5f, 0.163f, 0.35f, 0.80f},    // mouth width
-    {0.011f, 0.5f, 0.10f, -0.12f, 0.12f},    // corner up l
-    {0.011f, 0.5f, 0.10f, -0.12f, 0.12f},    // corner up r
-    {0.272f, 0.5f, 0.076f, 0.17f, 0.40f},    // corner out l
-    {0.272f, 0.5f, 0.076f, 0.17f, 0.40f},    // corner out r
-    {0.f, 0.5f, 0.076f, -0.15f, 0.15f},      // mouth shift
-    {0.f, 0.5f, 0.10f, -0.4f, 0.4f, 4.f},    // jaw shift
-    {0.087f, 0.5f, 0.054f, 0.02f, 0.20f},    // upper lip height
-    {0.109f, 0.5f, 0.071f, 0.02f, 0.25f},    // lower lip height
-    {1.196f, 0.5f, 0.37f, 0.8f, 1.6f, 4.f},  // chin drop
-    {0.50f, 0.5f, 0.17f, 0.35f, 0.65f},      // iris u l
-    {0.50f, 0.5f, 0.17f, 0.35f, 0.65f},      // iris u r
-    {0.02f, 0.5f, 0.14f, -0.12f, 0.16f},     // iris v l
-    {0.02f, 0.5f, 0.14f, -0.12f, 0.16f},     // iris v r
+    {0.20f, 0.6f, 0.18f, 0.08f, 0.40f},    // eye gap l
+    {0.20f, 0.6f, 0.18f, 0.08f, 0.40f},    // eye gap r
+    {0.41f, 0.5f, 0.25f, 0.10f, 0.90f},    // brow inner l
+    {0.41f, 0.5f, 0.25f, 0.10f, 0.90f},    // brow inner r
+    {0.343f, 0.5f, 0.25f, 0.f, 0.90f},     // brow outer l
+    {0.343f, 0.5f, 0.25f, 0.f, 0.90f},     // brow outer r
+    {-0.333f, 0.5f, 0.117f, -0.9f, 0.1f},  // cheek l
+    {-0.333f, 0.5f, 0.117f, -0.9f, 0.1f},  // cheek r
+    {0.f, 0.2f, 0.315f, 0.f, 0.1f},        // mouth gap
+    {0.543f, 0.5f, 0.163f, 0.35f, 0.80f},  // mouth width
+    {0.011f, 0.5f, 0.10f, -0.12f, 0.12f},  // corner up l
+    {0.011f, 0.5f, 0.10f, -0.12f, 0.12f},  // corner up r
+    {0.272f, 0.5f, 0.076f, 0.17f, 0.40f},  // corner out l
+    {0.272f, 0.5f, 0.076f, 0.17f, 0.40f},  // corner out r
+    {0.f, 0.5f, 0.076f, -0.15f, 0.15f},    // mouth shift
+    {0.f, 0.5f, 0.10f, -0.4f, 0.4f},       // jaw shift
+    {0.087f, 0.5f, 0.054f, 0.02f, 0.20f},  // upper lip height
+    {0.109f, 0.5f, 0.071f, 0.02f, 0.25f},  // lower lip height
+    {1.196f, 0.2f, 0.37f, 0.8f, 1.6f},     // chin drop
+    {0.50f, 0.5f, 0.17f, 0.35f, 0.65f},    // iris u l
+    {0.50f, 0.5f, 0.17f, 0.35f, 0.65f},    // iris u r
+    {0.02f, 0.5f, 0.14f, -0.12f, 0.16f},   // iris v l
+    {0.02f, 0.5f, 0.14f, -0.12f, 0.16f},   // iris v r
 };
 // After the window: a stochastic quantile estimate (Robbins-Monro). Each frame the neutral
 // moves up by step * q when the value is above it, down by step * (1 - q) below, with
@@ -105,7 +104,7 @@ constexpr float k_frown_full = 0.054f;
 constexpr float k_stretch_full = 0.076f;
 constexpr float k_shift_full = 0.076f;
 // The chin moves 0.10 face widths (9 mm) sideways for jawLeft/Right (the lower lip rides on
-// the jaw: the mouth's sideways measurements are taken from the upper lip, 0, alone).
+// the jaw: the mouth's sideways measurements are taken from the upper lip alone).
 // A lip rolled in (mouthRollUpper/Lower) shows 0.054 (5 mm) less of the upper lip's height,
 // 0.071 (6.5 mm) less of the lower's; its outer point moves toward the lip line, so half of
 // it moves the outer lips' middle the corners' height is measured from (taken back out).
@@ -187,19 +186,30 @@ void measure_features(const face_points& fp, const glm::quat& head_w, const glm:
   const glm::vec3 lip_gap = fp.lip_upper - fp.lip_lower;
   v[ff_mouth_gap] = glm::length(lip_gap - glm::dot(lip_gap, head_x) * head_x) * inv_face;
   v[ff_mouth_width] = glm::length(fp.mouth[0] - fp.mouth[1]) * inv_face;
+  // The upper lip's middle (outer 0 and inner 13): the mouth's sideways place, which the jaw
+  // (carrying the lower lip) does not move.
+  const glm::vec3 upper_lip = 0.5f * (fp.lip_top + fp.lip_upper);
   for (int s = 0; s < 2; ++s) {
     const glm::vec3 d = fp.mouth[s] - centre;
     v[ff_corner_up_l + s] = glm::dot(d, up) * inv_face;
     // The person's left corner lies toward +X, the right one toward -X.
     v[ff_corner_out_l + s] =
-        glm::dot(fp.mouth[s] - fp.lip_top, head_x) * (s == 0 ? inv_face : -inv_face);
+        glm::dot(fp.mouth[s] - upper_lip, head_x) * (s == 0 ? inv_face : -inv_face);
   }
-  v[ff_mouth_shift] = glm::dot(fp.lip_top - fp.nose_base, head_x) * inv_face;
-  // The chin against the outer eye corners (at about its depth, so a turned head hardly
-  // moves it): the head's X axis comes from the eye corners and cheeks, which the jaw does
-  // not move, and its up axis is made perpendicular to X, so a sideways chin leaves both.
-  v[ff_jaw_shift] =
-      glm::dot(fp.chin - 0.5f * (fp.eye[0].outer + fp.eye[1].outer), head_x) * inv_face;
+  v[ff_mouth_shift] = glm::dot(upper_lip - fp.nose_base, head_x) * inv_face;
+  // The chin against the face's midline (the line from the outer eye corners' midpoint through
+  // the forehead, followed down to the chin's height): a field of view other than the
+  // camera's unprojects the mesh with a sideways shear in proportion to depth, which a
+  // pitched head gives the chin (docs/expressions.md). The head's X axis comes from the eye
+  // corners and cheeks, which the jaw does not move, and its up axis is made perpendicular
+  // to X, so a sideways chin leaves both.
+  {
+    const glm::vec3 eyes = 0.5f * (fp.eye[0].outer + fp.eye[1].outer);
+    const glm::vec3 to_chin = fp.chin - eyes, to_forehead = fp.forehead - eyes;
+    const float along = glm::dot(to_forehead, up);
+    const float t = std::abs(along) > 1e-6f ? glm::dot(to_chin, up) / along : 0.f;
+    v[ff_jaw_shift] = glm::dot(to_chin - t * to_forehead, head_x) * inv_face;
+  }
   // The lips' visible (vermilion) heights along the head's up axis: a lip rolled in shows
   // less of it.
   v[ff_lip_upper_h] = glm::dot(fp.lip_top - fp.lip_upper, up) * inv_face;
@@ -302,6 +312,8 @@ namespace {
 constexpr int k_fit_iterations = 6;
 constexpr double k_huber = 1.345;
 constexpr double k_slope_prior_spread = 0.05;  // about 3 degrees
+// A slope moves the neutral at most this many full changes over a turn of 0.5 (30 degrees).
+constexpr float k_max_slope_fulls = 2.f;
 // The dead zone: this many standard deviations of the frame-to-frame noise (from the median
 // absolute change between consecutive read frames, what the fit leaves), at most this share
 // of a full change.
@@ -385,7 +397,7 @@ bool calibrate_take(const face_take& take, face_calibration& c) {
         w[k] = u > 1.0 ? 1.0 / u : 1.0;
       }
     }
-    const float max_slope = fi.max_slope_fulls * fi.full / 0.5f;
+    const float max_slope = k_max_slope_fulls * fi.full / 0.5f;
     const float sx = glm::clamp(static_cast<float>(beta[1]), -max_slope, max_slope);
     const float sy = glm::clamp(static_cast<float>(beta[2]), -max_slope, max_slope);
     // The neutral: the table's quantile of what the slopes leave, at a face looking straight

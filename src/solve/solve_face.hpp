@@ -29,9 +29,9 @@ enum face_feature : int {
   ff_mouth_width,  // corner to corner / face width
   ff_corner_up_l,  // mouth corner above the outer lips' middle / face width
   ff_corner_up_r,
-  ff_corner_out_l,  // mouth corner out from the upper lip's outer middle (0) / face width
+  ff_corner_out_l,  // mouth corner out from the upper lip's middle (0 and 13) / face width
   ff_corner_out_r,
-  ff_mouth_shift,  // upper lip's outer middle (0) toward the person's left of the nose base / F
+  ff_mouth_shift,  // upper lip's middle toward the person's left of the nose base / face width
   ff_jaw_shift,    // chin toward the person's left of the outer eye corners' midpoint / face w.
   ff_lip_upper_h,  // upper lip's height: outer (0) above inner (13) / face width
   ff_lip_lower_h,  // lower lip's height: inner (14) above outer (17) / face width

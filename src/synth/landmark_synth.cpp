@@ -6,7 +6,7 @@
 // - the face's own proportions and the reach of each shape: synth_face_shape (the population
 //   face by default, drawn per seed with synth_options::face_variation).
 // - build_face() deforms the template for each ARKit shape the solver measures (lids, brows,
-//   cheeks, mouth corners and lips, irises); docs/expressions.md ("The generator") writes the
+//   cheeks, mouth corners and lips, chin, irises); docs/expressions.md ("The generator") writes the
 //   rules out. They are the generator's own, written apart from the solver's measurements.
 // - irises (478 only): rest centre at inner + 0.5 (outer - inner) + 0.02 w up (+ the face's
 //   own offset); gaze moves it by the eyeball radius (0.012 s) times (sin yaw, -sin pitch)

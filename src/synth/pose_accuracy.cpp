@@ -137,8 +137,11 @@ void accumulate_pose_accuracy(const proxy_pose& truth, const proxy_pose& solved,
   for (int v = 0; v < 5; ++v)
     fa.visemes[v].add(solved.expressions[idx(expression::aa) + v] -
                       truth.expressions[idx(expression::aa) + v]);
-  for (int i = 0; i < k_blendshape_count; ++i)
+  for (int i = 0; i < k_blendshape_count; ++i) {
     fa.shapes[i].add(solved.blendshapes[i] - truth.blendshapes[i]);
+    if (truth.blendshapes[i] >= 0.2f)
+      fa.shapes_active[i].add(solved.blendshapes[i] - truth.blendshapes[i]);
+  }
 }
 
 status evaluate_pose_files(const std::string& truth_path, const std::string& solved_path,

@@ -69,6 +69,13 @@ void print_shapes(const pose_accuracy& acc) {
       std::printf(" %s %.3f", std::string(blendshape_name(static_cast<blendshape>(i))).c_str(),
                   acc.face.shapes[i].mean());
   std::printf("\n");
+  std::printf("[figures] face per-shape mean abs error where the truth is >= 0.2 (frames):");
+  for (int i = 0; i < k_blendshape_count; ++i)
+    if (acc.face.shapes_active[i].count > 0)
+      std::printf(" %s %.3f (%ld)",
+                  std::string(blendshape_name(static_cast<blendshape>(i))).c_str(),
+                  acc.face.shapes_active[i].mean(), acc.face.shapes_active[i].count);
+  std::printf("\n");
 }
 
 // The tuning seeds: printed only (the solver's constants were set on these).

@@ -264,6 +264,12 @@ TEST(Face, PresetsFromBlendshapes) {
   EXPECT_FLOAT_EQ(e[idx(expression::brow_up_left)], 0.5f);
   EXPECT_FLOAT_EQ(e[idx(expression::happy)], 0.3f * 0.6f);
   EXPECT_FLOAT_EQ(e[idx(expression::surprised)], 0.5f * 0.5f);  // up 0.5 x max(wide 0.5, o)
+  // mouthClose keeps the lips together: the mouth's opening is jawOpen - mouthClose.
+  b[idx(blendshape::mouth_close)] = 0.2f;  // o = 0.3
+  expressions_from_blendshapes(b, e);
+  EXPECT_FLOAT_EQ(e[idx(expression::aa)], 0.3f * 0.6f * 0.7f);
+  EXPECT_FLOAT_EQ(e[idx(expression::oh)], 0.4f * 0.3f);
+  b[idx(blendshape::mouth_close)] = 0.f;
   // Mirrored: the sides swap.
   mirror_blendshapes(b);
   EXPECT_FLOAT_EQ(b[idx(blendshape::eye_blink_right)], 0.9f);
@@ -344,6 +350,7 @@ TEST(Face, MirrorKeepsThePersonsSides) {
   proxy_pose p = standing(synth);
   p[blendshape::eye_blink_left] = 1.f;
   p[blendshape::mouth_smile_left] = 1.f;
+  p[blendshape::jaw_left] = 1.f;
   p[bone::left_eye] = p[bone::right_eye] = axis_angle({0, 1, 0}, 15.f * k_deg);
   landmark_frame f;
   synth.generate(p, f);
@@ -356,6 +363,8 @@ TEST(Face, MirrorKeepsThePersonsSides) {
   EXPECT_LT(out[blendshape::eye_blink_right], 0.1f);
   EXPECT_GT(out[blendshape::mouth_smile_left], 0.9f);
   EXPECT_LT(out[blendshape::mouth_smile_right], 0.1f);
+  EXPECT_GT(out[blendshape::jaw_left], 0.9f);
+  EXPECT_EQ(out[blendshape::jaw_right], 0.f);
   // The right eye is open: its look is read (the left one is shut and turns with it).
   EXPECT_GT(out[blendshape::eye_look_in_right], 0.4f);
   EXPECT_EQ(out[blendshape::eye_look_out_right], 0.f);

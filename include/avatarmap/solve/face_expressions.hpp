@@ -32,9 +32,10 @@ void eye_look_blendshapes(bool person_left, float sin_yaw, float sin_pitch,
 /// The 21 expressions from the 52 blendshapes (inputs clamped to [0, 1], non-finite read as
 /// 0; every output in [0, 1]):
 /// - blink = min(eyeBlinkLeft, eyeBlinkRight); blinkLeft/Right = that eye's blink - blink.
-/// - visemes from o = jawOpen, r = max(mouthFunnel, mouthPucker), w = max(mean mouthStretch,
-///   mean mouthSmile): aa = o (1 - r)(1 - w), ee = w (1 - r)(1 - o), ih = w (1 - r) o,
-///   oh = r o, ou = r (1 - o). Their sum is at most 1.
+/// - visemes from o = jawOpen - mouthClose (lips kept together show no viseme),
+///   r = max(mouthFunnel, mouthPucker), w = max(mean mouthStretch, mean mouthSmile): aa = o (1 -
+///   r)(1 - w), ee = w (1 - r)(1 - o), ih = w (1 - r) o, oh = r o, ou = r (1 - o). Their sum is at
+///   most 1.
 /// - lookLeft = mean(eyeLookOutLeft, eyeLookInRight), lookRight = mean(eyeLookInLeft,
 ///   eyeLookOutRight), lookUp/Down = the mean of both eyes' eyeLookUp/Down.
 /// - browUpLeft/Right = max(browInnerUp, browOuterUpLeft/Right), browDownLeft/Right =

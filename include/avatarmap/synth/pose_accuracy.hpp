@@ -118,6 +118,9 @@ struct face_accuracy {
   angle_stats gaze;
   angle_histogram gaze_histogram;
   std::array<weight_stats, k_blendshape_count> shapes;
+  /// Per shape over the frames whose truth weight is at least 0.2 (the shape in use: most
+  /// frames of a take hold a shape at 0, which the figure over every frame is mostly made of).
+  std::array<weight_stats, k_blendshape_count> shapes_active;
 };
 
 struct pose_accuracy {
