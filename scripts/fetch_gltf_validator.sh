@@ -13,6 +13,8 @@ set -euo pipefail
 spec="gltf-validator@2.0.0-dev.3.10"
 integrity="sha512-odJ4k0tRkGXiDGn78yDBg+fBbAIvBnXxh3RwAta0emSxGtyagFE8B4xELB1oYe3S5RD8Ci3uZAsZaascH2LAEQ=="
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# shellcheck source=npm_pack_checked.sh
+. "$root/scripts/npm_pack_checked.sh"
 dest="${AVATARMAP_NODE_MODULES:-$root/.cache/avatarmap/node_modules}"
 version="${spec##*@}"
 if [ -f "$dest/gltf-validator/package.json" ] &&
@@ -26,19 +28,7 @@ done
 mkdir -p "$dest"
 work="$(mktemp -d "$dest/.fetch.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
-echo "fetch_gltf_validator: npm pack $spec"
-tgz="$(cd "$work" && npm pack --silent "$spec" 2>"$work/npm.log" | tail -n 1)" || true
-if [ -z "$tgz" ] || [ ! -f "$work/$tgz" ]; then
-  cat "$work/npm.log" >&2
-  echo "fetch_gltf_validator: npm pack $spec failed (is the npm registry reachable?)" >&2
-  exit 1
-fi
-got="sha512-$(openssl dgst -sha512 -binary "$work/$tgz" | base64 -w0)"
-if [ "$got" != "$integrity" ]; then
-  echo "fetch_gltf_validator: $spec has integrity $got, expected $integrity: the registry" \
-       "served something else; stop and find out why" >&2
-  exit 1
-fi
+tgz="$(npm_pack_checked fetch_gltf_validator "$spec" "$integrity" "$work")"
 tar -xzf "$work/$tgz" -C "$work"
 rm -rf "${dest:?}/gltf-validator"
 mv "$work/package" "$dest/gltf-validator"

@@ -21,6 +21,8 @@ packages=(
 )
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# shellcheck source=npm_pack_checked.sh
+. "$root/scripts/npm_pack_checked.sh"
 dest="${AVATARMAP_VIEWER_MODULES:-$root/.cache/avatarmap/viewer}"
 want="$(for p in "${packages[@]}"; do echo "${p%% *}"; done)"
 
@@ -39,19 +41,7 @@ work="$(mktemp -d "$dest/.fetch.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 for p in "${packages[@]}"; do
   read -r spec dir integrity <<<"$p"
-  echo "fetch_viewer_modules: npm pack $spec"
-  tgz="$(cd "$work" && npm pack --silent "$spec" 2>"$work/npm.log" | tail -n 1)" || true
-  if [ -z "$tgz" ] || [ ! -f "$work/$tgz" ]; then
-    cat "$work/npm.log" >&2
-    echo "fetch_viewer_modules: npm pack $spec failed (is the npm registry reachable?)" >&2
-    exit 1
-  fi
-  got="sha512-$(openssl dgst -sha512 -binary "$work/$tgz" | base64 -w0)"
-  if [ "$got" != "$integrity" ]; then
-    echo "fetch_viewer_modules: $spec has integrity $got, expected $integrity: the registry" \
-         "served something else; stop and find out why" >&2
-    exit 1
-  fi
+  tgz="$(npm_pack_checked fetch_viewer_modules "$spec" "$integrity" "$work")"
   mkdir -p "$work/$dir"
   case "$dir" in
     three) tar -xzf "$work/$tgz" -C "$work/$dir" --strip-components=1 \

@@ -109,9 +109,10 @@ struct framing {
   double hfov = 50;
 };
 
-framing frame_motion(const std::vector<std::array<double, 3>>& hips, double rest_hips_y, int width,
-                     int height) {
-  double lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30};
+// The box the hips move in (finite values only); with none, the rest hips at X = Z = 0.
+void hips_range(const std::vector<std::array<double, 3>>& hips, double rest_hips_y, double lo[3],
+                double hi[3]) {
+  for (int i = 0; i < 3; ++i) lo[i] = 1e30, hi[i] = -1e30;
   for (const auto& p : hips)
     for (int i = 0; i < 3; ++i) {
       if (!std::isfinite(p[i])) continue;
@@ -120,6 +121,12 @@ framing frame_motion(const std::vector<std::array<double, 3>>& hips, double rest
     }
   for (int i = 0; i < 3; ++i)
     if (lo[i] > hi[i]) lo[i] = hi[i] = (i == 1 ? rest_hips_y : 0.0);
+}
+
+framing frame_motion(const std::vector<std::array<double, 3>>& hips, double rest_hips_y, int width,
+                     int height) {
+  double lo[3], hi[3];
+  hips_range(hips, rest_hips_y, lo, hi);
   const double r = std::max(0.2, rest_hips_y);
   const double y_low = std::min(0.0, lo[1] - r);
   const double y_high = hi[1] + 1.0 * r;  // the head (and hands raised) above the hips
@@ -148,15 +155,8 @@ constexpr double k_head_over_hips = 0.83;
 
 framing frame_face(const std::vector<std::array<double, 3>>& hips, double rest_hips_y, int width,
                    int height) {
-  double lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30};
-  for (const auto& p : hips)
-    for (int i = 0; i < 3; ++i) {
-      if (!std::isfinite(p[i])) continue;
-      lo[i] = std::min(lo[i], p[i]);
-      hi[i] = std::max(hi[i], p[i]);
-    }
-  for (int i = 0; i < 3; ++i)
-    if (lo[i] > hi[i]) lo[i] = hi[i] = (i == 1 ? rest_hips_y : 0.0);
+  double lo[3], hi[3];
+  hips_range(hips, rest_hips_y, lo, hi);
   framing f;
   const double aspect = static_cast<double>(width) / height;
   const double tan_v = std::tan(f.hfov * M_PI / 180 / 2) / aspect;

@@ -45,34 +45,9 @@ proxy_pose solve_one(landmark_synth& synth, const proxy_pose& truth) {
   return out;
 }
 
-// The shapes the solver measures (docs/expressions.md); the others stay 0.
-constexpr blendshape k_measured[] = {blendshape::brow_down_left,
-                                     blendshape::brow_down_right,
-                                     blendshape::brow_inner_up,
-                                     blendshape::brow_outer_up_left,
-                                     blendshape::brow_outer_up_right,
-                                     blendshape::cheek_squint_left,
-                                     blendshape::cheek_squint_right,
-                                     blendshape::eye_blink_left,
-                                     blendshape::eye_blink_right,
-                                     blendshape::eye_wide_left,
-                                     blendshape::eye_wide_right,
-                                     blendshape::jaw_open,
-                                     blendshape::mouth_frown_left,
-                                     blendshape::mouth_frown_right,
-                                     blendshape::mouth_funnel,
-                                     blendshape::mouth_left,
-                                     blendshape::mouth_pucker,
-                                     blendshape::mouth_right,
-                                     blendshape::mouth_smile_left,
-                                     blendshape::mouth_smile_right,
-                                     blendshape::mouth_stretch_left,
-                                     blendshape::mouth_stretch_right,
-                                     blendshape::jaw_left,
-                                     blendshape::jaw_right,
-                                     blendshape::mouth_roll_lower,
-                                     blendshape::mouth_roll_upper,
-                                     blendshape::mouth_close};
+// The shapes the solver measures from the mesh's shape (docs/expressions.md); the others stay
+// 0 but the eyeLook ones, which come from the irises.
+constexpr const auto& k_measured = k_mesh_blendshapes;
 
 TEST(Face, BlinkPerEyeWith468And478PointsAndAnyAspect) {
   for (synth_face mesh : {synth_face::mesh_468, synth_face::mesh_478}) {

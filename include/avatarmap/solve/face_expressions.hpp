@@ -19,6 +19,36 @@ using expression_weights = std::array<float, k_expression_count>;
 /// Gaze turn at which an eyeLook* shape (and VRM's lookLeft/Right, lookUp/Down) reaches 1:
 /// 25 degrees sideways, 20 degrees up or down (VRM's lookAt presets mean "looking fully"
 /// that way; the angles are the project's choice). As sines.
+/// The blendshapes the solver measures from the mesh's shape (docs/expressions.md, each
+/// one's measurement); the eight eyeLook ones come from the irises; the others stay 0.
+inline constexpr blendshape k_mesh_blendshapes[] = {blendshape::brow_down_left,
+                                                    blendshape::brow_down_right,
+                                                    blendshape::brow_inner_up,
+                                                    blendshape::brow_outer_up_left,
+                                                    blendshape::brow_outer_up_right,
+                                                    blendshape::cheek_squint_left,
+                                                    blendshape::cheek_squint_right,
+                                                    blendshape::eye_blink_left,
+                                                    blendshape::eye_blink_right,
+                                                    blendshape::eye_wide_left,
+                                                    blendshape::eye_wide_right,
+                                                    blendshape::jaw_open,
+                                                    blendshape::mouth_frown_left,
+                                                    blendshape::mouth_frown_right,
+                                                    blendshape::mouth_funnel,
+                                                    blendshape::mouth_left,
+                                                    blendshape::mouth_pucker,
+                                                    blendshape::mouth_right,
+                                                    blendshape::mouth_smile_left,
+                                                    blendshape::mouth_smile_right,
+                                                    blendshape::mouth_stretch_left,
+                                                    blendshape::mouth_stretch_right,
+                                                    blendshape::jaw_left,
+                                                    blendshape::jaw_right,
+                                                    blendshape::mouth_roll_lower,
+                                                    blendshape::mouth_roll_upper,
+                                                    blendshape::mouth_close};
+
 inline constexpr float k_eye_look_full_side_sin = 0.42261826f;  // sin 25 deg
 inline constexpr float k_eye_look_full_vert_sin = 0.34202014f;  // sin 20 deg
 

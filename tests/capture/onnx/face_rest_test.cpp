@@ -16,6 +16,7 @@
 
 #include "avatarmap/capture/capture_file.hpp"
 #include "avatarmap/jobs/solve_file.hpp"
+#include "avatarmap/solve/face_expressions.hpp"
 #include "onnx_support.hpp"
 #include "support/test_data.hpp"
 
@@ -75,33 +76,7 @@ TEST(face_rest, pose_squats_face_reads_near_zero_at_rest) {
 
   // The shapes the solver measures, but the eyeLook ones: where this person looks is not
   // known (their irises keep the live calibration, docs/expressions.md).
-  constexpr blendshape k_shapes[] = {blendshape::brow_down_left,
-                                     blendshape::brow_down_right,
-                                     blendshape::brow_inner_up,
-                                     blendshape::brow_outer_up_left,
-                                     blendshape::brow_outer_up_right,
-                                     blendshape::cheek_squint_left,
-                                     blendshape::cheek_squint_right,
-                                     blendshape::eye_blink_left,
-                                     blendshape::eye_blink_right,
-                                     blendshape::eye_wide_left,
-                                     blendshape::eye_wide_right,
-                                     blendshape::jaw_open,
-                                     blendshape::mouth_frown_left,
-                                     blendshape::mouth_frown_right,
-                                     blendshape::mouth_funnel,
-                                     blendshape::mouth_left,
-                                     blendshape::mouth_pucker,
-                                     blendshape::mouth_right,
-                                     blendshape::mouth_smile_left,
-                                     blendshape::mouth_smile_right,
-                                     blendshape::mouth_stretch_left,
-                                     blendshape::mouth_stretch_right,
-                                     blendshape::jaw_left,
-                                     blendshape::jaw_right,
-                                     blendshape::mouth_roll_lower,
-                                     blendshape::mouth_roll_upper,
-                                     blendshape::mouth_close};
+  constexpr const auto& k_shapes = k_mesh_blendshapes;
   for (blendshape b : k_shapes) {
     std::vector<float> v;
     for (const auto& s : shapes) v.push_back(s[idx(b)]);
