@@ -40,7 +40,10 @@ synth_options near_camera(synth_scenario scenario, std::uint32_t seed) {
   return o;
 }
 
-head_run run(const synth_options& so) {
+// Solves `seconds` of a head sweep frame by frame; `edit(t, frame)` may change each frame's
+// landmarks first (none by default).
+template <class Edit>
+head_run run(const synth_options& so, double seconds, Edit&& edit) {
   synth_recording rec(so);
   head_sweep sweep(so.seed);
   solver_options o;
@@ -52,10 +55,11 @@ head_run run(const synth_options& so) {
   std::array<glm::quat, k_bone_count> tw, sw;
   head_run r;
   r.fov = rec.landmarks().horizontal_fov_degrees();
-  const int frames = int(k_seconds * k_fps);
+  const int frames = int(seconds * k_fps);
   for (int i = 0; i < frames; ++i) {
     const double t = i / k_fps;
     rec.generate(t, truth, frame);
+    edit(t, frame);
     solver.solve(frame, solved);
     compute_world_rotations(truth, tw);
     compute_world_rotations(solved, sw);
@@ -63,6 +67,10 @@ head_run run(const synth_options& so) {
     r.pitch.push_back(sweep.at(t).pitch);
   }
   return r;
+}
+
+head_run run(const synth_options& so) {
+  return run(so, k_seconds, [](double, landmark_frame&) {});
 }
 
 double mean(const std::vector<double>& v) {
@@ -161,18 +169,9 @@ TEST(HeadRange, NoisyHeadHoldsOnAverage) {
 TEST(HeadRange, LostMeshFallsBackOnThePoseFacePointsTurnedByTheLearntOffset) {
   const synth_options so = near_camera(synth_scenario::clean, 31);
   auto errors = [&](bool mesh_at_start) {
-    synth_recording rec(so);
-    solver_options o;
-    o.image_width = float(so.image_width);
-    o.image_height = float(so.image_height);
-    frame_solver solver(o);
-    landmark_frame frame;
-    proxy_pose truth, solved;
-    std::array<glm::quat, k_bone_count> tw, sw;
-    std::vector<double> lost;
-    for (int i = 0; i < int(12.0 * k_fps); ++i) {
-      const double t = i / k_fps;
-      rec.generate(t, truth, frame);
+    // Lost: every frame without the mesh at start, else every other second from 6 s on.
+    auto lost = [&](double t) { return !mesh_at_start || (t >= 6.0 && std::fmod(t, 2.0) < 1.0); };
+    const head_run r = run(so, 12.0, [&](double t, landmark_frame& frame) {
       auto w = [&](int k) {
         const landmark& l = frame.pose_world[k];
         return glm::vec3(l.x, l.y, l.z);
@@ -183,15 +182,14 @@ TEST(HeadRange, LostMeshFallsBackOnThePoseFacePointsTurnedByTheLearntOffset) {
         frame.pose_world[k].y += 0.03f * back.y;
         frame.pose_world[k].z += 0.03f * back.z;
       }
-      const bool lose = !mesh_at_start || (t >= 6.0 && std::fmod(t, 2.0) < 1.0);
-      if (lose) frame.set(frame_part::face, false);
-      solver.solve(frame, solved);
-      compute_world_rotations(truth, tw);
-      compute_world_rotations(solved, sw);
-      if (t >= 6.0 && std::fmod(t, 2.0) < 1.0)
-        lost.push_back(angle_between(sw[idx(bone::head)], tw[idx(bone::head)]) / k_deg);
+      if (lost(t)) frame.set(frame_part::face, false);
+    });
+    std::vector<double> out;  // the frames of the lost spans after 6 s
+    for (size_t i = 0; i < r.error.size(); ++i) {
+      const double t = double(i) / k_fps;
+      if (t >= 6.0 && std::fmod(t, 2.0) < 1.0) out.push_back(r.error[i]);
     }
-    return lost;
+    return out;
   };
   const std::vector<double> learnt = errors(true), never = errors(false);
   std::printf(
