@@ -121,12 +121,13 @@ void frame_solver::begin_face_take() {
 
 void frame_solver::add_face_take(const landmark_frame& in) {
   if (!face_take_) begin_face_take();
-  // The field of view given, else the prior's (never the estimate so far): the calibration
-  // reads a take alike whenever it runs (a file's before its warm-up, a source's after).
-  const float fov = options_.horizontal_fov_degrees != 0.f ? options_.horizontal_fov_degrees
-                                                           : k_prior_fov_degrees;
+  // The field of view in use (given, else estimated so far): the take must be read through
+  // the lens its frames will be solved with (a field of view other than the camera's shears
+  // the mesh in proportion to depth, and the irises sit in front of the eye corners: a
+  // mismatch reads as a constant gaze). solve_file calibrates after its warm-up, once the
+  // field of view is held.
   prepared_frame f;
-  prepare_frame(in, options_, 0.5f / std::tan(0.5f * fov * k_deg), f);
+  prepare_frame(in, options_, focal_per_width_, f);
   face_features& ff = face_take_->frames.emplace_back();
   read_face_features(f, options_, ff);
 }

@@ -31,12 +31,18 @@ enum face_feature : int {
   ff_corner_up_r,
   ff_corner_out_l,  // mouth corner out from the upper lip's middle (0 and 13) / face width
   ff_corner_out_r,
-  ff_mouth_shift,  // upper lip's middle toward the person's left of the nose base / face width
-  ff_jaw_shift,    // chin toward the person's left of the outer eye corners' midpoint / face w.
-  ff_lip_upper_h,  // upper lip's height: outer (0) above inner (13) / face width
-  ff_lip_lower_h,  // lower lip's height: inner (14) above outer (17) / face width
-  ff_chin_drop,    // chin below the outer eye corners' midpoint / face width
-  ff_iris_u_l,     // iris (centre and ring) from the inner corner along the corner line / w
+  ff_mouth_shift,   // upper lip's middle toward the person's left of the nose base / face width
+  ff_jaw_shift,     // chin toward the person's left of the outer eye corners' midpoint / face w.
+  ff_lip_upper_h,   // upper lip's height: outer (0) above inner (13) / face width
+  ff_lip_lower_h,   // lower lip's height: inner (14) above outer (17) / face width
+  ff_chin_drop,     // chin below the outer eye corners' midpoint / face width
+  ff_upper_side_l,  // upper lip's side point above its middle-to-corner line / face width
+  ff_upper_side_r,
+  ff_lower_side_l,  // lower lip's side point below its middle-to-corner line / face width
+  ff_lower_side_r,
+  ff_nose_wing_l,  // nose's wing above the point below the nose (2) / face width
+  ff_nose_wing_r,
+  ff_iris_u_l,  // iris (centre and ring) from the inner corner along the corner line / w
   ff_iris_u_r,
   ff_iris_v_l,  // iris (centre and ring) above the corners' midpoint / eye width
   ff_iris_v_r,
@@ -68,8 +74,8 @@ struct face_features {
 /// robust estimate learnt from the face itself (docs/expressions.md, "Calibration"): the
 /// per-measurement quantile of the first k_window frontal frames, then a stochastic quantile
 /// step per frame whose size decreases (the quantile of the take so far) to a floor (slow
-/// changes followed); for the irises a slow median from the population's (no window). Fixed size;
-/// update() allocates nothing.
+/// changes followed); for the irises a slow median from the population's (no window; calibrate_take
+/// takes the take's gaze mode). Fixed size; update() allocates nothing.
 struct face_calibration {
   static constexpr int k_window = 24;
   std::array<float, k_face_feature_count> neutral{};
@@ -90,11 +96,15 @@ struct face_calibration {
   /// camera_x + slope_y * camera_y (the mesh's proportions change with the head's turn from
   /// the camera: MediaPipe's depth is not to scale), and a change from it smaller than
   /// `dead_zone` (the take's frame-to-frame noise) reads as none. 0 live. `from_take`: the
-  /// neutrals are the take's; update() then learns only the head offset and the irises.
+  /// neutrals are the take's; update() then learns only the head offset (and an iris the take
+  /// did not calibrate).
   std::array<float, k_face_feature_count> slope_x{};
   std::array<float, k_face_feature_count> slope_y{};
   std::array<float, k_face_feature_count> dead_zone{};
   bool from_take = false;
+  /// Per eye: its iris's rest place is the take's (the median over frontal frames with the eye
+  /// open); update() then leaves it. False for an eye the take saw too seldom: it learns live.
+  bool iris_from_take[2] = {false, false};
 
   face_calibration() { reset(); }
   void reset();
@@ -116,7 +126,8 @@ struct face_take {
 /// Calibrates `c` from a whole take (docs/expressions.md, "Calibration over a take"): per
 /// measurement but the irises', over every frame whose face is read, a robust linear fit of
 /// the value on the way to the camera (camera_x, camera_y), its neutral the table's quantile
-/// of what the fit leaves, and a dead zone of the frame-to-frame noise. A take with fewer than
+/// of what the fit leaves, and a dead zone of the frame-to-frame noise; each iris's rest
+/// place the median over frontal frames with that eye open. A take with fewer than
 /// k_take_min_frames read frames leaves `c` as it is (false).
 bool calibrate_take(const face_take& take, face_calibration& c);
 inline constexpr int k_take_min_frames = 8;

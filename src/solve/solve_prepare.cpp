@@ -136,6 +136,13 @@ void prepare_face(const landmark_frame& in, const solver_options& o, prepared_fr
   fp.lip_top = get(0);
   fp.lip_bottom = get(17);
   fp.nose_base = get(2);
+  fp.nose_tip = get(1);
+  fp.upper_side[l] = get(269);
+  fp.upper_side[r] = get(39);
+  fp.lower_side[l] = get(405);
+  fp.lower_side[r] = get(181);
+  fp.nose_wing[l] = get(327);
+  fp.nose_wing[r] = get(98);
   el.brow_inner = get(336);
   el.brow_outer = get(300);
   er.brow_inner = get(107);

@@ -52,11 +52,13 @@ struct eye_points {
   bool has_iris = false;
 };
 /// lip_upper/lip_lower: the inner lips (13, 14); lip_top/lip_bottom: the outer lips' middle
-/// (0, 17); nose_base: below the nose (2). docs/expressions.md lists every index.
+/// (0, 17); nose_base: below the nose (2); nose_tip (1). Per side: upper_side/lower_side, the
+/// outer lips two points out from the middle (269/39, 405/181), and nose_wing, the nose's
+/// wing beside the nostril (327/98). docs/expressions.md lists every index.
 struct face_points {
   bool valid = false;
   glm::vec3 forehead, chin, cheek[2], mouth[2], lip_upper, lip_lower, lip_top, lip_bottom,
-      nose_base;
+      nose_base, nose_tip, upper_side[2], lower_side[2], nose_wing[2];
   eye_points eye[2];
 };
 

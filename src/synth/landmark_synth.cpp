@@ -6,8 +6,9 @@
 // - the face's own proportions and the reach of each shape: synth_face_shape (the population
 //   face by default, drawn per seed with synth_options::face_variation).
 // - build_face() deforms the template for each ARKit shape the solver measures (lids, brows,
-//   cheeks, mouth corners and lips, chin, irises); docs/expressions.md ("The generator") writes the
-//   rules out. They are the generator's own, written apart from the solver's measurements.
+//   cheeks, mouth corners and lips, chin, nose wings, irises); docs/expressions.md ("The
+//   generator") writes the rules out. They are the generator's own, written apart from the solver's
+//   measurements.
 // - irises (478 only): rest centre at inner + 0.5 (outer - inner) + 0.02 w up (+ the face's
 //   own offset); gaze moves it by the eyeball radius (0.012 s) times (sin yaw, -sin pitch)
 //   along the head's X / Y axes, where (pitch, yaw) = euler_from_quat(eye bone local
@@ -86,8 +87,10 @@ const fixed_point k_fixed[] = {
     {21, 251, {-0.065f, 0.145f, 0.04f}},   // temples
     {172, 397, {-0.055f, 0.025f, 0.03f}},  // jaw angles
     {127, 356, {-0.072f, 0.105f, 0.02f}},  // beside the eyes
-    {93, 323, {-0.068f, 0.065f, 0.03f}},  {132, 361, {-0.062f, 0.045f, 0.03f}},
+    {93, 323, {-0.068f, 0.065f, 0.03f}},
+    {132, 361, {-0.062f, 0.045f, 0.03f}},
     {58, 288, {-0.06f, 0.035f, 0.03f}},
+    {98, 327, {-0.016f, 0.068f, 0.097f}},  // nose wings, beside the nostrils
 };
 
 void set_eye_rest(std::array<glm::vec3, k_face_mesh_iris_count>& t, const eye_indices& e,
@@ -126,6 +129,23 @@ void set_eye_rest(std::array<glm::vec3, k_face_mesh_iris_count>& t, const eye_in
   t[e.iris + 4] = iris + glm::vec3(0.f, -r, 0.f);
 }
 
+// The outer lips' side points (upper 39 / 269, lower 181 / 405, two out from the middle):
+// k_lip_side_along of the way from the lip's outer middle (0, 17) to the corner, the upper
+// k_upper_bow above that line, the lower k_lower_bow below it (the lips' curves; MediaPipe's
+// mesh of portrait.jpg puts them 0.04 and 0.08 face widths off), moved up / down by
+// `up_r`/`up_l` and `down_r`/`down_l` (metres, the person's right / left).
+constexpr float k_lip_side_along = 0.6f;
+constexpr float k_upper_bow = 0.0035f;
+constexpr float k_lower_bow = 0.004f;
+void set_lip_sides(std::array<glm::vec3, k_face_mesh_iris_count>& t, float s, float up_r,
+                   float up_l, float down_r, float down_l) {
+  t[39] = glm::mix(t[0], t[61], k_lip_side_along) + glm::vec3(0.f, k_upper_bow * s + up_r, 0.f);
+  t[269] = glm::mix(t[0], t[291], k_lip_side_along) + glm::vec3(0.f, k_upper_bow * s + up_l, 0.f);
+  t[181] = glm::mix(t[17], t[61], k_lip_side_along) - glm::vec3(0.f, k_lower_bow * s + down_r, 0.f);
+  t[405] =
+      glm::mix(t[17], t[291], k_lip_side_along) - glm::vec3(0.f, k_lower_bow * s + down_l, 0.f);
+}
+
 // Mouth points for a given width and inner-lip gap (metres).
 void set_mouth(std::array<glm::vec3, k_face_mesh_iris_count>& t, float width, float gap, float s) {
   const float y = k_mouth_y * s;
@@ -138,6 +158,7 @@ void set_mouth(std::array<glm::vec3, k_face_mesh_iris_count>& t, float width, fl
   t[14] = glm::vec3(0.f, y - 0.75f * gap, 0.095f * s);
   t[0] = glm::vec3(0.f, y + 0.008f * s + 0.25f * gap, 0.099f * s);
   t[17] = glm::vec3(0.f, y - 0.010f * s - 0.75f * gap, 0.097f * s);
+  set_lip_sides(t, s, 0.f, 0.f, 0.f, 0.f);
 }
 
 void build_template(std::array<glm::vec3, k_face_mesh_iris_count>& t, float s) {
@@ -225,6 +246,9 @@ synth_face_shape draw_face_shape(std::uint32_t seed) {
   f.roll_upper = u(0.0045f, 0.0055f);
   f.roll_lower = u(0.006f, 0.007f);
   f.chin_ratio = u(1.12f, 1.22f);
+  f.upper_up = u(0.0035f, 0.0045f);
+  f.lower_down = u(0.0035f, 0.0045f);
+  f.sneer = u(0.0025f, 0.0035f);
   return f;
 }
 
@@ -565,6 +589,14 @@ void landmark_synth::build_face(const proxy_pose& pose) {
       glm::vec3(shift + jaw, y - 0.010f * s - 0.5f * part - drop + roll_down, 0.097f * s + forward);
   f[152].x += jaw;
   f[152].y -= fs.chin_ratio * fs.jaw_drop * s * jaw_open;
+  // The lips' sides ride on the corners and middles just set; mouthUpperUp / mouthLowerDown
+  // move them off. noseSneer lifts the nose's wings.
+  set_lip_sides(f, s, fs.upper_up * s * B(blendshape::mouth_upper_up_left, 1),
+                fs.upper_up * s * B(blendshape::mouth_upper_up_left, 0),
+                fs.lower_down * s * B(blendshape::mouth_lower_down_left, 1),
+                fs.lower_down * s * B(blendshape::mouth_lower_down_left, 0));
+  f[327].y += fs.sneer * s * B(blendshape::nose_sneer_left, 0);
+  f[98].y += fs.sneer * s * B(blendshape::nose_sneer_left, 1);
 
   const glm::quat& head = fk_.world[idx(bone::head)];
   const glm::vec3& origin = fk_.joints[idx(bone::head)];

@@ -252,6 +252,22 @@ proxy_pose random_pose(std::mt19937& rng, const random_pose_limits& L) {
     // poses whose jaw is open.
     if (bs[idx(blendshape::jaw_open)] > 0.2f && uniform(own, 0.f, 1.f) < 0.2f)
       set(blendshape::mouth_close, bs[idx(blendshape::jaw_open)] * uniform(own, 0.3f, 1.f));
+    // A sneer (the nose's wings up, the upper lip's sides often with them) in 8 % of the poses;
+    // the lower lip's sides pulled down (the lower teeth shown) in 8 %. Each side within half
+    // of the other.
+    auto own_pair = [&](blendshape left, float v) {
+      const float other = std::min(1.f, v * uniform(own, 0.5f, 1.5f));
+      const bool first = uniform(own, 0.f, 1.f) < 0.5f;
+      bs[idx(left)] = first ? v : other;
+      bs[idx(left) + 1] = first ? other : v;
+    };
+    if (uniform(own, 0.f, 1.f) < 0.08f) {
+      own_pair(blendshape::nose_sneer_left, uniform(own, 0.f, 1.f));
+      if (uniform(own, 0.f, 1.f) < 0.5f)
+        own_pair(blendshape::mouth_upper_up_left, uniform(own, 0.f, 1.f));
+    }
+    if (uniform(own, 0.f, 1.f) < 0.08f)
+      own_pair(blendshape::mouth_lower_down_left, uniform(own, 0.f, 1.f));
   }
   set_truth_expressions(p);
   return p;

@@ -87,6 +87,11 @@ TEST(FaceAccuracy, TuningSeedsPrinted) {
   }
   print("tune 1-5", all, left_out);
   print_shapes(all);
+  pose_accuracy noisy;
+  long noisy_out = 0;
+  for (std::uint32_t seed : {1u, 2u, 3u, 4u, 5u})
+    noisy_out += run(synth_scenario::noisy, synth_motion::random, seed, 20.0, noisy);
+  print("tune 1-5 noisy", noisy, noisy_out);
 }
 
 TEST(FaceAccuracy, HeldOutSeedsCleanRandomMotion) {

@@ -2,9 +2,11 @@
 // "Calibration over a take") against the synthetic generator's faces (landmark_synth.cpp, its
 // own deformation rules): a resting face unlike the population's reads ~0 from the take's first
 // frame, even as the head turns; what a take that smiles most of the time reads (the quantile
-// decides); the held-out accuracy seeds keep their figures; short and empty takes.
+// decides); the irises' rest is the take's most frequent gaze; the held-out accuracy seeds keep
+// their figures; short and empty takes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -148,6 +150,61 @@ TEST(FaceTake, MostlySmilingTakeTakesTheSmileForNeutral) {
         EXPECT_GT(frown, smiling[i] ? -1.f : 0.8f) << i;
       }
     }
+  }
+}
+
+// The irises' rest is the take's most frequent gaze, not its median: a person who looks at the
+// camera 40 % of the time and down-left at a keyboard the rest (a spread of places, so no one
+// of them is as frequent) reads 0 at the camera, and the keyboard's looks at their true angles.
+// The take's median lies among the keyboard's looks: calibrated to it, the looks at the camera
+// would read 10 degrees or more off.
+TEST(FaceTake, IrisRestIsTheMostFrequentGazeNotTheMedian) {
+  for (std::uint32_t seed : {11u, 12u, 13u}) {
+    synth_options so;
+    so.face_variation = true;
+    so.seed = seed;
+    landmark_synth synth(so);
+    const int n = 300;
+    std::vector<landmark_frame> take(n);
+    std::vector<glm::vec2> gaze(n);  // (yaw, pitch) in degrees, the truth
+    proxy_pose p = standing(synth);
+    for (int i = 0; i < n; ++i) {
+      p.t = i / 30.0;
+      // Held 10 frames per place: at the camera, else a spread over the keyboard's area.
+      const int place = i / 10;
+      const bool at_camera = place % 5 < 2;
+      const float yaw = at_camera ? 0.f : -8.f - 3.f * float((place * 7) % 5);
+      const float pitch = at_camera ? 0.f : -10.f - 2.f * float((place * 3) % 4);
+      gaze[i] = glm::vec2(yaw, pitch);
+      p[bone::left_eye] = p[bone::right_eye] =
+          glm::angleAxis(yaw * k_deg, glm::vec3(0.f, 1.f, 0.f)) *
+          glm::angleAxis(-pitch * k_deg, glm::vec3(1.f, 0.f, 0.f));
+      synth.generate(p, take[i]);
+    }
+    frame_solver solver(options_for(so));
+    ASSERT_TRUE(solver.calibrate_face(take.data(), take.size()));
+    proxy_pose out;
+    double camera_sum = 0.0, keyboard_sum = 0.0;
+    int camera_n = 0, keyboard_n = 0;
+    for (int i = 0; i < n; ++i) {
+      solver.solve(take[i], out);
+      const glm::vec3 fwd(0.f, 0.f, 1.f);
+      const glm::quat truth = glm::angleAxis(gaze[i].x * k_deg, glm::vec3(0.f, 1.f, 0.f)) *
+                              glm::angleAxis(-gaze[i].y * k_deg, glm::vec3(1.f, 0.f, 0.f));
+      const float err =
+          std::acos(
+              std::min(1.f, glm::dot(truth * fwd, glm::normalize(out[bone::left_eye]) * fwd))) /
+          k_deg;
+      if (gaze[i] == glm::vec2(0.f)) {
+        camera_sum += err;
+        ++camera_n;
+      } else {
+        keyboard_sum += err;
+        ++keyboard_n;
+      }
+    }
+    EXPECT_LT(camera_sum / camera_n, 1.5) << seed << ": looks at the camera";
+    EXPECT_LT(keyboard_sum / keyboard_n, 2.5) << seed << ": looks at the keyboard";
   }
 }
 

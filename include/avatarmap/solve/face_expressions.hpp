@@ -47,7 +47,13 @@ inline constexpr blendshape k_mesh_blendshapes[] = {blendshape::brow_down_left,
                                                     blendshape::jaw_right,
                                                     blendshape::mouth_roll_lower,
                                                     blendshape::mouth_roll_upper,
-                                                    blendshape::mouth_close};
+                                                    blendshape::mouth_close,
+                                                    blendshape::mouth_upper_up_left,
+                                                    blendshape::mouth_upper_up_right,
+                                                    blendshape::mouth_lower_down_left,
+                                                    blendshape::mouth_lower_down_right,
+                                                    blendshape::nose_sneer_left,
+                                                    blendshape::nose_sneer_right};
 
 inline constexpr float k_eye_look_full_side_sin = 0.42261826f;  // sin 25 deg
 inline constexpr float k_eye_look_full_vert_sin = 0.34202014f;  // sin 20 deg

@@ -186,6 +186,9 @@ struct synth_face_shape {
                                       // mouthRollUpper 1 [4.5, 5.5] mm
   float roll_lower = 0.0065f;         // lower lip's outer edge at mouthRollLower 1 [6, 7] mm
   float chin_ratio = 1.17f;           // chin's drop / the lower lip's at jawOpen [1.12, 1.22]
+  float upper_up = 0.004f;    // upper lip's side points' rise at mouthUpperUp 1 [3.5, 4.5] mm
+  float lower_down = 0.004f;  // lower lip's side points' drop at mouthLowerDown 1 [3.5, 4.5] mm
+  float sneer = 0.003f;       // nose wing's rise at noseSneer 1 [2.5, 3.5] mm
 };
 
 /// Draws a face for `seed` (the ranges of synth_face_shape).

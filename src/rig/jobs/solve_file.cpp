@@ -188,14 +188,16 @@ status solve_file_job::run(solve_file_summary& s) const {
   // exactly: no warm-up.
   state->warming = filter_mode == pose_filter_mode::offline;
   pose_stream& stream = state->stream;
-  // Whatever the filter, a regular file's face is calibrated over all its frames first; a
-  // source's, a pipe's or standard input's (read once) over the first k_warm_up_frames (the
-  // warm-up's with the offline filter, else held back for it): these give a file's poses when
-  // it is no longer.
+  // Whatever the filter, a regular file's face is calibrated over all its frames (with the
+  // offline filter after the warm-up, else before the first frame); a source's, a pipe's or
+  // standard input's (read once) over the first k_warm_up_frames (the warm-up's with the
+  // offline filter, else held back for it): these give a file's poses when it is no longer.
   std::error_code fs_error;
   const bool read_twice = !source && std::filesystem::is_regular_file(input, fs_error);
   const bool face = solve_options.parts.face;
-  if (face && read_twice) calibrate_face_over_file(input, stream_solver(stream));
+  // With the warm-up (the offline filter) the calibration waits for its end, when the field
+  // of view is learnt and held: the take is read through the lens it is solved with.
+  if (face && read_twice && !state->warming) calibrate_face_over_file(input, stream_solver(stream));
   state->holding_face = face && !read_twice && !state->warming;
   auto end_holding_face = [&]() -> status {
     solve_state& ws = *state;
@@ -212,12 +214,14 @@ status solve_file_job::run(solve_file_summary& s) const {
   auto end_warm_up = [&]() -> status {
     solve_state& ws = *state;
     ws.warming = false;
-    if (face && !read_twice)
-      stream_solver(ws.stream).calibrate_face(ws.warm.data(), ws.warm.size());
     ws.stream.restart_take(false);
     for (const landmark_frame& f : ws.warm) ws.stream.learn_camera(f);
     ws.stream.restart_take();
     ws.stream.hold_view();
+    if (face && read_twice)
+      calibrate_face_over_file(input, stream_solver(ws.stream));
+    else if (face)
+      stream_solver(ws.stream).calibrate_face(ws.warm.data(), ws.warm.size());
     for (const landmark_frame& f : ws.warm)
       if (status st = ws.stream.push(f, emit); !st.ok()) return st;
     ws.warm.clear();

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -74,10 +75,12 @@ TEST(face_rest, pose_squats_face_reads_near_zero_at_rest) {
   ASSERT_EQ(shapes.size(), 65u);
   ASSERT_GT(ss.face_iris_frames, 50);
 
-  // The shapes the solver measures, but the eyeLook ones: where this person looks is not
-  // known (their irises keep the live calibration, docs/expressions.md).
-  constexpr const auto& k_shapes = k_mesh_blendshapes;
-  for (blendshape b : k_shapes) {
+  // Every shape the solver measures: the mesh's (k_mesh_blendshapes) and the eyes' looks (the
+  // irises' rest is the take's most frequent gaze, docs/expressions.md).
+  std::vector<blendshape> measured(std::begin(k_mesh_blendshapes), std::end(k_mesh_blendshapes));
+  for (int b = idx(blendshape::eye_look_down_left); b <= idx(blendshape::eye_look_up_right); ++b)
+    measured.push_back(static_cast<blendshape>(b));
+  for (blendshape b : measured) {
     std::vector<float> v;
     for (const auto& s : shapes) v.push_back(s[idx(b)]);
     const float m = quantile(v, 0.5f), p90 = quantile(v, 0.9f), j = jitter(v);

@@ -126,8 +126,9 @@ std::vector<proxy_pose> reference_offline_poses(const std::string& path, solver_
   landmark_reader reader;
   EXPECT_TRUE(reader.open(path).ok());
   frame_solver solver(options);
-  calibrate_face(solver, path);
+  // The face is calibrated after the warm-up, through the field of view it learnt.
   warm_up(solver, path);
+  calibrate_face(solver, path);
   offline_smoother smoother(smooth);
   foot_contact_stage contacts(foot_contact_options{}, true);  // both-sided, as for files
   // As the warm-up's end does (pose_stream::restart_take).
