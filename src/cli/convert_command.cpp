@@ -16,6 +16,7 @@
 #include "avatarmap/core/limits.hpp"
 #include "avatarmap/jobs/clip_output.hpp"
 #include "avatarmap/jobs/convert_file.hpp"
+#include "avatarmap/jobs/people.hpp"
 #include "avatarmap/rig/bound_avatar.hpp"
 #include "avatarmap/rig/retarget.hpp"
 #include "avatarmap/skeleton/proxy_skeleton.hpp"
@@ -49,7 +50,8 @@ const cli_flag k_convert_flags[] = {
     {"--avatar", nullptr, "FILE",
      "the avatar (.vrm, .glb, .gltf, or a .bvh's skeleton) to drive (.glb: the built-in avatar "
      "when not given, as `avatarmap avatar` writes it; with .bvh: write its rig instead of "
-     "the proxy skeleton)"},
+     "the proxy skeleton). Repeat it for a file of several people: person i (in id order) "
+     "drives the i-th avatar, cycling"},
     {"--rig", nullptr, "auto|NAME|FILE.json",
      "how the avatar's joints map to the proxy: auto (default) uses a VRM's own humanoid map, "
      "else the best shipped table (mixamo, unity_humanoid, ue4_mannequin, ue5_mannequin, "
@@ -74,7 +76,7 @@ const cli_flag k_convert_flags[] = {
 #define AVATARMAP_CONVERT_SOLVE_FLAGS                                         \
   {                                                                           \
     "--smoothing", "--min-cutoff", "--beta", "--threads", "--skip-bad-lines", \
-        "--no-foot-contacts", "--no-root-follow"                              \
+        "--no-foot-contacts", "--no-root-follow", "--person"                  \
   }
 
 void append_position(std::string& s, const std::string& name, glm::dvec3 p, bool first) {
@@ -179,90 +181,9 @@ std::string binding_hint(const convert_file_job& job, const convert_file_summary
          job.avatar + "` lists the joints)";
 }
 
-}  // namespace
-
-void add_convert_command_flag_specs(std::vector<flag_spec>& out) {
-  const solve_file_job start = make_cli_solve_job();
-  add_flag_specs(k_convert_flags, out);
-  add_flag_specs(k_solver_option_table, start.options, out);
-  add_flag_specs(k_solve_file_option_table, start, out, AVATARMAP_CONVERT_SOLVE_FLAGS);
-}
-
-int run_convert(int argc, char** argv) {
-  args a(argc, argv, 2);
-  if (a.flag("--help") || a.flag("-h")) {
-    const solve_file_job start = make_cli_solve_job();
-    std::fputs(k_convert_help, stdout);
-    std::fputs(cli_flags_help(k_convert_flags).c_str(), stdout);
-    std::fputs("\nLandmark input (solved as by `avatarmap solve`):\n", stdout);
-    std::fputs(option_flags_help(k_solver_option_table, start.options).c_str(), stdout);
-    std::fputs(
-        option_flags_help(k_solve_file_option_table, start, AVATARMAP_CONVERT_SOLVE_FLAGS).c_str(),
-        stdout);
-    return 0;
-  }
-  convert_file_job job;
-  job.avatar_name = "--avatar AVATAR";
-  job.binding.overrides_name = "--bind";
-  std::string value;
-  a.value("--output", job.output, "-o");
-  a.value("--avatar", job.avatar);
-  a.value("--rig", job.binding.rig);
-  while (a.value("--bind", value)) {  // --bind BONE=JOINT, repeatable
-    bone_override o;
-    if (status st = parse_bone_override(value, o); !st.ok()) {
-      std::fprintf(stderr, "avatarmap convert: --bind %s\n", st.message().c_str());
-      return 2;
-    }
-    job.binding.overrides.push_back(o);
-  }
-  std::string dump_path;  // hidden diagnostic option, see dump_positions()
-  a.value("--dump-positions", dump_path);
-  double fps = 0.0;
-  const bool fps_given = a.number("--fps", fps);
-  job.keep_feet_on_ground = a.flag("--ground");
-  job.root_motion = !a.flag("--no-root-motion");
-  job.foot_lock.enabled = !a.flag("--no-foot-lock");
-  const bool quiet = a.flag("--quiet");
-  job.solve = make_cli_solve_job();
-  std::string error;
-  if (!parse_option_flags(a, k_solver_option_table, job.solve.options, error) ||
-      !parse_option_flags(a, k_solve_file_option_table, job.solve, error,
-                          AVATARMAP_CONVERT_SOLVE_FLAGS)) {
-    std::fprintf(stderr, "avatarmap convert: %s\n", error.c_str());
-    return 2;
-  }
-  if (!parse_parts_flag(a, job.solve.options.parts, error)) {
-    std::fprintf(stderr, "avatarmap convert: landmark input: %s\n", error.c_str());
-    return 2;
-  }
-  if (a.value("--image-size", value)) {
-    int w = 0, h = 0;
-    if (!parse_image_size(value, w, h)) {
-      std::fprintf(stderr, "avatarmap convert: --image-size wants WxH in pixels, e.g. 1280x720\n");
-      return 2;
-    }
-    job.solve.image_width = float(w);
-    job.solve.image_height = float(h);
-  }
-  if (a.value("--filter", value) && !apply_filter_option(value, job.solve)) {
-    std::fprintf(stderr, "avatarmap convert: --filter is %s, got '%s'\n", k_filter_names,
-                 value.c_str());
-    return 2;
-  }
-  if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 1 || job.output.empty()) {
-    std::fprintf(stderr, "avatarmap convert: %s\n",
-                 !a.error().empty()     ? a.error().c_str()
-                 : a.rest().size() != 1 ? "give exactly one input file (see --help)"
-                                        : "give the output with -o OUT (see --help)");
-    return 2;
-  }
-  if (fps_given && !(fps >= 0.0 && fps <= k_max_fps)) {
-    std::fprintf(stderr, "avatarmap convert: --fps must be 0 or in (0, %s], got %s\n",
-                 limit_text(k_max_fps).c_str(), limit_text(fps).c_str());
-    return 2;
-  }
-  job.input = a.rest()[0];
+// One conversion: the avatar (the built-in one for a .glb without --avatar), the rate, the run.
+int convert_one(convert_file_job& job, bool fps_given, double fps, bool quiet,
+                const std::string& dump_path) {
   // A .glb without --avatar carries the built-in avatar (as `view` shows it): written to a
   // private temporary file that the binding and the writer read, removed at the end (or by
   // the signal handlers, main.cpp).
@@ -320,6 +241,119 @@ int run_convert(int argc, char** argv) {
     std::fprintf(stderr, "wrote %s\n", job.output.c_str());
   }
   return 0;
+}
+
+}  // namespace
+
+void add_convert_command_flag_specs(std::vector<flag_spec>& out) {
+  const solve_file_job start = make_cli_solve_job();
+  add_flag_specs(k_convert_flags, out);
+  add_flag_specs(k_solver_option_table, start.options, out);
+  add_flag_specs(k_solve_file_option_table, start, out, AVATARMAP_CONVERT_SOLVE_FLAGS);
+}
+
+int run_convert(int argc, char** argv) {
+  args a(argc, argv, 2);
+  if (a.flag("--help") || a.flag("-h")) {
+    const solve_file_job start = make_cli_solve_job();
+    std::fputs(k_convert_help, stdout);
+    std::fputs(cli_flags_help(k_convert_flags).c_str(), stdout);
+    std::fputs("\nLandmark input (solved as by `avatarmap solve`):\n", stdout);
+    std::fputs(option_flags_help(k_solver_option_table, start.options).c_str(), stdout);
+    std::fputs(
+        option_flags_help(k_solve_file_option_table, start, AVATARMAP_CONVERT_SOLVE_FLAGS).c_str(),
+        stdout);
+    return 0;
+  }
+  convert_file_job job;
+  job.avatar_name = "--avatar AVATAR";
+  job.binding.overrides_name = "--bind";
+  std::string value;
+  a.value("--output", job.output, "-o");
+  std::vector<std::string> avatars;  // --avatar A, repeatable: person i gets avatar i mod n
+  while (a.value("--avatar", value)) avatars.push_back(value);
+  if (!avatars.empty()) job.avatar = avatars.front();
+  a.value("--rig", job.binding.rig);
+  while (a.value("--bind", value)) {  // --bind BONE=JOINT, repeatable
+    bone_override o;
+    if (status st = parse_bone_override(value, o); !st.ok()) {
+      std::fprintf(stderr, "avatarmap convert: --bind %s\n", st.message().c_str());
+      return 2;
+    }
+    job.binding.overrides.push_back(o);
+  }
+  std::string dump_path;  // hidden diagnostic option, see dump_positions()
+  a.value("--dump-positions", dump_path);
+  double fps = 0.0;
+  const bool fps_given = a.number("--fps", fps);
+  job.keep_feet_on_ground = a.flag("--ground");
+  job.root_motion = !a.flag("--no-root-motion");
+  job.foot_lock.enabled = !a.flag("--no-foot-lock");
+  const bool quiet = a.flag("--quiet");
+  job.solve = make_cli_solve_job();
+  std::string error;
+  if (!parse_option_flags(a, k_solver_option_table, job.solve.options, error) ||
+      !parse_option_flags(a, k_solve_file_option_table, job.solve, error,
+                          AVATARMAP_CONVERT_SOLVE_FLAGS)) {
+    std::fprintf(stderr, "avatarmap convert: %s\n", error.c_str());
+    return 2;
+  }
+  if (!parse_parts_flag(a, job.solve.options.parts, error)) {
+    std::fprintf(stderr, "avatarmap convert: landmark input: %s\n", error.c_str());
+    return 2;
+  }
+  if (a.value("--image-size", value)) {
+    int w = 0, h = 0;
+    if (!parse_image_size(value, w, h)) {
+      std::fprintf(stderr, "avatarmap convert: --image-size wants WxH in pixels, e.g. 1280x720\n");
+      return 2;
+    }
+    job.solve.image_width = float(w);
+    job.solve.image_height = float(h);
+  }
+  if (a.value("--filter", value) && !apply_filter_option(value, job.solve)) {
+    std::fprintf(stderr, "avatarmap convert: --filter is %s, got '%s'\n", k_filter_names,
+                 value.c_str());
+    return 2;
+  }
+  if (!a.error().empty() || !a.check_no_options() || a.rest().size() != 1 || job.output.empty()) {
+    std::fprintf(stderr, "avatarmap convert: %s\n",
+                 !a.error().empty()     ? a.error().c_str()
+                 : a.rest().size() != 1 ? "give exactly one input file (see --help)"
+                                        : "give the output with -o OUT (see --help)");
+    return 2;
+  }
+  if (fps_given && !(fps >= 0.0 && fps <= k_max_fps)) {
+    std::fprintf(stderr, "avatarmap convert: --fps must be 0 or in (0, %s], got %s\n",
+                 limit_text(k_max_fps).c_str(), limit_text(fps).c_str());
+    return 2;
+  }
+  job.input = a.rest()[0];
+  // A landmark file of several people: one run per person (jobs/people.hpp).
+  std::vector<person_run> runs;
+  const motion_input_info* kind = nullptr;
+  if (find_motion_input(job.input, kind).ok() && kind->kind == motion_input::landmarks) {
+    if (status st = plan_person_runs(job.input, job.solve.person, job.output, runs); !st.ok()) {
+      std::fprintf(stderr, "avatarmap convert: %s\n", st.message().c_str());
+      return st.code() == status_code::invalid_argument ? 2 : 1;
+    }
+  } else if (job.solve.person >= 0) {
+    std::fprintf(stderr, "avatarmap convert: --person applies to a landmark input only\n");
+    return 2;
+  }
+  if (runs.size() > 1) {
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      convert_file_job one = job;
+      one.solve.person = runs[i].person;
+      one.output = runs[i].output;
+      if (!avatars.empty()) one.avatar = avatars[i % avatars.size()];
+      if (!quiet) std::fprintf(stderr, "person %d -> %s\n", runs[i].person, one.output.c_str());
+      if (const int rc = convert_one(one, fps_given, fps, quiet, dump_path); rc != 0) return rc;
+    }
+    return 0;
+  }
+  if (runs.size() == 1) job.solve.person = runs[0].person;
+  return convert_one(job, fps_given, fps, quiet, dump_path);
 }
 
 }  // namespace avatarmap::cli

@@ -1,7 +1,9 @@
 // `avatarmap solve`: *.landmarks.jsonl -> *.pose.jsonl.
 #include <cstdio>
 #include <string>
+#include <vector>
 
+#include "avatarmap/jobs/people.hpp"
 #include "avatarmap/jobs/solve_file.hpp"
 #include "cli/cli_args.hpp"
 #include "cli/commands.hpp"
@@ -97,13 +99,26 @@ int run_solve(int argc, char** argv) {
     std::fprintf(stderr, "avatarmap solve: %s\n", st.message().c_str());
     return 2;
   }
-  solve_file_summary summary;
-  st = run_solve_job(job, progress, summary);
+  // One run per person of a file of several (jobs/people.hpp).
+  std::vector<person_run> runs;
+  st = plan_person_runs(job.input, job.person, job.output, runs);
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap solve: %s\n", st.message().c_str());
-    return 1;
+    return st.code() == status_code::invalid_argument ? 2 : 1;
   }
-  print_summary(job, summary, stderr);
+  for (const person_run& r : runs) {
+    solve_file_job one = job;
+    one.person = r.person;
+    one.output = r.output;
+    if (runs.size() > 1) std::fprintf(stderr, "person %d -> %s\n", r.person, r.output.c_str());
+    solve_file_summary summary;
+    st = run_solve_job(one, progress, summary);
+    if (!st.ok()) {
+      std::fprintf(stderr, "avatarmap solve: %s\n", st.message().c_str());
+      return 1;
+    }
+    print_summary(one, summary, stderr);
+  }
   return 0;
 }
 

@@ -24,7 +24,7 @@ using io_detail::line_status;
 namespace {
 
 constexpr std::string_view k_landmark_format = "avatarmap.landmarks";
-constexpr int k_supported_version = 1;
+constexpr int k_supported_version = 2;
 
 // Part from its JSON key, or -1.
 int part_from_key(std::string_view key) {
@@ -215,6 +215,7 @@ struct landmark_reader::impl {
   io_detail::jsonl_reader_core core;
   landmark_file_header header;
   long frame_index = 0;  // frame lines seen (good or bad), for t = index / fps
+  int person = -1;       // set_person: only this person's lines (-1: every line)
   std::string scratch;
 #if AVATARMAP_HAVE_SIMDJSON
   simdjson::ondemand::parser simd_parser;
@@ -246,6 +247,12 @@ struct landmark_reader::impl {
       if (key == "t") {
         if (value.get_double().get(out.t) || !std::isfinite(out.t)) return false;
         has_t = true;
+        continue;
+      }
+      if (key == "person") {
+        std::int64_t id = 0;
+        if (value.get_int64().get(id) || id < 0 || id > k_max_person_id) return false;
+        out.person = static_cast<int>(id);
         continue;
       }
       const int part = part_from_key(key);
@@ -322,12 +329,12 @@ struct landmark_reader::impl {
       if (key == "version") {
         double v = 0;
         if (!c.parse_double(v) || !(v >= 1) || v != std::floor(v)) {
-          problem = "\"version\" must be a positive integer (expected 1)";
+          problem = "\"version\" must be a positive integer (expected 1 or 2)";
           return false;
         }
         if (v > k_supported_version) {
           problem = "version " + std::to_string(static_cast<long long>(std::min(v, 1e18))) +
-                    " is newer than this reader supports (expected 1); update avatarmap";
+                    " is newer than this reader supports (expected 1 or 2); update avatarmap";
           return false;
         }
         header.version = static_cast<int>(v);
@@ -427,6 +434,16 @@ struct landmark_reader::impl {
           if (!std::isfinite(out.t)) return c.fail("not a finite number (expected seconds)");
           has_t = true;
           ctx.key = {};
+        } else if (key == "person") {
+          ctx.key = "person";
+          double id = 0;
+          bool was_null = false;
+          if (!c.parse_double(id, &was_null)) return false;
+          if (was_null || !(id >= 0 && id <= k_max_person_id) || id != std::floor(id))
+            return c.fail("must be a person id, an integer in [0, " +
+                          std::to_string(k_max_person_id) + "]");
+          out.person = static_cast<int>(id);
+          ctx.key = {};
         } else if (key == "format" || key == "version") {
           return c.fail("header key \"" + std::string(key) +
                         "\" in a frame (a header is only allowed as the first line)");
@@ -443,6 +460,13 @@ struct landmark_reader::impl {
       if (!c.at_end()) ok = c.fail("unexpected text after the frame object (expected end of line)");
     }
     if (ok && !has_t) {
+      if (header.version >= 2) {
+        // Several people share a time: a line's place does not tell it.
+        core.set_error(
+            "missing \"t\" (a version-2 file, several people, gives every line its time)");
+        out.clear();
+        return read_result::error;
+      }
       if (header.fps > 0) {
         out.t = static_cast<double>(index) / header.fps;
         if (!std::isfinite(out.t)) {
@@ -492,18 +516,42 @@ status landmark_reader::open_memory(const char* data, std::size_t size, const st
 const landmark_file_header& landmark_reader::header() const { return impl_->header; }
 
 read_result landmark_reader::next(landmark_frame& out) {
-  std::string_view line;
-  switch (impl_->core.next_line(line)) {
-    case line_status::end:
-      out.clear();
-      return read_result::end;
-    case line_status::error:
-      out.clear();
-      return read_result::error;
-    case line_status::line:
-      break;
+  for (;;) {
+    std::string_view line;
+    switch (impl_->core.next_line(line)) {
+      case line_status::end:
+        out.clear();
+        return read_result::end;
+      case line_status::error:
+        out.clear();
+        return read_result::error;
+      case line_status::line:
+        break;
+    }
+    const read_result r = impl_->parse_frame(line, out);
+    if (r != read_result::frame || impl_->person < 0 || out.person == impl_->person) return r;
   }
-  return impl_->parse_frame(line, out);
+}
+
+void landmark_reader::set_person(int person) { impl_->person = person < 0 ? -1 : person; }
+
+status people_in_file(const std::string& path, std::vector<int>& ids) {
+  ids.clear();
+  landmark_reader reader;
+  if (status s = reader.open(path); !s) return s;
+  auto frame = std::make_unique<landmark_frame>();
+  std::vector<bool> seen;
+  for (;;) {
+    const read_result r = reader.next(*frame);
+    if (r == read_result::end) break;
+    if (r == read_result::error) return status::failure(reader.error_code(), reader.error());
+    const auto at = static_cast<std::size_t>(frame->person);
+    if (at >= seen.size()) seen.resize(at + 1, false);
+    seen[at] = true;
+  }
+  for (std::size_t i = 0; i < seen.size(); ++i)
+    if (seen[i]) ids.push_back(static_cast<int>(i));
+  return {};
 }
 
 const std::string& landmark_reader::error() const { return impl_->core.error(); }
@@ -514,6 +562,7 @@ long landmark_reader::line() const { return impl_->core.line(); }
 
 struct landmark_writer::impl {
   io_detail::text_output out;
+  int version = 1;
 
   bool put_points(const landmark* pts, int count, bool always_five) {
     for (int i = 0; i < count; ++i) {
@@ -549,7 +598,9 @@ status landmark_writer::open(const std::string& path, const landmark_file_header
   if (!s) return s;
   auto& o = impl_->out;
   o.reserve(256);
-  o.put("{\"format\":\"avatarmap.landmarks\",\"version\":1");
+  impl_->version = header.version >= 2 ? 2 : 1;
+  o.put(impl_->version == 2 ? "{\"format\":\"avatarmap.landmarks\",\"version\":2"
+                            : "{\"format\":\"avatarmap.landmarks\",\"version\":1");
   if (header.image_width > 0 && header.image_height > 0) {
     o.put(",\"image_size\":[");
     o.put_number(header.image_width);
@@ -571,6 +622,10 @@ status landmark_writer::write(const landmark_frame& frame) {
   if (!o.reserve(64)) return o.error_status();
   o.put("{\"t\":");
   o.put_number(frame.t);
+  if (impl_->version >= 2) {
+    o.put(",\"person\":");
+    o.put_number(frame.person);
+  }
   for (int p = 0; p < k_frame_part_count; ++p) {
     auto fp = static_cast<frame_part>(p);
     if (!frame.has(fp)) continue;

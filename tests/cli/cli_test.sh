@@ -78,6 +78,51 @@ synth_input() {
 }
 
 case $case_name in
+  people)
+    # A landmark file of two people (version 2, docs/file-formats.md): two recordings' lines
+    # interleaved by time with ids 0 and 5 (written here, apart from the tool's writer).
+    "$exe" synth -o a.landmarks.jsonl --seconds 2 --seed 3 >/dev/null 2>&1 || fail "synth a"
+    "$exe" synth -o b.landmarks.jsonl --seconds 2 --seed 4 --scenario clean >/dev/null 2>&1 ||
+      fail "synth b"
+    python3 -c 'import json
+a = open("a.landmarks.jsonl").read().splitlines()
+b = open("b.landmarks.jsonl").read().splitlines()
+h = json.loads(a[0]); h["version"] = 2
+out = [json.dumps(h)]
+for la, lb in zip(a[1:], b[1:]):
+    for pid, line in ((0, la), (5, lb)):
+        d = json.loads(line); d["person"] = pid; out.append(json.dumps(d))
+open("two.landmarks.jsonl", "w").write("\n".join(out) + "\n")' || fail "could not write the two-person file"
+    # Each person to its own output, the same poses as solving that person's recording alone.
+    run 0 solve two.landmarks.jsonl -o take.pose.jsonl
+    expect_in err.txt "person 0 -> take.p0.pose.jsonl"
+    expect_in err.txt "person 5 -> take.p5.pose.jsonl"
+    [ -e take.pose.jsonl ] && fail "solve of two people wrote take.pose.jsonl"
+    run 0 solve a.landmarks.jsonl -o a.pose.jsonl
+    run 0 solve b.landmarks.jsonl -o b.pose.jsonl
+    cmp -s a.pose.jsonl take.p0.pose.jsonl || fail "person 0's poses differ from a's alone"
+    cmp -s b.pose.jsonl take.p5.pose.jsonl || fail "person 5's poses differ from b's alone"
+    # One person asked for: one output under the name given.
+    run 0 solve two.landmarks.jsonl -o five.pose.jsonl --person 5
+    cmp -s b.pose.jsonl five.pose.jsonl || fail "--person 5 is not b's poses"
+    run 2 solve two.landmarks.jsonl -o x.pose.jsonl --person 3
+    expect_in err.txt "no person 3 (its people: 0, 5)"
+    run 2 solve two.landmarks.jsonl -o -
+    expect_in err.txt "cannot share standard output"
+    # A single-person file keeps its name; --person 0 is it, another id is not there.
+    run 0 solve a.landmarks.jsonl -o one.pose.jsonl --person 0
+    cmp -s a.pose.jsonl one.pose.jsonl || fail "--person 0 of a one-person file changed it"
+    run 2 solve a.landmarks.jsonl -o one.pose.jsonl --person 1
+    expect_in err.txt "no person 1 (its people: 0)"
+    # convert: one .glb per person, the avatars given in turn.
+    run 0 convert two.landmarks.jsonl -o take.glb --quiet
+    [ -s take.p0.glb ] && [ -s take.p5.glb ] || fail "convert did not write take.p0.glb and take.p5.glb"
+    [ -e take.glb ] && fail "convert of two people wrote take.glb"
+    run 0 convert two.landmarks.jsonl -o five.pose.jsonl --person 5 --quiet
+    cmp -s b.pose.jsonl five.pose.jsonl || fail "convert --person 5 is not b's poses"
+    # An old reader's view: the header says version 2, so a version-1 reader refuses it.
+    expect_in two.landmarks.jsonl '"version": 2'
+    ;;
   glb_builtin)
     # A .glb without --avatar carries the built-in avatar, as `avatarmap avatar` writes it:
     # the same file as with --avatar set to that avatar, loaded by our own loader (inspect) as

@@ -436,7 +436,7 @@ TEST(landmark_file, header_rules) {
     const char* expected;
   } bad[] = {
       {"{\"format\":\"avatarmap.pose\",\"version\":1}", "wrong format \"avatarmap.pose\""},
-      {"{\"format\":\"avatarmap.landmarks\",\"version\":2}", "version 2 is newer"},
+      {"{\"format\":\"avatarmap.landmarks\",\"version\":3}", "version 3 is newer"},
       {"{\"format\":\"avatarmap.landmarks\",\"version\":0}", "\"version\" must be"},
       {"{\"format\":\"avatarmap.landmarks\",\"image_size\":[640]}", "\"image_size\" must be"},
       {"{\"format\":\"avatarmap.landmarks\",\"fps\":-1}", "\"fps\" must be"},
@@ -451,6 +451,87 @@ TEST(landmark_file, header_rules) {
     EXPECT_EQ(s.message().rfind("h.jsonl:1: bad header line", 0), 0u) << s.message();
     EXPECT_NE(s.message().find(b.expected), std::string::npos) << s.message();
   }
+}
+
+// Version 2 (several people): each line carries its person; the writer writes it only with a
+// version-2 header, so a version-1 file's bytes do not change; the reader filters by person.
+TEST(landmark_file, version_2_carries_a_person_per_line) {
+  temp_dir dir;
+  auto frames = make_frames(12, 3);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    frames[i].t = static_cast<double>(i / 3) / 30.0;  // three people per time
+    frames[i].person = static_cast<int>(i % 3) * 7;   // ids 0, 7, 14
+  }
+  landmark_file_header h;
+  h.version = 2;
+  h.fps = 30.0;
+  const std::string path = dir.file("three.landmarks.jsonl");
+  {
+    landmark_writer w;
+    ASSERT_TRUE(w.open(path, h).ok());
+    for (auto& f : frames) ASSERT_TRUE(w.write(f).ok());
+    ASSERT_TRUE(w.commit().ok());
+  }
+  EXPECT_EQ(read_text(path).rfind("{\"format\":\"avatarmap.landmarks\",\"version\":2", 0), 0u);
+  EXPECT_NE(read_text(path).find("{\"t\":0,\"person\":7,"), std::string::npos);
+  landmark_reader r;
+  ASSERT_TRUE(r.open(path).ok());
+  EXPECT_EQ(r.header().version, 2);
+  landmark_frame f;
+  for (const landmark_frame& want : frames) {
+    ASSERT_EQ(r.next(f), read_result::frame) << r.error();
+    EXPECT_EQ(f.person, want.person);
+    expect_same_frame(want, f);
+  }
+  EXPECT_EQ(r.next(f), read_result::end);
+  // One person's lines only.
+  landmark_reader one;
+  ASSERT_TRUE(one.open(path).ok());
+  one.set_person(7);
+  for (int k = 0; k < 4; ++k) {
+    ASSERT_EQ(one.next(f), read_result::frame) << one.error();
+    EXPECT_EQ(f.person, 7);
+    EXPECT_EQ(f.t, k / 30.0);
+    expect_same_frame(frames[static_cast<std::size_t>(3 * k + 1)], f);
+  }
+  EXPECT_EQ(one.next(f), read_result::end);
+  std::vector<int> ids;
+  ASSERT_TRUE(people_in_file(path, ids).ok());
+  EXPECT_EQ(ids, (std::vector<int>{0, 7, 14}));
+
+  // The same frames through a version-1 writer: no person written, every line person 0.
+  const std::string v1 = dir.file("one.landmarks.jsonl");
+  {
+    landmark_writer w;
+    ASSERT_TRUE(w.open(v1, landmark_file_header{}).ok());
+    for (auto& f2 : frames) ASSERT_TRUE(w.write(f2).ok());
+    ASSERT_TRUE(w.commit().ok());
+  }
+  EXPECT_EQ(read_text(v1).find("person"), std::string::npos);
+  ASSERT_TRUE(people_in_file(v1, ids).ok());
+  EXPECT_EQ(ids, (std::vector<int>{0}));
+  landmark_reader r1;
+  ASSERT_TRUE(r1.open(v1).ok());
+  r1.set_person(7);
+  EXPECT_EQ(r1.next(f), read_result::end);
+
+  // Bad persons, and a version-2 line without its time, name their line; reading goes on.
+  const std::string bad =
+      "{\"format\":\"avatarmap.landmarks\",\"version\":2,\"fps\":30}\n"
+      "{\"t\":0,\"person\":-1}\n{\"t\":0,\"person\":1.5}\n{\"t\":0,\"person\":\"a\"}\n"
+      "{\"t\":0,\"person\":1000000}\n{\"person\":2}\n{\"t\":0.5,\"person\":3}\n";
+  landmark_reader rb;
+  ASSERT_TRUE(rb.open_memory(bad.data(), bad.size(), "b.jsonl").ok());
+  for (int line = 2; line <= 5; ++line) {
+    ASSERT_EQ(rb.next(f), read_result::error) << line;
+    EXPECT_EQ(rb.error().rfind("b.jsonl:" + std::to_string(line) + ":", 0), 0u) << rb.error();
+    EXPECT_NE(rb.error().find("person"), std::string::npos) << rb.error();
+  }
+  ASSERT_EQ(rb.next(f), read_result::error);
+  EXPECT_NE(rb.error().find("missing \"t\""), std::string::npos) << rb.error();
+  ASSERT_EQ(rb.next(f), read_result::frame) << rb.error();
+  EXPECT_EQ(f.person, 3);
+  EXPECT_EQ(f.t, 0.5);
 }
 
 TEST(landmark_file, blank_lines_crlf_bom_and_last_line_without_newline) {

@@ -7,17 +7,19 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 
 namespace avatarmap {
 
-/// The optional first line {"format":"avatarmap.landmarks","version":1,...}.
+/// The optional first line {"format":"avatarmap.landmarks","version":1,...}. Version 2 (several
+/// people): each line also carries "person" and must carry "t" (docs/file-formats.md).
 struct landmark_file_header {
   bool present = false;  // false when the file has no header line
-  int version = 1;
-  int image_width = 0;  // 0 = not given
+  int version = 1;       // 1 or 2; the writer writes this one
+  int image_width = 0;   // 0 = not given
   int image_height = 0;
   double fps = 0.0;  // 0 = not given
 };
@@ -33,7 +35,7 @@ class landmark_reader {
 
   /// Opens `path` ("-" = standard input) and reads the header line if there is one. Fails
   /// when the file cannot be opened (status_code::io) or the header is bad (wrong format,
-  /// version > 1: status_code::parse).
+  /// version > 2: status_code::parse).
   status open(const std::string& path);
   /// Reads from a memory buffer (not copied: it must outlive the reader). For tests/fuzzing.
   status open_memory(const char* data, std::size_t size, const std::string& name = "<memory>");
@@ -49,11 +51,18 @@ class landmark_reader {
   status_code error_code() const;
   /// 1-based number of the line last read.
   long line() const;
+  /// Only this person's lines from now on (-1, the default: every line). next() passes the
+  /// others over; a version-1 file's lines are all person 0.
+  void set_person(int person);
 
  private:
   struct impl;
   std::unique_ptr<impl> impl_;
 };
+
+/// The person ids of a landmark file, ascending (one pass over it; {0} for a version-1 file).
+/// Fails as landmark_reader::open does, or on the first malformed line.
+status people_in_file(const std::string& path, std::vector<int>& ids);
 
 class landmark_writer {
  public:
@@ -67,8 +76,9 @@ class landmark_writer {
   /// image_size when both sizes are > 0, fps when > 0). Fails when the temporary file
   /// cannot be created (message names `path`).
   status open(const std::string& path, const landmark_file_header& header);
-  /// Writes one frame (only the parts it has). Numbers are the shortest text that reads back
-  /// bit-identical; non-finite numbers are written as null. Fails on a write error.
+  /// Writes one frame (only the parts it has; with a version-2 header also its person).
+  /// Numbers are the shortest text that reads back bit-identical; non-finite numbers are
+  /// written as null. Fails on a write error.
   status write(const landmark_frame& frame);
   /// Flushes, fsyncs and renames the temporary file over `path`. Destroying the writer
   /// without commit() removes the temporary file and leaves `path` untouched.

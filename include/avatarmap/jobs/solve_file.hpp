@@ -97,6 +97,10 @@ struct solve_file_job : pose_stream_filters {
   /// thread that calls run() (`threads` does not apply); no header: the image size is
   /// image_width/height or options.image_width/height, the output's fps 0.
   std::function<status(landmark_frame& out, bool& end)> source;
+  /// Which person of a file of several (docs/file-formats.md, version 2) is solved; -1: the
+  /// file's only person (a file of several people is then refused: jobs/people.hpp plans one
+  /// run per person). Not used with `source`.
+  int person = -1;
   /// *.pose.jsonl to write ("-" = standard output), atomically: on failure an existing file is
   /// left as it was. Ignored when `sink` is set.
   std::string output;
@@ -225,6 +229,12 @@ inline constexpr option_row<solve_file_job> k_solve_file_option_table[] = {
         .cli(nullptr, nullptr, "--no-root-follow")
         .help("--no-root-follow: detect foot contacts but leave the hips as filtered (default: "
               "the hips move so that a planted foot stays where it landed)"),
+    option_row<solve_file_job>("person", AVATARMAP_OPTION_FIELD(solve_file_job, person))
+        .integer(-1, k_max_person_id)
+        .cli("--person", "ID")
+        .not_in_c()
+        .help("of a file of several people, solve only person ID (default: each person to its "
+              "own output, the id before the extension: take.p0.glb, take.p1.glb)"),
     option_row<solve_file_job>("output_fps", AVATARMAP_OPTION_FIELD(solve_file_job, output_fps))
         .number(0, k_max_fps, true)
         .or_zero()

@@ -56,8 +56,12 @@ constexpr int frame_part_capacity(frame_part p) {
   }
 }
 
+/// The largest person id a landmark file may carry (docs/file-formats.md, version 2).
+inline constexpr int k_max_person_id = 999999;
+
 struct landmark_frame {
   double t = 0.0;           // capture time in seconds
+  int person = 0;           // which person (0 .. k_max_person_id): several per time, version 2
   std::uint32_t parts = 0;  // bit (1 << frame_part) set for each part present
   int face_count = 0;       // 468 or 478 when the face part is present, else 0
   std::array<landmark, k_pose_landmark_count> pose{};
@@ -99,6 +103,7 @@ struct landmark_frame {
   /// Removes every part; keeps the storage.
   void clear() {
     t = 0.0;
+    person = 0;
     parts = 0;
     face_count = 0;
   }

@@ -89,9 +89,10 @@ frame_solver& stream_solver(pose_stream& stream) { return stream.solver(); }
 // "Calibration over a take"): a first pass reads every frame's face measurements (a few
 // hundred bytes a frame). Lines the reader cannot parse are passed over here (the solving pass
 // reports them); a file that cannot be opened is left to the solving pass too.
-void calibrate_face_over_file(const std::string& path, frame_solver& solver) {
+void calibrate_face_over_file(const std::string& path, int person, frame_solver& solver) {
   landmark_reader reader;
   if (!reader.open(path).ok()) return;
+  reader.set_person(person);
   auto frame = std::make_unique<landmark_frame>();
   solver.begin_face_take();
   for (;;) {
@@ -115,6 +116,9 @@ status solve_file_job::validate() const {
     return status::error("solve_file_job.output is empty: give a *.pose.jsonl path or a sink");
   if (status st = options.validate(); !st.ok())
     return status::error("solve_file_job.options: " + st.message());
+  if (person < -1 || person > k_max_person_id)
+    return status::error("solve_file_job.person must be -1 (the file's only person) or in [0, " +
+                         std::to_string(k_max_person_id) + "]");
   if (!(std::isfinite(image_width) && std::isfinite(image_height) && image_width >= 0.f &&
         image_height >= 0.f) ||
       (image_width > 0.f) != (image_height > 0.f))
@@ -138,9 +142,30 @@ status solve_file_job::run(solve_file_summary& s) const {
   const auto t0 = clock_type::now();
   landmark_reader reader;
   status st;
+  // The person solved: `person`, else the file's only one (a version-1 file's lines are all
+  // person 0; a version-2 file of several people needs `person`, jobs/people.hpp).
+  int only = person;
   if (!source) {
     st = reader.open(input);
     if (!st.ok()) return st;  // io (cannot be opened) or parse (a bad header)
+    if (only < 0 && reader.header().version >= 2) {
+      std::error_code ec;
+      if (input == "-" || !std::filesystem::is_regular_file(input, ec))
+        return status::invalid_argument(
+            input + ": several people's landmarks (version 2) read once: choose one (person)");
+      std::vector<int> ids;
+      if (st = people_in_file(input, ids); !st.ok()) return st;
+      if (ids.size() > 1) {
+        std::string list;
+        for (int id : ids) list += (list.empty() ? "" : ", ") + std::to_string(id);
+        return status::invalid_argument(input + " has " + std::to_string(ids.size()) + " people (" +
+                                        list +
+                                        "): choose one (person), or solve each to its own output "
+                                        "(jobs/people.hpp; the CLI does)");
+      }
+      if (ids.size() == 1) only = ids[0];
+    }
+    reader.set_person(only);
   }
   s.input_opened = true;
   // Frames from a source have no header: its defaults (no image size, no fps).
@@ -197,7 +222,8 @@ status solve_file_job::run(solve_file_summary& s) const {
   const bool face = solve_options.parts.face;
   // With the warm-up (the offline filter) the calibration waits for its end, when the field
   // of view is learnt and held: the take is read through the lens it is solved with.
-  if (face && read_twice && !state->warming) calibrate_face_over_file(input, stream_solver(stream));
+  if (face && read_twice && !state->warming)
+    calibrate_face_over_file(input, only, stream_solver(stream));
   state->holding_face = face && !read_twice && !state->warming;
   auto end_holding_face = [&]() -> status {
     solve_state& ws = *state;
@@ -219,7 +245,7 @@ status solve_file_job::run(solve_file_summary& s) const {
     ws.stream.restart_take();
     ws.stream.hold_view();
     if (face && read_twice)
-      calibrate_face_over_file(input, stream_solver(ws.stream));
+      calibrate_face_over_file(input, only, stream_solver(ws.stream));
     else if (face)
       stream_solver(ws.stream).calibrate_face(ws.warm.data(), ws.warm.size());
     for (const landmark_frame& f : ws.warm)
