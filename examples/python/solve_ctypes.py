@@ -96,6 +96,7 @@ class AvmSolverOptions(ctypes.Structure):
         ("file_filter", _I), ("file_smoothing", _F), ("file_threads", _I),
         ("fit_hand_shape", _I), ("fit_body_to_image", _I),
         ("foot_contacts", _I), ("root_follows_contacts", _I), ("lower_body_rest", _I),
+        ("person", _I),
     ]
 
 

@@ -270,3 +270,31 @@ def test_write_animation_rejects_bad_poses(pose_file, tmp_path):
     back = am.read_poses(tmp_path / "holes.pose.jsonl")
     assert np.isfinite(back.rotations).all()
     np.testing.assert_array_equal(back.rotations[4:8], np.repeat(back.rotations[3:4], 4, axis=0))
+
+
+def test_solve_file_takes_one_person_of_several(cli, tmp_path):
+    """A landmark file of two people (version 2): person=ID solves that person's lines as the
+    CLI's --person does; without it the file is refused with the ids."""
+    a, b = tmp_path / "a.landmarks.jsonl", tmp_path / "b.landmarks.jsonl"
+    cli("synth", "-o", a, "--seconds", "1", "--seed", "3")
+    cli("synth", "-o", b, "--seconds", "1", "--seed", "4", "--scenario", "clean")
+    la, lb = a.read_text().splitlines(), b.read_text().splitlines()
+    header = json.loads(la[0])
+    header["version"] = 2
+    lines = [json.dumps(header)]
+    for x, y in zip(la[1:], lb[1:]):
+        for pid, line in ((0, x), (5, y)):
+            d = json.loads(line)
+            d["person"] = pid
+            lines.append(json.dumps(d))
+    two = tmp_path / "two.landmarks.jsonl"
+    two.write_text("\n".join(lines) + "\n")
+    cli("solve", two, "-o", tmp_path / "cli.pose.jsonl", "--person", "5")
+    want = am.read_poses(tmp_path / "cli.pose.jsonl")
+    got = am.solve_file(two, person=5)
+    np.testing.assert_array_equal(got.rotations, want.rotations)
+    np.testing.assert_array_equal(got.hips_position, want.hips_position)
+    alone = am.solve_file(b)
+    np.testing.assert_array_equal(got.rotations, alone.rotations)
+    with pytest.raises(am.AvatarmapError, match=r"has 2 people \(0, 5\)"):
+        am.solve_file(two)

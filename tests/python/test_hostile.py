@@ -235,7 +235,7 @@ def test_read_landmarks_memory_follows_the_data(tmp_path):
 _BOOL_FIELDS = {"mirror", "solve_body", "solve_hands", "solve_face", "solve_hips_translation",
                 "filter_rotations", "filter_position", "filter_expressions", "fit_hand_shape",
                 "fit_body_to_image", "foot_contacts", "root_follows_contacts"}
-_INT_FIELDS = {"file_filter", "file_threads", "lower_body_rest"}
+_INT_FIELDS = {"file_filter", "file_threads", "lower_body_rest", "person"}
 _FLOAT_FIELDS = set(am.SOLVER_OPTION_NAMES) - _BOOL_FIELDS - _INT_FIELDS
 
 

@@ -71,6 +71,7 @@ constexpr c_field k_fields[] = {
     AVM_FIELD(foot_contacts),
     AVM_FIELD(root_follows_contacts),
     AVM_FIELD(lower_body_rest),
+    AVM_FIELD(person),
 };
 #undef AVM_FIELD
 static_assert(sizeof(k_fields) / sizeof(k_fields[0]) * 4 + 4 == sizeof(avm_solver_options),
@@ -198,6 +199,7 @@ bool read_options(const avm_solver_options* in, core_options& out, std::string& 
   out.file_smoothing = lib.file.offline.strength;
   out.file_threads = lib.file.threads;
   out.foot_contacts = lib.file.foot_contacts;
+  out.person = lib.file.person;
   return true;
 }
 
@@ -213,6 +215,7 @@ solve_file_job file_job(const core_options& o) {
   job.filter_channels = o.channels;
   job.threads = o.file_threads;
   job.foot_contacts = o.foot_contacts;
+  job.person = o.person;
   return job;
 }
 

@@ -23,6 +23,7 @@ struct core_options {
   float file_smoothing = 1.f;
   int file_threads = 2;                           // avm_solve_file, avm_solve_file_to_clip
   avatarmap::foot_contact_options foot_contacts;  // both paths (pose_stream_filters)
+  int person = -1;                                // the file paths: which person of several
 };
 
 /// The defaults, as avm_solver_options_init() gives them.

@@ -112,6 +112,7 @@ class AvmSolverOptions(ctypes.Structure):
         ("fit_hand_shape", _I32), ("fit_body_to_image", _I32),
         ("foot_contacts", _I32), ("root_follows_contacts", _I32),
         ("lower_body_rest", _I32),
+        ("person", _I32),
     ]
     _kinds_ = {name: BOOL for name in (
         "mirror", "solve_body", "solve_hands", "solve_face", "solve_hips_translation",
@@ -119,6 +120,7 @@ class AvmSolverOptions(ctypes.Structure):
         "fit_body_to_image", "foot_contacts", "root_follows_contacts")}
     _ranges_ = {"file_filter": (0, 2),  # avm_file_filter
                 "lower_body_rest": (0, 2),  # standing, sitting, off
+                "person": (-1, 999999),  # -1: the file's only person
                 "file_threads": (1, 2)}
 
 

@@ -232,7 +232,6 @@ inline constexpr option_row<solve_file_job> k_solve_file_option_table[] = {
     option_row<solve_file_job>("person", AVATARMAP_OPTION_FIELD(solve_file_job, person))
         .integer(-1, k_max_person_id)
         .cli("--person", "ID")
-        .not_in_c()
         .help("of a file of several people, solve only person ID (default: each person to its "
               "own output, the id before the extension: take.p0.glb, take.p1.glb)"),
     option_row<solve_file_job>("output_fps", AVATARMAP_OPTION_FIELD(solve_file_job, output_fps))

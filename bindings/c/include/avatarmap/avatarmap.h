@@ -425,6 +425,13 @@ typedef struct avm_solver_options {
    * hysteresis; arms, hands and face still drive (docs/solver.md "Bodies that are not
    * followed"): 0 standing (default), 1 sitting, 2 off (follow every body) */
   int32_t lower_body_rest;
+  /* -- added in 0.2.0 after lower_body_rest (a caller whose struct_size ends before it gets
+   *    the default) -- */
+  /* Of a landmark file of several people (docs/file-formats.md, version 2), the person
+   * avm_solve_file, avm_solve_file_to_clip and avm_convert_file solve: its id in
+   * [0, 999999]; -1 (default): the file's only person (a file of several is then an error
+   * that lists their ids) */
+  int32_t person;
 } avm_solver_options;
 
 /* What avm_solve_file does after solving each frame. */
