@@ -165,10 +165,13 @@ int weighted_non_max_suppression(const std::vector<detection>& detections, float
   out.clear();
   scratch.clear();
   for (int i = 0; i < static_cast<int>(detections.size()); ++i) scratch.push_back(i);
-  // Stable, so equal scores keep the decoder's (anchor) order as MediaPipe's sort does in
-  // practice.
-  std::stable_sort(scratch.begin(), scratch.end(),
-                   [&](int a, int b) { return detections[a].score > detections[b].score; });
+  // Equal scores keep the decoder's (anchor) order as MediaPipe's sort does in practice: the
+  // order of a stable sort, without the buffer std::stable_sort allocates (the detectors run
+  // on the per-frame path when several people are followed).
+  std::sort(scratch.begin(), scratch.end(), [&](int a, int b) {
+    const float sa = detections[a].score, sb = detections[b].score;
+    return sa > sb || (!(sb > sa) && a < b);
+  });
   size_t remaining = scratch.size();
   while (remaining > 0) {
     if (max_detections > 0 && static_cast<int>(out.size()) >= max_detections) break;

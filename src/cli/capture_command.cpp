@@ -30,7 +30,9 @@ const char* k_capture_help =
     "and the face mesh. Video is tracked (detectors run only when a part is lost) and\n"
     "smoothed as MediaPipe does; --static treats every frame on its own. A device or stream\n"
     "is read until it ends, stalls (--stall-seconds) or --seconds have passed; what was\n"
-    "captured is written.\n"
+    "captured is written. --people N follows up to N people, each with its own id, hands\n"
+    "and face: the file is then version 2, one line per person in view and frame (none\n"
+    "when nobody is), and --overlay draws the lowest id (docs/capture-people.md).\n"
     "\n"
     "Options:\n";
 
@@ -150,7 +152,12 @@ int run_capture(int argc, char** argv) {
                frames, s.input.width, s.input.height, s.input.codec.c_str(), el,
                frames / (el > 0 ? el : 1),
                errors ? (", " + std::to_string(errors) + " frames not decoded").c_str() : "");
-  std::fprintf(stderr, "found: body in %ld frames", s.part_frames[0]);
+  // Several people: the counts are of lines, one per person and frame.
+  if (job.options.max_people > 1)
+    std::fprintf(stderr, "people: %ld ids, %ld lines, someone in %ld of %ld frames\n", s.people_ids,
+                 s.person_lines, s.frames_with_people, frames);
+  std::fprintf(stderr, "found: body in %ld %s", s.part_frames[0],
+               job.options.max_people > 1 ? "lines" : "frames");
   if (job.options.hands)
     std::fprintf(stderr, ", left hand %ld, right hand %ld",
                  s.part_frames[static_cast<int>(frame_part::left_hand)],

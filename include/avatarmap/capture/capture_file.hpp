@@ -32,8 +32,13 @@ struct capture_file_summary {
   long frames = 0;                            // frames written
   long part_frames[k_frame_part_count] = {};  // frames that had each part
   long frames_not_decoded = 0;                // broken frames skipped with a warning
-  video_info input{};                         // the input as opened (size, fps, codec, kind)
-  double startup_ms = 0.0;                    // creating the estimator (loading the models)
+  /// Several people (options.max_people > 1; the file is then version 2, one line per person
+  /// and frame): part_frames counts those lines; the lines written, the frames with at least
+  /// one person, and the distinct ids seen (of the first k_max_people * 64; more are counted
+  /// once each beyond that). All 0 with one person.
+  long person_lines = 0, frames_with_people = 0, people_ids = 0;
+  video_info input{};            // the input as opened (size, fps, codec, kind)
+  double startup_ms = 0.0;       // creating the estimator (loading the models)
   double capture_seconds = 0.0;  // from the first frame's decode to the output's commit
   double seconds = 0.0;          // the whole run, opening and start-up included
   /// Sums of the estimator's per-frame timings (estimator::last_timings()) over timed_frames

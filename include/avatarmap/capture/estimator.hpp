@@ -43,6 +43,9 @@ inline std::string model_file_name(std::string_view stem, model_precision precis
   return std::string(stem) + (precision == model_precision::int8 ? ".int8.onnx" : ".onnx");
 }
 
+/// The most people one estimator follows at once (estimator_options::max_people, --people).
+inline constexpr int k_max_people = 8;
+
 /// Options given when a backend is created; a struct for the same reason.
 struct estimator_options {
   std::string source;  // replay: the *.landmarks.jsonl path; onnx: the models folder
@@ -69,6 +72,12 @@ struct estimator_options {
   /// refined lips and eyes; falls back to 1 when its file is missing), 1 face_landmark (468
   /// points, cheaper). docs/capture-face.md has the costs.
   int face_model = 0;
+  /// onnx: how many people to follow, 1..k_max_people. 1 (the default) is the single-person
+  /// capture, unchanged. More: the pose detector's boxes are kept per person (up to this many,
+  /// best scores first), each person tracked with a stable id and given its own hands and face;
+  /// estimate() then gives the first person (the lowest id) and last_people() every person
+  /// (docs/capture-people.md). Runs on one lane.
+  int max_people = 1;
 };
 
 /// The estimator's options as every front end takes them (the CLI's capture, live and animate
@@ -137,6 +146,15 @@ inline constexpr option_row<estimator_options> k_estimator_option_table[] = {
         .not_in_c()
         .help("face mesh model: attention = 478 points with irises (gaze), refined lips and "
               "eyes; mesh = 468 points, about half the face stage's cost"),
+    option_row<estimator_options>("max_people",
+                                  AVATARMAP_OPTION_FIELD(estimator_options, max_people))
+        .integer(1, k_max_people)
+        .defaults_to(1)
+        .cli("--people", "N")
+        .not_in_c()
+        .help("follow up to N people, each with an id, its hands and face (a version-2 "
+              "landmark file, one line per person and frame); 1 is the single-person capture "
+              "(docs/capture-people.md)"),
     option_row<estimator_options>("spin", AVATARMAP_OPTION_FIELD(estimator_options, spin))
         .boolean()
         .cli("--spin")
@@ -201,6 +219,17 @@ class estimator {
   }
   /// How many calls of estimate_pipelined() a frame waits before it comes back (0 or 1).
   virtual int pipeline_delay() const { return 0; }
+
+  /// Every person of the frame last given back (estimate(), or estimate_pipelined() with
+  /// `ready`), when the backend follows several (estimator_options::max_people > 1): `count`
+  /// frames, ascending by their `person` id, each with its own parts and the frame's t; count
+  /// 0 when nobody is in view. {nullptr, -1} for a single-person backend: its one frame is
+  /// the estimate. Valid until the next estimate call.
+  struct people_view {
+    const landmark_frame* frames = nullptr;
+    int count = -1;
+  };
+  virtual people_view last_people() const { return {}; }
 };
 
 /// One row of the backend table.

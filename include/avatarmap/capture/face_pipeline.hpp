@@ -217,6 +217,10 @@ class face_pipeline {
 
   /// Forgets the tracked region: the next frame acquires again.
   void reset();
+  /// Several people (estimator_options::max_people > 1): makes person slot `person` (0 ..
+  /// k_max_people - 1, clamped) the one process(), reset(), tracking() and last_roi() act on;
+  /// each slot tracks its own face, the models are shared. Slot 0 is selected at creation.
+  void select_person(int person);
 
   /// The mesh model loaded (after a fallback, mesh) and its point count (478 or 468).
   face_mesh_model mesh_model() const;

@@ -217,6 +217,10 @@ class hand_pipeline {
 
   /// Forgets the tracked hands: the next frame starts afresh.
   void reset();
+  /// Several people (estimator_options::max_people > 1): makes person slot `person` (0 ..
+  /// k_max_people - 1, clamped) the one process(), reset() and tracked_count() act on; each
+  /// slot tracks its own hands, the models are shared. Slot 0 is selected at creation.
+  void select_person(int person);
 
   /// Hands found in the last frame (0..max_hands), and each of them (i < hand_count()).
   int hand_count() const;

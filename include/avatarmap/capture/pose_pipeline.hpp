@@ -112,6 +112,28 @@ class pose_pipeline {
   /// Forgets the tracked region: the next frame runs the detector.
   void reset();
 
+  // ---- several people (estimator_options::max_people > 1) ----
+  // Each person slot keeps its own tracked region and smoothing; the models are shared, so
+  // the people of a frame run one after another. Slot 0 is selected at creation, and the
+  // single-person capture uses only it.
+
+  /// Makes slot `person` (0 .. k_max_people - 1, clamped) the one process(), reset(),
+  /// start_track(), tracking(), tracked_roi() and last_roi() act on.
+  void select_person(int person);
+  /// Runs the detector on the whole image: the regions of up to `max` (1 .. k_max_people)
+  /// people, best detection score first, into out_rois, their scores into out_scores and
+  /// their hip centre (keypoint 0) and shoulder centre (keypoint 2) into out_anchors as x0, y0,
+  /// x2, y2 (normalised; room for 4 x `max`). Returns how many (0: nobody), or -1 on an error
+  /// (last_error()). Touches no person's state.
+  int detect_people(const image_view& image, int max, normalized_rect* out_rois, float* out_scores,
+                    float* out_anchors);
+  /// Starts the selected person's track at `roi` (normalised; a region detect_people() gave):
+  /// the next process() runs the landmark model there without the detector (also with
+  /// static_images), with fresh smoothing.
+  void start_track(const normalized_rect& roi);
+  /// The region tracked into the selected person's next frame (meaningful when tracking()).
+  const normalized_rect& tracked_roi() const;
+
   /// Region used for the last landmark inference, and the one tracked for the next frame.
   const normalized_rect& last_roi() const;
   bool tracking() const;

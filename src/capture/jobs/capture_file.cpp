@@ -7,6 +7,7 @@
 #endif
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -155,6 +156,10 @@ status capture_file_job::run(capture_file_summary& s) const {
   h.image_width = info.width;
   h.image_height = info.height;
   h.fps = info.fps;
+  // Several people: version 2 (each line carries its person); one person stays version 1,
+  // byte for byte as before.
+  const bool several = options.max_people > 1;
+  if (several) h.version = 2;
   st = writer.open(output, h);
   if (!st.ok()) return fail(st);
 
@@ -212,12 +217,40 @@ status capture_file_job::run(capture_file_summary& s) const {
   ea.face = options.face;
   jobs_detail::prefetch_ring<decoded> ring(k_decode_ahead, decode);
   // A frame given back by the estimator: counted, written, handed to the hook.
+  // Ids seen (several people), as a bitset over the first ids; fixed size, no allocation.
+  std::array<std::uint64_t, k_max_people> ids_seen{};
+  landmark_frame person_frame;
   auto emit = [&](const decoded& d) {
     frame.t = d.t;
-    for (int p = 0; p < k_frame_part_count; ++p)
-      s.part_frames[p] += frame.has(static_cast<frame_part>(p));
     if (const estimator_timings* et = est->last_timings()) add_timings(*et, s);
-    status w = writer.write(frame);
+    status w;
+    const estimator::people_view people = several ? est->last_people() : estimator::people_view{};
+    if (people.count >= 0) {
+      // One line per person in view (none when nobody is), ascending by id.
+      for (int i = 0; i < people.count && w.ok(); ++i) {
+        landmark_frame& pf = person_frame;
+        pf = people.frames[i];
+        pf.t = d.t;
+        for (int p = 0; p < k_frame_part_count; ++p)
+          s.part_frames[p] += pf.has(static_cast<frame_part>(p));
+        const int id = pf.person;
+        if (id >= 0 && id < k_max_people * 64) {
+          std::uint64_t& word = ids_seen[static_cast<std::size_t>(id / 64)];
+          const std::uint64_t bit = std::uint64_t{1} << (id % 64);
+          s.people_ids += (word & bit) ? 0 : 1;
+          word |= bit;
+        } else {
+          ++s.people_ids;
+        }
+        w = writer.write(pf);
+      }
+      s.person_lines += people.count;
+      s.frames_with_people += people.count > 0;
+    } else {
+      for (int p = 0; p < k_frame_part_count; ++p)
+        s.part_frames[p] += frame.has(static_cast<frame_part>(p));
+      w = writer.write(frame);
+    }
     if (w.ok() && on_frame) w = on_frame(d.view, frame);
     if (!w.ok()) return w;
     ++s.frames;

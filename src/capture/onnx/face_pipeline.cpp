@@ -57,6 +57,26 @@ struct face_pipeline::impl {
   bool has_body_center = false;
   float body_center_x = 0.f, body_center_y = 0.f;
   double missed_at = -1.0;  // when the last search found no face (-1: it did, or none yet)
+  // Several people (select_person()): the tracked state above (has_roi .. missed_at) is the
+  // selected person's; the others' wait here (small: swapped in and out).
+  struct person_state {
+    bool has_roi = false;
+    normalized_rect roi, used_roi;
+    bool has_body_center = false;
+    float body_center_x = 0.f, body_center_y = 0.f;
+    double missed_at = -1.0;
+  };
+  std::array<person_state, k_max_people> parked{};
+  int person = 0;
+  void swap_person(person_state& p) {
+    std::swap(has_roi, p.has_roi);
+    std::swap(roi, p.roi);
+    std::swap(used_roi, p.used_roi);
+    std::swap(has_body_center, p.has_body_center);
+    std::swap(body_center_x, p.body_center_x);
+    std::swap(body_center_y, p.body_center_y);
+    std::swap(missed_at, p.missed_at);
+  }
   float presence = 0.f;
   bool ran_detector = false;
   face_acquisition acquisition = face_acquisition::none;
@@ -312,6 +332,14 @@ void face_pipeline::reset() {
   impl_->has_roi = false;
   impl_->has_body_center = false;
   impl_->missed_at = -1.0;
+}
+void face_pipeline::select_person(int person) {
+  impl& m = *impl_;
+  person = std::clamp(person, 0, k_max_people - 1);
+  if (person == m.person) return;
+  m.swap_person(m.parked[m.person]);  // park the current person's state
+  m.swap_person(m.parked[person]);    // and take the new one's
+  m.person = person;
 }
 face_mesh_model face_pipeline::mesh_model() const { return impl_->model; }
 int face_pipeline::mesh_points() const { return impl_->points; }

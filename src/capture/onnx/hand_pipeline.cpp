@@ -97,6 +97,20 @@ struct hand_pipeline::impl {
   int hand_count = 0;
   // Per side (left, right): when its last region from the body held no hand (-1: never).
   std::array<double, 2> missed_at{-1.0, -1.0};
+  // Several people (select_person()): the tracked state above (slots, slot_count, missed_at)
+  // is the selected person's; the others' wait here (small: swapped in and out).
+  struct person_state {
+    std::array<slot, k_max_hands> slots{};
+    int slot_count = 0;
+    std::array<double, 2> missed_at{-1.0, -1.0};
+  };
+  std::array<person_state, k_max_people> parked{};
+  int person = 0;
+  void swap_person(person_state& p) {
+    std::swap(slots, p.slots);
+    std::swap(slot_count, p.slot_count);
+    std::swap(missed_at, p.missed_at);
+  }
   double now = -1.0;  // this frame's time (process()'s t)
   bool ran_palm = false;
   hand_timings timings;
@@ -467,6 +481,14 @@ hand_result hand_pipeline::process(const image_view& image, const landmark_frame
 void hand_pipeline::reset() {
   impl_->slot_count = 0;
   impl_->missed_at = {-1.0, -1.0};
+}
+void hand_pipeline::select_person(int person) {
+  impl& m = *impl_;
+  person = std::clamp(person, 0, k_max_people - 1);
+  if (person == m.person) return;
+  m.swap_person(m.parked[m.person]);  // park the current person's state
+  m.swap_person(m.parked[person]);    // and take the new one's
+  m.person = person;
 }
 int hand_pipeline::hand_count() const { return impl_->hand_count; }
 const hand_observation& hand_pipeline::hand(int i) const { return impl_->hands[i]; }

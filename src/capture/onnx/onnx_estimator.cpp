@@ -9,6 +9,7 @@
 
 #include "avatarmap/capture/face_pipeline.hpp"
 #include "avatarmap/capture/hand_pipeline.hpp"
+#include "avatarmap/capture/people_tracker.hpp"
 #include "avatarmap/capture/pose_pipeline.hpp"
 #include "capture/two_lanes.hpp"
 
@@ -45,15 +46,25 @@ constexpr std::uint32_t k_face_parts = 1u << static_cast<int>(frame_part::face);
 class onnx_estimator final : public estimator {
  public:
   onnx_estimator(std::unique_ptr<pose_pipeline> pose, std::unique_ptr<hand_pipeline> hands,
-                 std::unique_ptr<face_pipeline> face, bool two_lanes, std::string description)
+                 std::unique_ptr<face_pipeline> face, bool two_lanes, std::string description,
+                 int max_people, bool static_images)
       : pose_(std::move(pose)),
         hands_(std::move(hands)),
         face_(std::move(face)),
-        description_(std::move(description)) {
+        description_(std::move(description)),
+        max_people_(max_people),
+        static_images_(static_images) {
     if (two_lanes) lanes_ = std::make_unique<capture_detail::two_lanes>();
+    if (max_people_ > 1) {
+      people_tracker_options to;
+      to.max_people = max_people_;
+      tracker_ = people_tracker(to);
+      people_ = std::make_unique<people_state>();
+    }
   }
 
   status estimate(const estimate_args& args, landmark_frame& out) override {
+    if (max_people_ > 1) return estimate_people(args, out);
     for (std::string& e : task_error_) e.clear();
     out.clear();
     out.t = args.t;
@@ -78,6 +89,7 @@ class onnx_estimator final : public estimator {
 
   status estimate_pipelined(const estimate_args* in, landmark_frame& out, bool& ready) override {
     if (!lanes_) return estimator::estimate_pipelined(in, out, ready);
+    if (max_people_ > 1) return estimate_people_pipelined(in, out, ready);
     ready = false;
     // One batch: the body of frame `in` (into slot cur_) beside the hands and face of the
     // frame before (slot prev, whose body is done).
@@ -107,12 +119,230 @@ class onnx_estimator final : public estimator {
   }
 
   int pipeline_delay() const override { return lanes_ ? 1 : 0; }
+  people_view last_people() const override {
+    if (max_people_ <= 1) return {};
+    const people_frame& f = people_->frame[people_->given];
+    return {f.frames.data(), f.count};
+  }
   std::string describe() const override { return description_; }
   std::string_view name() const override { return "onnx"; }
   const estimator_timings* last_timings() const override { return &timings_; }
 
  private:
-  enum class task_kind : std::uint8_t { body, hands, face };
+  enum class task_kind : std::uint8_t { body, hands, face, people_body, people_hands, people_face };
+
+  // ---- several people (max_people_ > 1) ----------------------------------------------------
+  // The same stages per person, one after another through the shared sessions (a session runs
+  // one inference at a time); each person's tracking state lives in its slot of each pipeline
+  // (select_person()), and people_tracker says who is who. With two lanes, as for one person:
+  // every person's body of frame t beside every person's hands and face of frame t-1.
+  struct people_frame {
+    std::array<landmark_frame, k_max_people> frames;  // ascending by person id
+    std::array<int, k_max_people> slot{};             // the pipelines' slot of each
+    std::array<bool, k_max_people> fresh{};  // a new track: its hand and face slots restart
+    int count = 0;
+    estimate_args args;
+    estimator_timings tm;
+    int side_detector_runs[2] = {0, 0};  // palm (hands task), face (face task)
+  };
+  struct people_state {
+    people_frame frame[2];  // estimate_pipelined(): two in flight, as slot_
+    std::array<landmark_frame, k_max_people> side_hands, side_face;
+    int given = 0;  // the frame last given back (last_people())
+  };
+
+  // Every person's body on frame `f` (f.args set): the detector when the tracker wants it,
+  // then each tracked person's landmarks; merged tracks resolved. False on an error
+  // (task_error_[slot] set).
+  bool people_body(people_frame& f, int slot) {
+    task_error_[slot].clear();
+    f.count = 0;
+    f.tm = {};
+    f.side_detector_runs[0] = f.side_detector_runs[1] = 0;
+    const estimate_args& a = f.args;
+    if (!a.body) return true;
+    const int w = a.image.width, h = a.image.height;
+    if (static_images_) tracker_.reset();  // images unrelated: each one's people anew
+    if (tracker_.wants_detection(a.t)) {
+      std::array<normalized_rect, k_max_people> regions;
+      std::array<float, k_max_people> scores;
+      std::array<float, 4 * k_max_people> anchors;
+      const int n =
+          pose_->detect_people(a.image, max_people_, regions.data(), scores.data(), anchors.data());
+      if (n < 0) {
+        task_error_[slot] = pose_->last_error();
+        return false;
+      }
+      f.tm.pose_detector_ms += pose_->last_timings().detector_ms;
+      ++f.tm.detector_runs;
+      tracker_.on_detections(a.t, regions.data(), anchors.data(), n, w, h);
+    }
+    // A copy: on_lost() below changes the tracker's list.
+    std::array<people_tracker::track, k_max_people> tracks;
+    const int count = tracker_.active_count();
+    for (int i = 0; i < count; ++i) tracks[i] = tracker_.active(i);
+    for (int i = 0; i < count; ++i) {
+      const people_tracker::track& tr = tracks[i];
+      pose_->select_person(tr.slot);
+      if (tr.is_new) pose_->start_track(tr.start_region);
+      landmark_frame& fr = f.frames[f.count];
+      fr.clear();
+      fr.t = a.t;
+      fr.person = tr.id;
+      const pose_result r = pose_->process(a.image, fr);
+      f.tm.pose_landmark_ms += pose_->last_timings().landmark_ms;
+      if (r == pose_result::error) {
+        task_error_[slot] = pose_->last_error();
+        return false;
+      }
+      if (r == pose_result::not_found) {
+        tracker_.on_lost(tr.slot, a.t);
+        continue;
+      }
+      tracker_.on_found(tr.slot, a.t, pose_->last_roi(), pose_->tracked_roi(), fr.pose.data(), w,
+                        h);
+      f.slot[f.count] = tr.slot;
+      f.fresh[f.count] = tr.is_new;
+      ++f.count;
+    }
+    std::array<int, k_max_people> dropped;
+    const int nd = tracker_.resolve_merges(a.t, dropped.data());
+    for (int d = 0; d < nd; ++d) {
+      pose_->select_person(dropped[d]);
+      pose_->reset();
+      int k = 0;
+      for (int i = 0; i < f.count; ++i) {
+        if (f.slot[i] == dropped[d]) continue;
+        if (k != i) {
+          std::swap(f.frames[k], f.frames[i]);
+          f.slot[k] = f.slot[i];
+          f.fresh[k] = f.fresh[i];
+        }
+        ++k;
+      }
+      f.count = k;
+    }
+    return true;
+  }
+
+  // Every person's hands (hands true) or face of frame `f`, each from its own body, into the
+  // side frames (merged by people_merge()).
+  bool people_side(people_frame& f, bool hands, int slot) {
+    task_error_[slot].clear();
+    const estimate_args& a = f.args;
+    if (hands ? !(a.hands && hands_) : !(a.face && face_)) return true;
+    for (int i = 0; i < f.count; ++i) {
+      if (hands) {
+        hands_->select_person(f.slot[i]);
+        if (f.fresh[i]) hands_->reset();
+        if (hands_->process(a.image, &f.frames[i], people_->side_hands[i], a.t) ==
+            hand_result::error) {
+          task_error_[slot] = hands_->last_error();
+          return false;
+        }
+        const hand_timings& ht = hands_->last_timings();
+        f.tm.palm_detector_ms += ht.palm_ms;
+        f.tm.hand_landmark_ms += ht.landmark_ms;
+        f.side_detector_runs[0] += hands_->last_ran_palm_detector();
+      } else {
+        face_->select_person(f.slot[i]);
+        if (f.fresh[i]) face_->reset();
+        if (face_->process(a.image, &f.frames[i], people_->side_face[i], a.t) ==
+            face_result::error) {
+          task_error_[slot] = face_->last_error();
+          return false;
+        }
+        const face_timings& ft = face_->last_timings();
+        f.tm.face_detector_ms += ft.detector_ms;
+        f.tm.face_mesh_ms += ft.mesh_ms;
+        f.side_detector_runs[1] += face_->last_ran_detector();
+      }
+    }
+    return true;
+  }
+
+  void people_merge(people_frame& f) {
+    for (int i = 0; i < f.count; ++i) {
+      if (f.args.hands && hands_) copy_parts(people_->side_hands[i], k_hand_parts, f.frames[i]);
+      if (f.args.face && face_) copy_parts(people_->side_face[i], k_face_parts, f.frames[i]);
+    }
+    f.tm.detector_runs += f.side_detector_runs[0] + f.side_detector_runs[1];
+    add_total(f.tm);
+  }
+
+  // The frame's first person (the lowest id: the one known longest), or an empty frame.
+  static void first_person(const people_frame& f, landmark_frame& out) {
+    if (f.count > 0) {
+      out = f.frames[0];
+    } else {
+      out.clear();
+      out.t = f.args.t;
+    }
+  }
+
+  status people_errors(int count) {
+    for (int i = 0; i < count; ++i)
+      if (!task_error_[i].empty()) return status::internal(task_error_[i]);
+    return {};
+  }
+
+  status estimate_people(const estimate_args& args, landmark_frame& out) {
+    for (std::string& e : task_error_) e.clear();
+    people_frame& f = people_->frame[0];
+    people_->given = 0;
+    f.args = args;
+    if (!people_body(f, 0)) {
+      f.count = 0;
+      first_person(f, out);
+      return people_errors(1);
+    }
+    task_count_ = 0;
+    if (args.hands && hands_)
+      tasks_[task_count_++] = {task_kind::people_hands, &f.args, nullptr, nullptr};
+    if (args.face && face_)
+      tasks_[task_count_++] = {task_kind::people_face, &f.args, nullptr, nullptr};
+    if (lanes_) {
+      run_tasks();
+    } else {
+      for (int i = 0; i < task_count_; ++i)
+        people_side(f, tasks_[i].kind == task_kind::people_hands, i);
+    }
+    people_merge(f);
+    timings_ = f.tm;
+    first_person(f, out);
+    return people_errors(task_count_);
+  }
+
+  status estimate_people_pipelined(const estimate_args* in, landmark_frame& out, bool& ready) {
+    ready = false;
+    const int prev = cur_ ^ 1;
+    people_frame& fc = people_->frame[cur_];
+    people_frame& fp = people_->frame[prev];
+    task_count_ = 0;
+    if (in) {
+      fc.args = *in;
+      tasks_[task_count_++] = {task_kind::people_body, &fc.args, nullptr, nullptr};
+    }
+    if (pending_) {
+      if (fp.args.hands && hands_)
+        tasks_[task_count_++] = {task_kind::people_hands, &fp.args, nullptr, nullptr};
+      if (fp.args.face && face_)
+        tasks_[task_count_++] = {task_kind::people_face, &fp.args, nullptr, nullptr};
+    }
+    people_cur_ = cur_;
+    run_tasks();
+    if (status s = people_errors(task_count_); !s.ok()) return s;
+    if (pending_) {
+      people_merge(fp);
+      people_->given = prev;
+      timings_ = fp.tm;
+      first_person(fp, out);
+      ready = true;
+    }
+    pending_ = in != nullptr;
+    if (in) cur_ = prev;
+    return {};
+  }
   struct task {
     task_kind kind = task_kind::body;
     const estimate_args* args = nullptr;
@@ -140,6 +370,17 @@ class onnx_estimator final : public estimator {
         case task_kind::face:
           run_face(*k.args, *k.frame, side_[1], *k.timings, i);
           break;
+        case task_kind::people_body:
+          people_body(people_->frame[people_cur_], i);
+          break;
+        case task_kind::people_hands:
+        case task_kind::people_face: {
+          // The frame whose args these are (estimate(): frame 0; pipelined: the previous one).
+          people_frame& f =
+              k.args == &people_->frame[0].args ? people_->frame[0] : people_->frame[1];
+          people_side(f, k.kind == task_kind::people_hands, i);
+          break;
+        }
       }
     };
     lanes_->run_batch(task_count_, run);
@@ -226,6 +467,12 @@ class onnx_estimator final : public estimator {
   estimator_timings slot_timings_[2];
   int cur_ = 0;
   bool pending_ = false;  // slot_[cur_ ^ 1] has its body and waits for its hands and face
+  // Several people.
+  int max_people_ = 1;
+  bool static_images_ = false;
+  people_tracker tracker_;
+  std::unique_ptr<people_state> people_;
+  int people_cur_ = 0;  // the frame the people_body task fills
 };
 
 }  // namespace
@@ -237,6 +484,11 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
   if (options.hand_model_complexity < 0 || options.hand_model_complexity > 1)
     return status::error("hand model complexity must be 0 (lite) or 1 (full)");
   if (options.lanes != 1 && options.lanes != 2) return status::error("lanes must be 1 or 2");
+  if (options.max_people < 1 || options.max_people > k_max_people)
+    return status::invalid_argument("max_people (--people) must be in 1.." +
+                                    std::to_string(k_max_people) + ", got " +
+                                    std::to_string(options.max_people));
+  const bool several = options.max_people > 1;
   const int all_threads = options.threads < 1 ? 1 : options.threads;
   // Two lanes only pay when there is a second model per frame to run beside the body.
   const bool two_lanes = options.lanes == 2 && all_threads >= 2 && (options.hands || options.face);
@@ -271,6 +523,8 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
     ho.mirrored_input = options.mirrored_input;
     ho.allow_spinning = po.allow_spinning;
     ho.static_images = options.static_images;
+    // Several people: a hand only from its person's wrists, never a palm found anywhere.
+    if (several) ho.roi_source = hand_roi_source::pose;
     s = hand_pipeline::create(ho, hands);
     if (!s.ok()) return s;
   }
@@ -282,6 +536,8 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
     fo.intra_op_threads = threads;
     fo.allow_spinning = po.allow_spinning;
     fo.static_images = options.static_images;
+    // Several people: a face only in its person's face region, never the image's best face.
+    if (several) fo.roi_source = face_roi_source::pose;
     if (options.face_model < 0 || options.face_model > 1)
       return status::error("face model must be 0 (attention) or 1 (mesh)");
     fo.model = static_cast<face_mesh_model>(options.face_model);
@@ -289,8 +545,10 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
     if (!s.ok()) return s;
     if (!face->note().empty()) description += "; " + face->note();
   }
+  if (options.max_people > 1)
+    description += "; up to " + std::to_string(options.max_people) + " people";
   out.reset(new onnx_estimator(std::move(pose), std::move(hands), std::move(face), two_lanes,
-                               std::move(description)));
+                               std::move(description), options.max_people, options.static_images));
   return {};
 }
 

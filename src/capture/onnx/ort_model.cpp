@@ -173,13 +173,18 @@ bool bound_model::crop_input(const image_view& image, const normalized_rect& roi
 
 namespace {
 thread_local int t_run_depth = 0;
-}
+thread_local bool t_has_run = false;
+}  // namespace
 
 int ort_run_depth() noexcept { return t_run_depth; }
+bool ort_thread_has_run() noexcept { return t_has_run; }
 
 void bound_model::run() {
   struct depth_guard {
-    depth_guard() { ++t_run_depth; }
+    depth_guard() {
+      ++t_run_depth;
+      t_has_run = true;
+    }
     ~depth_guard() { --t_run_depth; }
   } guard;
   const char* in = input_name.c_str();

@@ -38,6 +38,10 @@ inline std::string missing_model_hint(model_precision precision) {
 /// How many bound_model::run() calls are under way on this thread (0 or 1): lets a test
 /// count the heap allocations of the pipelines outside ONNX Runtime.
 int ort_run_depth() noexcept;
+/// Whether this thread has called bound_model::run(): the pipelines' threads (the caller's,
+/// the lanes' worker) have; ONNX Runtime's own threads never do, so a test can leave out their
+/// allocations (inside ONNX Runtime, whenever its threads make them).
+bool ort_thread_has_run() noexcept;
 
 /// Checks the options every detect-then-track pipeline has (threads >= 1, detection score in
 /// (0, 1), NMS threshold in (0, 1], presence in [0, 1]); the message starts with `who`, or

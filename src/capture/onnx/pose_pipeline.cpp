@@ -7,6 +7,7 @@
 #include <onnxruntime_cxx_api.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -80,18 +81,25 @@ struct pose_pipeline::impl {
   crop_options detector_crop;
   crop_options landmark_crop;
 
-  // Video-mode smoothing (pose_pipeline_options::smoothing): tfjs-models' BlazePose
-  // configuration (velocity filters on the image and auxiliary points) or MediaPipe's
-  // current pose_landmark_filtering.pbtxt (One Euro); world points One Euro in both.
-  // smooth_image and smooth_aux get their filter in create(), from options.smoothing.
-  landmark_smoother smooth_image;
-  landmark_smoother smooth_aux;
-  landmark_smoother smooth_world{{0.1f, 40.f, 1.f, true}};
-  visibility_smoother smooth_visibility{0.1f};
+  // What is tracked of one person between frames. The single-person capture uses people[0];
+  // with several people (select_person()) each has its own, the models are shared.
+  struct person_state {
+    // Video-mode smoothing (pose_pipeline_options::smoothing): tfjs-models' BlazePose
+    // configuration (velocity filters on the image and auxiliary points) or MediaPipe's
+    // current pose_landmark_filtering.pbtxt (One Euro); world points One Euro in both.
+    // smooth_image and smooth_aux get their filter in create(), from options.smoothing.
+    landmark_smoother smooth_image;
+    landmark_smoother smooth_aux;
+    landmark_smoother smooth_world{{0.1f, 40.f, 1.f, true}};
+    visibility_smoother smooth_visibility{0.1f};
 
-  bool has_roi = false;
-  normalized_rect roi;  // tracked region for the next frame
-  normalized_rect used_roi;
+    bool has_roi = false;
+    bool seeded = false;  // start_track(): the next process() runs on roi without the detector
+    normalized_rect roi;  // tracked region for the next frame
+    normalized_rect used_roi;
+  };
+  std::array<person_state, k_max_people> people;
+  person_state* st = &people[0];  // the selected person
   float presence = 0.f;
   bool ran_detector = false;
   pose_timings timings;
@@ -126,11 +134,50 @@ struct pose_pipeline::impl {
     return true;
   }
 
+  // Several people: the detector on the whole image, the regions of up to `max` boxes after
+  // suppression, best score first (the suppression's order), into out_rois / out_scores.
+  // Returns their number, or -1 when the image could not be cropped.
+  int detect_all(const image_view& image, int max, normalized_rect* out_rois, float* out_scores,
+                 float* out_anchors) {
+    const auto t0 = std::chrono::steady_clock::now();
+    crop_transform tr;
+    if (!detector.crop_input(image, normalized_rect{}, detector_crop, &tr)) {
+      error = "pose detector: the image could not be cropped";
+      return -1;
+    }
+    const auto ti = std::chrono::steady_clock::now();
+    detector.run();
+    timings.detector_inference_ms = ms_since(ti);
+    decode_detections(detector.outputs[0].data(), detector.outputs[1].data(), anchors.data(),
+                      decode, decoded);
+    weighted_non_max_suppression(decoded, options.nms_iou_threshold, max, kept, scratch);
+    int n = 0;
+    for (const detection& k : kept) {
+      if (n >= max) break;
+      detection d = k;
+      for (int i = 0; i < d.keypoint_count; ++i) {
+        const crop_point p = project_to_image(tr, {d.keypoints[2 * i] * k_detector_size,
+                                                   d.keypoints[2 * i + 1] * k_detector_size, 0});
+        d.keypoints[2 * i] = p.x;
+        d.keypoints[2 * i + 1] = p.y;
+      }
+      out_rois[n] = pose_detection_to_roi(d, image.width, image.height);
+      out_scores[n] = d.score;
+      out_anchors[4 * n] = d.keypoints[0];  // hip centre
+      out_anchors[4 * n + 1] = d.keypoints[1];
+      out_anchors[4 * n + 2] = d.keypoints[4];  // shoulder centre (keypoint 2)
+      out_anchors[4 * n + 3] = d.keypoints[5];
+      ++n;
+    }
+    timings.detector_ms = ms_since(t0);
+    return n;
+  }
+
   void reset_smoothing() {
-    smooth_image.reset();
-    smooth_world.reset();
-    smooth_aux.reset();
-    smooth_visibility.reset();
+    st->smooth_image.reset();
+    st->smooth_world.reset();
+    st->smooth_aux.reset();
+    st->smooth_visibility.reset();
   }
 
   // Runs the landmark model on `r`; false when the pose is not present. `t` (seconds) and
@@ -189,17 +236,17 @@ struct pose_pipeline::impl {
       aux[k].z = c.z;
     }
     if (smoothing) {
-      smooth_image.apply(t, out.pose.data(), k_pose_landmark_count, true, image.width,
-                         image.height);
-      smooth_visibility.apply(out.pose.data(), k_pose_landmark_count);
-      smooth_world.apply(t, out.pose_world.data(), k_pose_landmark_count, false, 0, 0);
-      smooth_aux.apply(t, aux, 2, true, image.width, image.height);
+      st->smooth_image.apply(t, out.pose.data(), k_pose_landmark_count, true, image.width,
+                             image.height);
+      st->smooth_visibility.apply(out.pose.data(), k_pose_landmark_count);
+      st->smooth_world.apply(t, out.pose_world.data(), k_pose_landmark_count, false, 0, 0);
+      st->smooth_aux.apply(t, aux, 2, true, image.width, image.height);
       for (int i = 0; i < k_pose_landmark_count; ++i)
         out.pose_world[i].visibility = out.pose[i].visibility;
     }
-    roi = roi_from_alignment_points(aux[0].x, aux[0].y, aux[1].x, aux[1].y, image.width,
-                                    image.height);
-    has_roi = true;
+    st->roi = roi_from_alignment_points(aux[0].x, aux[0].y, aux[1].x, aux[1].y, image.width,
+                                        image.height);
+    st->has_roi = true;
     timings.landmark_ms = ms_since(t0);
     return true;
   }
@@ -253,12 +300,14 @@ status pose_pipeline::create(const pose_pipeline_options& options,
   } catch (const Ort::Exception& ex) {
     return status::parse_error("pose_pipeline: ONNX Runtime: " + std::string(ex.what()));
   }
-  if (options.smoothing == pose_smoothing::velocity) {
-    m->smooth_image = landmark_smoother(mediapipe_velocity_params{5, 10.f});
-    m->smooth_aux = landmark_smoother(mediapipe_velocity_params{5, 10.f});
-  } else {
-    m->smooth_image = landmark_smoother(mediapipe_one_euro_params{0.05f, 80.f, 1.f, false});
-    m->smooth_aux = landmark_smoother(mediapipe_one_euro_params{0.01f, 10.f, 1.f, false});
+  for (impl::person_state& ps : m->people) {
+    if (options.smoothing == pose_smoothing::velocity) {
+      ps.smooth_image = landmark_smoother(mediapipe_velocity_params{5, 10.f});
+      ps.smooth_aux = landmark_smoother(mediapipe_velocity_params{5, 10.f});
+    } else {
+      ps.smooth_image = landmark_smoother(mediapipe_one_euro_params{0.05f, 80.f, 1.f, false});
+      ps.smooth_aux = landmark_smoother(mediapipe_one_euro_params{0.01f, 10.f, 1.f, false});
+    }
   }
   generate_ssd_anchors(pose_detection_anchor_options(), m->anchors);
   m->decode.min_score_thresh = options.min_detection_score;
@@ -291,21 +340,24 @@ pose_result pose_pipeline::process(const image_view& image, landmark_frame& out)
     return pose_result::error;
   }
   try {
-    normalized_rect r = m.roi;
-    if (!m.has_roi || m.options.static_images) {
+    impl::person_state& ps = *m.st;
+    normalized_rect r = ps.roi;
+    if (!ps.seeded && (!ps.has_roi || m.options.static_images)) {
       m.ran_detector = true;
-      m.has_roi = false;
+      ps.has_roi = false;
       if (!m.detect(image, r)) return m.error.empty() ? pose_result::not_found : pose_result::error;
     }
-    m.used_roi = r;
+    ps.seeded = false;
+    ps.used_roi = r;
     const bool smoothing = m.options.smoothing != pose_smoothing::none && !m.options.static_images;
     if (!m.landmarks(image, r, out.t, smoothing, out)) {
-      m.has_roi = false;  // lost: the next frame runs the detector
+      ps.has_roi = false;  // lost: the next frame runs the detector
       m.reset_smoothing();
       return m.error.empty() ? pose_result::not_found : pose_result::error;
     }
   } catch (const Ort::Exception& ex) {
-    m.has_roi = false;
+    m.st->has_roi = false;
+    m.st->seeded = false;
     m.error = std::string("pose_pipeline: ONNX Runtime: ") + ex.what();
     return pose_result::error;
   }
@@ -315,11 +367,45 @@ pose_result pose_pipeline::process(const image_view& image, landmark_frame& out)
 }
 
 void pose_pipeline::reset() {
-  impl_->has_roi = false;
+  impl_->st->has_roi = false;
+  impl_->st->seeded = false;
   impl_->reset_smoothing();
 }
-const normalized_rect& pose_pipeline::last_roi() const { return impl_->used_roi; }
-bool pose_pipeline::tracking() const { return impl_->has_roi; }
+
+void pose_pipeline::select_person(int person) {
+  impl_->st = &impl_->people[std::clamp(person, 0, k_max_people - 1)];
+}
+
+int pose_pipeline::detect_people(const image_view& image, int max, normalized_rect* out_rois,
+                                 float* out_scores, float* out_anchors) {
+  impl& m = *impl_;
+  m.timings = {};
+  m.error.clear();
+  m.ran_detector = true;
+  if (image.data == nullptr || image.width <= 0 || image.height <= 0) {
+    m.error = "pose_pipeline: empty image";
+    return -1;
+  }
+  max = std::clamp(max, 1, k_max_people);
+  try {
+    return m.detect_all(image, max, out_rois, out_scores, out_anchors);
+  } catch (const Ort::Exception& ex) {
+    m.error = std::string("pose_pipeline: ONNX Runtime: ") + ex.what();
+    return -1;
+  }
+}
+
+void pose_pipeline::start_track(const normalized_rect& roi) {
+  impl::person_state& ps = *impl_->st;
+  ps.roi = roi;
+  ps.has_roi = true;
+  ps.seeded = true;
+  impl_->reset_smoothing();
+}
+
+const normalized_rect& pose_pipeline::tracked_roi() const { return impl_->st->roi; }
+const normalized_rect& pose_pipeline::last_roi() const { return impl_->st->used_roi; }
+bool pose_pipeline::tracking() const { return impl_->st->has_roi; }
 float pose_pipeline::last_presence() const { return impl_->presence; }
 bool pose_pipeline::last_ran_detector() const { return impl_->ran_detector; }
 const pose_timings& pose_pipeline::last_timings() const { return impl_->timings; }
