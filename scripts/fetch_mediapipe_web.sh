@@ -6,7 +6,7 @@
 #   <dir>/pose/{pose.js,pose_solution_*.{js,wasm,data},*.tflite,pose_web.binarypb,package.json}
 #   <dir>/VERSION                                       what was fetched
 #
-# The version is the one /work/shared/data/golden/upper_body_* and pose_jpg_full.json were
+# The version is the one the shared data's golden/upper_body_* and pose_jpg_full.json were
 # made with (data/README.md). Folder: $AVATARMAP_MEDIAPIPE_WEB, default
 # .cache/avatarmap/mediapipe_web in the repository (git-ignored; never committed). Idempotent:
 # when VERSION names the pinned package it exits at once. The tarball is checked against the

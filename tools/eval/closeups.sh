@@ -14,7 +14,7 @@
 # % of the crop's diagonal over the points Google sees (visibility > 0.5, inside the image)
 # and the shoulder (11, 12) and elbow (13, 14) errors in px, then a summary.
 #
-# Environment: AVATARMAP_TEST_DATA (default /work/shared/data, else ../shared/data),
+# Environment: AVATARMAP_TEST_DATA (default: ../shared/data beside the checkout),
 # AVATARMAP_EXE (default build/avatarmap), AVATARMAP_MODELS as for capture. Needs ffmpeg,
 # chromium, python3 and the package scripts/fetch_mediapipe_web.sh fetches (run here when
 # missing). Exit 77 when chromium, ffmpeg or the data is missing.
@@ -24,7 +24,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 out="${1:-$root/out/closeups}"
 data="${AVATARMAP_TEST_DATA:-}"
 if [ -z "$data" ]; then
-  for d in /work/shared/data "$root/../shared/data"; do [ -d "$d" ] && { data="$d"; break; }; done
+  for d in "$root/../shared/data"; do [ -d "$d" ] && { data="$d"; break; }; done
 fi
 exe="${AVATARMAP_EXE:-$root/build/avatarmap}"
 mp="$root/tools/eval/mediapipe_web"

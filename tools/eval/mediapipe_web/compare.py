@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Compares two pose reference files in the goldens' layout (landmarks_px, world), e.g. the
-output of reference.py against /work/shared/data/golden/upper_body_portrait_pose.json:
+output of reference.py against the shared data's golden/upper_body_portrait_pose.json:
 prints the max / mean pixel distance over all 33 points and over the in-frame visible ones
 (visibility > 0.5 in B, inside the image), the max |dz| px, the max visibility difference and
 the max world-point distance (m). Exit 1 when the in-frame max exceeds --tolerance px."""
