@@ -17,6 +17,8 @@ constexpr float k_merge_jump_margin = 0.3f;
 // k_steady_move torso lengths is steady (its motion is what a lost id waits with).
 constexpr double k_jump_fade_seconds = 0.3;
 constexpr float k_steady_move = 0.15f;
+// The jump rule applies between tracks started at least this long ago.
+constexpr double k_settled_seconds = 0.3;
 // A region's side in pixels (regions are squares in pixels; the larger side otherwise).
 float side_px(const normalized_rect& r, int w, int h) {
   return std::max(r.width * static_cast<float>(w), r.height * static_cast<float>(h));
@@ -127,6 +129,7 @@ void people_tracker::on_detections(double t, const normalized_rect* regions, con
     tr.is_new = true;
     tr.start_region = r;
     body_[slot] = body_points{};
+    body_[slot].start = t;
     motion_[slot] = motion{tr.id, t, x, y, size, 0.f, 0.f, false};
     steady_[slot] = motion_[slot];
   }
@@ -223,8 +226,11 @@ int people_tracker::resolve_merges(double t, int* out_slots) {
       const float torso = std::min(a.torso, b.torso);
       if (torso > 0.f && mean <= options_.merged_offset * torso) {
         // tracks_ ascend by id: j is the younger. The one that jumped onto the body ends.
-        const bool i_jumped = a.jump > b.jump + k_merge_jump_margin;
-        const bool j_jumped = b.jump > a.jump + k_merge_jump_margin;
+        // Only between tracks both followed for a while: a track just started from a detector
+        // box on a body another track follows is the extra one, whatever moved.
+        const bool settled = t - a.start >= k_settled_seconds && t - b.start >= k_settled_seconds;
+        const bool i_jumped = settled && a.jump > b.jump + k_merge_jump_margin;
+        const bool j_jumped = settled && b.jump > a.jump + k_merge_jump_margin;
         const int end = i_jumped ? i : j;
         out_slots[n++] = tracks_[end].slot;
         remove(end, t, true, i_jumped || j_jumped);

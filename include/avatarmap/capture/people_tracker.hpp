@@ -79,12 +79,12 @@ class people_tracker {
                 const landmark* pose, int image_width, int image_height);
   /// The track in slot `slot` lost its person at `t`: its id waits keep_lost_seconds.
   void on_lost(int slot, double t);
-  /// Ends one of every two tracks that follow one body (merged_offset; as lost): the one that
-  /// jumped onto it (its recent moves, in torso lengths and fading with a time constant of
-  /// k_jump_fade_seconds, exceed the other's by k_merge_jump_margin: a track whose person is
-  /// hidden slides onto the one in front), else the younger; a track ended for jumping waits
-  /// with its motion from its last steady frame. Their slots into `out_slots` (room for
-  /// max_people). Returns how many.
+  /// Ends one of every two tracks that follow one body (merged_offset; as lost): between two
+  /// tracks started at least 0.3 s ago the one that jumped onto it (its recent moves, in torso
+  /// lengths and fading with a time constant of k_jump_fade_seconds, exceed the other's by
+  /// k_merge_jump_margin: a track whose person is hidden slides onto the one in front), else the
+  /// younger; a track ended for jumping waits with its motion from its last steady frame. Their
+  /// slots into `out_slots` (room for max_people). Returns how many.
   int resolve_merges(double t, int* out_slots);
 
  private:
@@ -108,8 +108,9 @@ class people_tracker {
   struct body_points {
     std::array<float, 10> xy{};
     float torso = 0.f;
-    float jump = 0.f;  // the shoulder centre's recent moves, torso lengths, fading
-    double t = 0.0;    // when found last
+    float jump = 0.f;    // the shoulder centre's recent moves, torso lengths, fading
+    double t = 0.0;      // when found last
+    double start = 0.0;  // when the track started
   };
   std::array<body_points, k_max_people> body_{};
   int active_count_ = 0;

@@ -72,13 +72,22 @@ void count_steady_state_allocations(int threads, bool pipelined, int people = 1)
     else
       ASSERT_TRUE(est->estimate(a, f).ok());
     if (ready) parts |= static_cast<int>(f.parts);
-    if (people > 1 && ready && i >= 10) seen = std::max(seen, est->last_people().count);
+    if (people > 1 && ready && i >= 10) {
+      const estimator::people_view v = est->last_people();
+      seen = std::max(seen, v.count);
+      // Every person's parts: the first one (the lowest id) may be one whose track restarted
+      // (three_people.jpg's seated man drifts onto his neighbour, docs/capture-people.md).
+      for (int k = 0; k < v.count; ++k) parts |= static_cast<int>(v.frames[k].parts);
+    }
     if (ready && i >= 10 && est->last_timings())
       detector_runs += est->last_timings()->detector_runs;
   }
   g_counting = false;
   EXPECT_TRUE(f.has(frame_part::pose));
-  EXPECT_TRUE(f.has(frame_part::face));
+  if (people > 1)
+    EXPECT_TRUE(parts & (1 << static_cast<int>(frame_part::face)));
+  else
+    EXPECT_TRUE(f.has(frame_part::face));
   // The three people of three_people.jpg (one may be lost for a frame and found again).
   if (people > 1) EXPECT_EQ(seen, people);
   std::printf(
