@@ -88,8 +88,8 @@ constexpr float k_refine_floor = 0.002f;
 // did worse, 3.0-5.2 degrees; so did the take's gaze mode, below, learnt live from 3 s on:
 // 4.02 degrees, from 10 s on 2.69.)
 constexpr float k_gaze_refine_rate = 0.002f;
-// An eye counts as open for the irises' calibration (live and over a take) when its lid gap
-// is above this share of its neutral (a closing lid pushes MediaPipe's iris down).
+// An eye counts as open for the irises' calibration over a take when its lid gap is above
+// this share of its neutral (a closing lid pushes MediaPipe's iris down).
 constexpr float k_take_iris_open = 0.6f;
 
 // Full changes (see the table in docs/expressions.md). Eyes: the lids shut at 0.1 of the

@@ -13,6 +13,9 @@
 
 namespace avatarmap {
 
+/// Person ids as messages list them: "0, 3, 7".
+std::string person_id_list(const std::vector<int>& ids);
+
 /// One person to solve and the output it goes to.
 struct person_run {
   int person = 0;

@@ -7,15 +7,11 @@
 
 namespace avatarmap {
 
-namespace {
-
-std::string id_list(const std::vector<int>& ids) {
+std::string person_id_list(const std::vector<int>& ids) {
   std::string s;
   for (std::size_t i = 0; i < ids.size(); ++i) s += (i == 0 ? "" : ", ") + std::to_string(ids[i]);
   return s;
 }
-
-}  // namespace
 
 std::string person_output_path(const std::string& output, int person) {
   const std::string tag = ".p" + std::to_string(person);
@@ -52,9 +48,9 @@ status plan_person_runs(const std::string& input, int person, const std::string&
     bool found = !regular;  // a stream is taken at its word
     for (int id : ids) found = found || id == person;
     if (!found)
-      return status::invalid_argument(input + ": no person " + std::to_string(person) +
-                                      " (its people: " + (ids.empty() ? "none" : id_list(ids)) +
-                                      ")");
+      return status::invalid_argument(
+          input + ": no person " + std::to_string(person) +
+          " (its people: " + (ids.empty() ? "none" : person_id_list(ids)) + ")");
     out.push_back({person, output});
     return {};
   }
@@ -64,7 +60,7 @@ status plan_person_runs(const std::string& input, int person, const std::string&
   }
   if (output == "-")
     return status::invalid_argument(input + " has " + std::to_string(ids.size()) + " people (" +
-                                    id_list(ids) +
+                                    person_id_list(ids) +
                                     "): they cannot share standard output; give an output file "
                                     "(one per person is written) or one person");
   for (int id : ids) out.push_back({id, person_output_path(output, id)});

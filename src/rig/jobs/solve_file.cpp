@@ -9,6 +9,7 @@
 #include "avatarmap/io/landmark_file.hpp"
 #include "avatarmap/io/pose_file.hpp"
 #include "avatarmap/jobs/clip_output.hpp"  // k_max_output_fps
+#include "avatarmap/jobs/people.hpp"
 #include "avatarmap/solve/pose_stream.hpp"
 #include "avatarmap/time/resample_clip.hpp"
 #include "avatarmap/time/seconds_text.hpp"
@@ -156,10 +157,8 @@ status solve_file_job::run(solve_file_summary& s) const {
       std::vector<int> ids;
       if (st = people_in_file(input, ids); !st.ok()) return st;
       if (ids.size() > 1) {
-        std::string list;
-        for (int id : ids) list += (list.empty() ? "" : ", ") + std::to_string(id);
         return status::invalid_argument(input + " has " + std::to_string(ids.size()) + " people (" +
-                                        list +
+                                        person_id_list(ids) +
                                         "): choose one (person), or solve each to its own output "
                                         "(jobs/people.hpp; the CLI does)");
       }
