@@ -8,9 +8,20 @@
 // Poses from the WebSocket win over the animation: the first that arrives stops it (except the
 // server's own stream of the pose file the page plays itself).
 //
+// Several people: a message with a "slot" key (and "person", the person's id) is that slot's
+// person's pose; a message without one is slot 0's. Slot 0 is the page's avatar; every other slot
+// that gets a pose gets an avatar of its own (the same file, parsed again from the bytes fetched
+// once: three-vrm cannot clone a VRM), posed by the newest pose of its slot. A person whose poses
+// carry a root translation (hips_position X or Z not 0) stands where it says, from the same
+// origin as the others (the first pose's hips); one without stands 1 m to the right per slot.
+// Once a pose has carried a "slot", an avatar whose slot got no pose for 1.5 s is hidden until
+// its slot gets one again (slot 0's too, unless it plays an animation); one person's is never.
+//
 // For tests and tools: window.avatarmapViewer.state() says what the page shows,
-// boneRotation(name) / rawBoneRotation(name) the avatar's normalised / raw local rotation of a
-// bone ([x, y, z, w]); ?hud=0 hides the text box and the control bar (a clean picture for
+// boneRotation(name, slot = 0) / rawBoneRotation(name, slot = 0) the normalised / raw local
+// rotation of a bone of a slot's avatar ([x, y, z, w]; null when the slot has none), people()
+// each slot's avatar ({slot, person, visible, loading, failed, posesApplied, x: its hips' world
+// X}); ?hud=0 hides the text box and the control bar (a clean picture for
 // screenshots; the controls still work); the page logs "avatarmap-viewer: first posed frame N
 // ms" and sends {"first_posed_ms": N} to the server once it has drawn its first posed frame (N
 // counted from the start of the page's navigation).
@@ -88,6 +99,7 @@ const state = {
   socketUrl: '',
   posesReceived: 0,
   posesApplied: 0,
+  people: 0,             // avatars shown (slot 0's, the page's own, included)
   arkitTargets: 0,       // morph targets named after ARKit's shapes that poses drive directly
   arkitExpressions: 0,   // expressions named after ARKit's shapes (Perfect Sync clips)
   badMessages: 0,
@@ -268,7 +280,10 @@ async function loadAvatar(url, name, animated = false) {
     VRMUtils.rotateVRM0(loaded);  // VRM 0.x faces -Z: turn it to face +Z as VRM 1.0 does
     vrm = loaded;
     scene.add(vrm.scene);
-    findArkitTargets(vrm);
+    mainBody.face = findArkitTargets(vrm);
+    state.arkitTargets = mainBody.face.targets.length;
+    state.arkitExpressions = mainBody.face.expressions.size;
+    forgetPeople(url);  // the other slots' avatars are this file's too, loaded when needed
     const rest = vrm.humanoid.normalizedRestPose.hips?.position ?? [0, 1, 0];
     restHips = rest;
     restHipsY = Math.max(0.1, rest[1]);
@@ -557,9 +572,11 @@ function openFile(file) {
 
 if (!renderMode) {
   const rotation = (node) => (node ? node.quaternion.toArray() : null);
+  const slotVrm = (slot) => (slot ? bodies[slot]?.vrm : vrm);
   Object.assign(window.avatarmapViewer, {
-    boneRotation: (name) => rotation(vrm?.humanoid.getNormalizedBoneNode(name)),
-    rawBoneRotation: (name) => rotation(vrm?.humanoid.getRawBoneNode(name)),
+    boneRotation: (name, slot = 0) => rotation(slotVrm(slot)?.humanoid.getNormalizedBoneNode(name)),
+    rawBoneRotation: (name, slot = 0) => rotation(slotVrm(slot)?.humanoid.getRawBoneNode(name)),
+    people: () => bodies.map((b, slot) => personOf(slot)).filter((p) => p),
   });
   document.getElementById('open').addEventListener('click', (e) => {
     e.currentTarget.blur();
@@ -620,50 +637,45 @@ function arkitShapeOf(name) {
 // three-vrm) and, for the shapes no expression claims, its morph targets named after one (the
 // built-in avatar's 52; set directly after vrm.update(), so that they win over the expressions
 // bound to the same targets, as in the .glb writer).
-let arkitExpressions = new Map();  // shape -> expression name
-let arkitTargets = [];             // {mesh, index, shape}
-let shapeWeights = null;           // the last pose's blendshapes, while any is non-zero
-
+// Each avatar has its face: {expressions: shape -> expression name, targets: [{mesh, index,
+// shape}], weights: the last pose's blendshapes while any is non-zero}.
 function findArkitTargets(v) {
-  arkitExpressions = new Map();
-  arkitTargets = [];
-  shapeWeights = null;
+  const face = { expressions: new Map(), targets: [], weights: null };
   for (const e of v.expressionManager?.expressions ?? []) {
     const shape = arkitShapeOf(e.expressionName);
-    if (shape && !arkitExpressions.has(shape)) arkitExpressions.set(shape, e.expressionName);
+    if (shape && !face.expressions.has(shape)) face.expressions.set(shape, e.expressionName);
   }
   v.scene.traverse((o) => {
     if (!o.morphTargetDictionary || !o.morphTargetInfluences) return;
     for (const [name, index] of Object.entries(o.morphTargetDictionary)) {
       const shape = arkitShapeOf(name);
-      if (shape && !arkitExpressions.has(shape)) arkitTargets.push({ mesh: o, index, shape });
+      if (shape && !face.expressions.has(shape)) face.targets.push({ mesh: o, index, shape });
     }
   });
-  state.arkitTargets = arkitTargets.length;
-  state.arkitExpressions = arkitExpressions.size;
+  return face;
 }
 
 // Takes a pose's blendshapes: Perfect Sync expressions get their values now (before
 // vrm.update()); the named targets in applyShapeTargets() after it. A pose without blendshapes,
 // or with all of them 0, leaves the face to the expressions (and clears the targets once).
-function takeBlendshapes(pose) {
+function takeBlendshapes(pose, v, face) {
   const b = pose.blendshapes;
   const active = b && typeof b === 'object' && Object.values(b).some((x) => Number(x) > 0);
-  const expressions = vrm.expressionManager;
+  const expressions = v.expressionManager;
   if (!active) {
-    if (shapeWeights) {
-      for (const t of arkitTargets) t.mesh.morphTargetInfluences[t.index] = 0;
+    if (face.weights) {
+      for (const t of face.targets) t.mesh.morphTargetInfluences[t.index] = 0;
       // An ARKit-named expression that is also the proxy's (browDownLeft) keeps the pose's value.
       if (expressions)
-        for (const name of arkitExpressions.values())
+        for (const name of face.expressions.values())
           expressions.setValue(name, clamp01(pose.expressions?.[name]));
     }
-    shapeWeights = null;
+    face.weights = null;
     return;
   }
-  shapeWeights = b;
+  face.weights = b;
   if (expressions)
-    for (const [shape, name] of arkitExpressions) expressions.setValue(name, clamp01(b[shape]));
+    for (const [shape, name] of face.expressions) expressions.setValue(name, clamp01(b[shape]));
 }
 
 function clamp01(x) {
@@ -671,52 +683,256 @@ function clamp01(x) {
   return Number.isFinite(v) ? Math.min(1, Math.max(0, v)) : 0;
 }
 
-function applyShapeTargets() {
+function applyShapeTargets(face = mainBody.face) {
   // A .vrma or .glb animation drives the face itself.
-  if (!shapeWeights || player.kind === 'glb' || player.kind === 'vrma') return;
-  for (const t of arkitTargets) t.mesh.morphTargetInfluences[t.index] = clamp01(shapeWeights[t.shape]);
+  if (!face.weights || player.kind === 'glb' || player.kind === 'vrma') return;
+  for (const t of face.targets) t.mesh.morphTargetInfluences[t.index] = clamp01(face.weights[t.shape]);
 }
 
 // ---- poses ----------------------------------------------------------------------------------
-let newestMessage = null;  // only the newest pose is parsed, once per drawn frame
 let standingHipsY = 0;     // the highest hips height seen: the performer standing
 let firstHips = null;      // the first pose's hips: horizontal motion is shown relative to it
 
-function applyPose(pose) {
+// The page's own avatar (slot 0) as applyPose() takes it; other slots' avatars are makeBody()'s.
+const mainBody = {
+  get vrm() { return vrm; },
+  get restHips() { return restHips; },
+  get restHipsY() { return restHipsY; },
+  get standingHipsY() { return standingHipsY; },
+  set standingHipsY(y) { standingHipsY = y; },
+  face: { expressions: new Map(), targets: [], weights: null },
+  rooted: false,           // its poses carry a root translation (hips X or Z not 0)
+  person: null,
+  lastSeen: 0,
+  posesApplied: 0,
+};
+
+// Poses `body`'s avatar (mainBody: the page's own, slot 0; else another slot's, makeBody()).
+function applyPose(pose, body = mainBody) {
+  const v = body.vrm;
   // VRM 0.x models keep their own axes under three-vrm's normalised bones: X and Z flip (as
   // three-vrm-animation does for VRMA clips).
-  const flip = vrm.meta?.metaVersion === '0' ? -1 : 1;
+  const flip = v.meta?.metaVersion === '0' ? -1 : 1;
   const bones = pose.bones ?? {};
   for (const name in bones) {
     const q = bones[name];
-    const node = vrm.humanoid.getNormalizedBoneNode(name);
+    const node = v.humanoid.getNormalizedBoneNode(name);
     if (!node || !Array.isArray(q) || q.length !== 4) continue;
     node.quaternion.set(flip * q[0], q[1], flip * q[2], q[3]);
   }
   const h = pose.hips_position;
-  const hips = vrm.humanoid.getNormalizedBoneNode('hips');
+  const hips = v.humanoid.getNormalizedBoneNode('hips');
   if (renderMode && hips && Array.isArray(h) && h.length === 3 && h.every(Number.isFinite)) {
     // Absolute placement: the performer's metres times the avatar's over the performer's hips.
-    const s = render.performerHips > 0 ? restHipsY / render.performerHips : 1;
+    const s = render.performerHips > 0 ? body.restHipsY / render.performerHips : 1;
     state.hipsScale = s;
     hips.position.set(flip * h[0] * s, h[1] * s, flip * h[2] * s);
   } else if (hips && Array.isArray(h) && h.length === 3 && h.every(Number.isFinite)) {
+    // Every slot's horizontal motion is relative to the same origin (the first pose's hips), so
+    // that people keep their places relative to each other.
     if (!firstHips) firstHips = h;
-    standingHipsY = Math.min(2.5, Math.max(standingHipsY, h[1], 0.3));
-    const s = restHipsY / standingHipsY;  // performer metres -> avatar metres
-    hips.position.set(restHips[0] + flip * (h[0] - firstHips[0]) * s, h[1] * s,
-                      restHips[2] + flip * (h[2] - firstHips[2]) * s);
+    body.standingHipsY = Math.min(2.5, Math.max(body.standingHipsY, h[1], 0.3));
+    const s = body.restHipsY / body.standingHipsY;  // performer metres -> avatar metres
+    const rest = body.restHips;
+    hips.position.set(rest[0] + flip * (h[0] - firstHips[0]) * s, h[1] * s,
+                      rest[2] + flip * (h[2] - firstHips[2]) * s);
+    if (h[0] !== 0 || h[2] !== 0) body.rooted = true;
   }
   const weights = pose.expressions ?? {};
-  const expressions = vrm.expressionManager;
+  const expressions = v.expressionManager;
   if (expressions) {
     for (const name in weights) {
       if (expressions.getExpression(name)) expressions.setValue(name, Number(weights[name]) || 0);
     }
   }
-  takeBlendshapes(pose);
+  takeBlendshapes(pose, v, body.face);
   state.lastPoseT = typeof pose.t === 'number' ? pose.t : null;
   state.posesApplied++;
+}
+
+// ---- people: one avatar per slot ------------------------------------------------------------
+const MAX_SLOTS = 8;          // the server's k_pose_server_slots
+const HIDE_AFTER_MS = 1500;   // a slot without a pose for this long is hidden
+const SLOT_SPACING = 1.0;     // metres between people whose poses carry no root translation
+const newestMessages = new Array(MAX_SLOTS).fill(null);  // each slot's newest, parsed once a frame
+const bodies = new Array(MAX_SLOTS).fill(null);  // slot -> its avatar's body (slot 0: mainBody)
+bodies[0] = mainBody;
+let avatarUrl = '';           // the page's avatar file: every slot's avatar is loaded from it
+let avatarBytes = null;       // a promise of its bytes, fetched once for all the slots
+let avatarGeneration = 0;     // counts the page's avatars: a slot loading an older one drops it
+let peopleSeen = false;       // a pose carried a "slot": several people, slot 0 included, hide
+
+// The slot a message is for, found without parsing it (only each slot's newest message is
+// parsed): the "slot" key the server writes last; none = slot 0; -1 = out of range.
+function slotOf(text) {
+  const at = text.lastIndexOf('"slot":');
+  if (at < 0) return 0;
+  const slot = parseInt(text.slice(at + 7, at + 12), 10);
+  return Number.isInteger(slot) && slot >= 0 && slot < MAX_SLOTS ? slot : -1;
+}
+
+function makeBody(v) {
+  const rest = v.humanoid.normalizedRestPose.hips?.position ?? [0, 1, 0];
+  return {
+    vrm: v, restHips: rest, restHipsY: Math.max(0.1, rest[1]), standingHipsY: 0,
+    face: findArkitTargets(v), rooted: false, person: null, lastSeen: 0,
+    posesApplied: 0,
+  };
+}
+
+// The page's avatar changed (or is loading): the other slots' avatars go, to be loaded again
+// from `url` when their slots next get a pose.
+function forgetPeople(url) {
+  avatarGeneration++;
+  avatarUrl = url;
+  avatarBytes = null;
+  for (let slot = 1; slot < MAX_SLOTS; slot++) {
+    const body = bodies[slot];
+    if (body?.vrm) {
+      scene.remove(body.vrm.scene);
+      VRMUtils.deepDispose(body.vrm.scene);
+    }
+    bodies[slot] = null;
+  }
+  Object.assign(mainBody, { rooted: false, person: null });
+}
+
+// Loads slot's avatar: the page's avatar file parsed again (the bytes fetched once).
+async function loadBody(slot) {
+  const generation = avatarGeneration;
+  bodies[slot] = { loading: true };
+  try {
+    avatarBytes ??= fetch(avatarUrl).then((r) => {
+      if (!r.ok) throw new Error(`HTTP ${r.status}`);
+      return r.arrayBuffer();
+    });
+    const gltf = await gltfLoader().parseAsync(await avatarBytes, '');
+    const loaded = gltf.userData.vrm;
+    if (!loaded) throw new Error('not a VRM avatar');
+    if (generation !== avatarGeneration) {  // the page's avatar changed meanwhile
+      VRMUtils.deepDispose(gltf.scene);
+      return;
+    }
+    VRMUtils.removeUnnecessaryVertices(gltf.scene);
+    VRMUtils.rotateVRM0(loaded);
+    // Skinned meshes are culled by a bounding sphere three.js computes once, at the first
+    // frame drawn: a person whose first pose stood elsewhere (off screen) kept a face culled
+    // wherever it went. Several avatars are few: draw them all.
+    gltf.scene.traverse((o) => {
+      if (o.isMesh) o.frustumCulled = false;
+    });
+    bodies[slot] = makeBody(loaded);
+    loaded.scene.visible = false;  // until its first pose
+    scene.add(loaded.scene);
+  } catch (e) {
+    if (generation !== avatarGeneration) return;
+    bodies[slot] = { failed: true };
+    state.error = `could not load an avatar for person slot ${slot}: ${e.message ?? e}`;
+    console.error('avatarmap-viewer:', state.error);
+  }
+}
+
+// Applies slot's newest message, if any, to its avatar (loading the avatar first for a slot
+// other than 0); true when a pose was applied.
+function poseSlot(slot, now) {
+  const text = newestMessages[slot];
+  if (text === null) return false;
+  let body = bodies[slot];
+  if (!body) loadBody(slot);
+  if (!body || body.loading || body.failed) return false;  // the newest message waits
+  newestMessages[slot] = null;
+  let pose;
+  try {
+    pose = JSON.parse(text);
+  } catch (e) {
+    state.badMessages++;
+    return false;
+  }
+  if (slot === 0) stopAnimation();
+  state.mode = 'live';
+  applyPose(pose, body);
+  if (typeof pose.slot === 'number') peopleSeen = true;
+  body.person = typeof pose.person === 'number' ? pose.person : null;
+  body.lastSeen = now;
+  body.posesApplied++;
+  // Without a root translation people stand side by side, slot 0 where one person stands.
+  body.vrm.scene.position.x = body.rooted ? 0 : slot * SLOT_SPACING;
+  return true;
+}
+
+let framedPeople = 1;  // the most people the camera was framed for
+
+// Frames every shown avatar from the front: the box of their hips (each person about 1.2 m
+// wide and 1.9 m tall; skinned meshes' own boxes are of the rest pose, not where a person
+// stands).
+function framePeople() {
+  const box = new THREE.Box3();
+  const p = new THREE.Vector3();
+  for (const body of bodies) {
+    if (!body?.vrm || !body.vrm.scene.visible) continue;
+    const hips = body.vrm.humanoid.getNormalizedBoneNode('hips');
+    if (!hips) continue;
+    body.vrm.scene.updateMatrixWorld(true);
+    hips.getWorldPosition(p);
+    box.expandByPoint(new THREE.Vector3(p.x - 0.6, 0, p.z));
+    box.expandByPoint(new THREE.Vector3(p.x + 0.6, 1.9, p.z));
+  }
+  if (box.isEmpty()) return;
+  const centre = box.getCenter(new THREE.Vector3());
+  const width = box.max.x - box.min.x, height = box.max.y - box.min.y;
+  const fov = THREE.MathUtils.degToRad(camera.fov);
+  const fitHeight = (1.3 * height) / 2 / Math.tan(fov / 2);
+  const fitWidth = (1.15 * width) / 2 / Math.tan(fov / 2) / Math.max(0.2, camera.aspect);
+  const distance = Math.max(fitHeight, fitWidth);
+  camera.position.set(centre.x, 0.55 * height, box.max.z + distance);
+  controls.target.set(centre.x, 0.55 * height, centre.z);
+  controls.update();
+}
+
+// Poses, steps and shows or hides every slot's avatar; true when any pose was applied.
+function updatePeople(now, delta) {
+  let posed = false;
+  let shown = 0;
+  for (let slot = 0; slot < MAX_SLOTS; slot++) {
+    if (poseSlot(slot, now)) {
+      posed = true;
+      if (slot !== 0) stopAnimation();  // live poses win over the animation, whoever they are
+    }
+    const body = bodies[slot];
+    if (!body?.vrm) continue;
+    // The page's avatar is never hidden for one person (messages without "slot"), as before
+    // several people were, nor while it plays an animation.
+    const kept = slot === 0 && (!peopleSeen || player.kind !== '');
+    const visible = kept || now - body.lastSeen < HIDE_AFTER_MS;
+    body.vrm.scene.visible = visible;
+    if (visible) shown++;
+    if (slot !== 0 && visible) {
+      body.vrm.update(delta);
+      applyShapeTargets(body.face);
+    }
+  }
+  state.people = shown;
+  // More people than the view was framed for: frame them all (once per new count, so that the
+  // user's own camera moves are not undone every frame).
+  if (shown > framedPeople && shown > 1 && !renderMode) framePeople();
+  framedPeople = Math.max(framedPeople, shown);
+  return posed;
+}
+
+function personOf(slot) {
+  const body = bodies[slot];
+  if (!body) return null;
+  const hips = body.vrm?.humanoid.getNormalizedBoneNode('hips');
+  const where = new THREE.Vector3();
+  if (hips) {
+    body.vrm.scene.updateMatrixWorld(true);
+    hips.getWorldPosition(where);
+  }
+  return {
+    slot, person: body.person ?? null, visible: !!body.vrm?.scene.visible,
+    loading: !!body.loading, failed: !!body.failed, posesApplied: body.posesApplied ?? 0,
+    x: hips ? where.x : null,
+  };
 }
 
 let socket = null;
@@ -731,7 +947,10 @@ function connect(url) {
   socket.onmessage = (event) => {
     state.posesReceived++;
     // The server's stream of the pose file this page plays itself is not applied.
-    if (!(config.poses && !config.pose_socket)) newestMessage = event.data;
+    if (config.poses && !config.pose_socket) return;
+    const slot = slotOf(event.data);
+    if (slot < 0) state.badMessages++;
+    else newestMessages[slot] = event.data;
   };
   socket.onclose = () => {
     state.socket = 'closed';
@@ -773,7 +992,8 @@ function hudText() {
                `${state.clipTime.toFixed(1)} / ${state.clipDuration.toFixed(1)} s`);
   if (state.videoName) lines.push(`video ${state.videoName} (${state.video})`);
   lines.push(`poses: ${state.socketUrl} ${state.socket}` +
-             (state.mode === 'live' ? `, ${rate.perSecond.toFixed(0)}/s, t ${(state.lastPoseT ?? 0).toFixed(2)} s` : ''));
+             (state.mode === 'live' ? `, ${rate.perSecond.toFixed(0)}/s, t ${(state.lastPoseT ?? 0).toFixed(2)} s` : '') +
+             (state.people > 1 ? `, ${state.people} people` : ''));
   return lines.join('\n');
 }
 
@@ -782,19 +1002,9 @@ function frame() {
   const delta = Math.min(clock.getDelta(), 0.1);
   let posed = false;
   if (vrm) {
-    if (newestMessage !== null) {
-      const text = newestMessage;
-      newestMessage = null;
-      try {
-        const pose = JSON.parse(text);
-        stopAnimation();
-        state.mode = 'live';
-        applyPose(pose);
-        posed = true;
-        rate.count++;
-      } catch (e) {
-        state.badMessages++;
-      }
+    if (updatePeople(performance.now(), delta)) {
+      posed = true;
+      rate.count++;
     } else if (player.kind) {
       advance(delta);
       posed = true;

@@ -45,7 +45,7 @@ class AvmEstimatorOptions(ctypes.Structure):
                 ("model_complexity", ctypes.c_int32), ("hands", ctypes.c_int32),
                 ("face", ctypes.c_int32), ("hand_model_complexity", ctypes.c_int32),
                 ("threads", ctypes.c_int32), ("mirrored", ctypes.c_int32),
-                ("static_images", ctypes.c_int32)]
+                ("static_images", ctypes.c_int32), ("max_people", ctypes.c_int32)]
 
 
 class AvmLiveStats(ctypes.Structure):

@@ -1,5 +1,6 @@
 #include "avatarmap/capture/capture_pipeline.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -60,7 +61,9 @@ status capture_pipeline::create(const capture_pipeline_options& options,
   p->options_ = options;
   if (status st = create_estimator(options.backend, options.estimator, p->estimator_); !st.ok())
     return st;
-  p->stream_ = std::make_unique<pose_stream>(stream_options(options));
+  const int streams = std::max(1, options.estimator.max_people);
+  for (int i = 0; i < streams; ++i)
+    p->streams_.push_back(std::make_unique<pose_stream>(stream_options(options)));
   p->args_.body = true;
   p->args_.hands = options.estimator.hands;
   p->args_.face = options.estimator.face;
@@ -89,7 +92,7 @@ status capture_pipeline::estimate(const image_view& image, double t, landmark_fr
     solver_options so = options_.solver;
     so.image_width = static_cast<float>(image.width);
     so.image_height = static_cast<float>(image.height);
-    stream_->restart(so);
+    for (auto& s : streams_) s->restart(so);
     solver_width_ = image.width;
     solver_height_ = image.height;
   }
@@ -102,7 +105,7 @@ status capture_pipeline::estimate(const image_view& image, double t, landmark_fr
 
 void capture_pipeline::solve(const landmark_frame& frame, proxy_pose& pose) {
   // One pose per frame (the live filter or none, no grid): emit is called once.
-  stream_->push(frame, [&pose](const proxy_pose& p) {
+  streams_[0]->push(frame, [&pose](const proxy_pose& p) {
     pose = p;
     return status{};
   });
@@ -113,6 +116,73 @@ const estimator_timings* capture_pipeline::last_timings() const {
   return estimator_->last_timings();
 }
 
-void capture_pipeline::reset() { stream_->reset(); }
+void capture_pipeline::reset() {
+  for (auto& s : streams_) s->reset();
+  slots_ = {};
+  have_shared_origin_ = false;
+}
+
+int capture_pipeline::slot_for(int id, double t) {
+  const int n = max_people();
+  for (int k = 0; k < n; ++k)
+    if (slots_[k].id == id) return k;
+  // The lowest free slot, else the one whose person was seen longest ago (only when more ids
+  // than slots are held at once, which the estimator does not give).
+  int pick = -1;
+  for (int k = 0; k < n && pick < 0; ++k)
+    if (slots_[k].id < 0) pick = k;
+  if (pick < 0) {
+    pick = 0;
+    for (int k = 1; k < n; ++k)
+      if (slots_[k].seen_t < slots_[pick].seen_t) pick = k;
+  }
+  streams_[pick]->reset();
+  slots_[pick] = {id, t};
+  return pick;
+}
+
+void capture_pipeline::solve_people(const landmark_frame& frame, people_poses& out) {
+  out.count = 0;
+  const estimator::people_view view = estimator_->last_people();
+  const double t = frame.t;
+  if (view.count < 0) {  // one person: the frame estimate() gave, in slot 0
+    if (!frame.has(frame_part::pose) && !frame.has(frame_part::pose_world)) {
+      proxy_pose ignored;
+      solve(frame, ignored);  // the stream holds and eases what it lost
+      return;
+    }
+    person_pose& p = out.people[0];
+    p.id = 0;
+    p.slot = 0;
+    p.frame = &frame;
+    solve(frame, p.pose);
+    slots_[0] = {0, t};
+    out.count = 1;
+    return;
+  }
+  // Free the slots of people gone for longer than the estimator keeps their ids.
+  for (int k = 0; k < max_people(); ++k)
+    if (slots_[k].id >= 0 && t - slots_[k].seen_t > k_person_hold_seconds) slots_[k] = {};
+  for (int i = 0; i < view.count && i < k_max_people; ++i) {
+    const landmark_frame& f = view.frames[i];
+    person_pose& p = out.people[out.count++];
+    p.id = f.person;
+    p.slot = slot_for(f.person, t);
+    p.frame = &f;
+    slots_[p.slot].seen_t = t;
+    pose_stream& stream = *streams_[p.slot];
+    // One origin for everyone: the first person's first ground position.
+    glm::vec2 origin;
+    if (have_shared_origin_ && !stream.solver().ground_origin(origin))
+      stream.solver().set_ground_origin(shared_origin_);
+    stream.push(f, [&p](const proxy_pose& q) {
+      p.pose = q;
+      return status{};
+    });
+    p.pose.t = t;
+    if (!have_shared_origin_ && stream.solver().ground_origin(shared_origin_))
+      have_shared_origin_ = true;
+  }
+}
 
 }  // namespace avatarmap

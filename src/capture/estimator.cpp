@@ -28,27 +28,20 @@ bool cpu_has_vnni() {
 #endif
 }
 
-status replay_estimator::open(const std::string& path, std::unique_ptr<replay_estimator>& out) {
+status replay_estimator::open(const std::string& path, std::unique_ptr<replay_estimator>& out,
+                              int max_people) {
   out.reset();
   std::unique_ptr<replay_estimator> r(new replay_estimator());
+  r->max_people_ = max_people;
   status s = r->reader_.open(path);
   if (!s.ok()) return s;
   out = std::move(r);
   return {};
 }
 
-status replay_estimator::estimate(const estimate_args& args, landmark_frame& out) {
-  if (finished_) return status::error("end of recording");
-  for (;;) {
-    read_result r = reader_.next(out);
-    if (r == read_result::end) {
-      finished_ = true;
-      out.clear();
-      return status::error("end of recording");
-    }
-    if (r == read_result::error) return status::failure(reader_.error_code(), reader_.error());
-    break;
-  }
+namespace {
+// Removes the parts `args` does not ask for.
+void keep_asked_parts(const estimate_args& args, landmark_frame& out) {
   if (!args.body) {
     out.set(frame_part::pose, false);
     out.set(frame_part::pose_world, false);
@@ -63,6 +56,55 @@ status replay_estimator::estimate(const estimate_args& args, landmark_frame& out
     out.set(frame_part::face, false);
     out.face_count = 0;
   }
+}
+}  // namespace
+
+estimator::people_view replay_estimator::last_people() const {
+  if (max_people_ <= 1) return {};
+  return {people_.data(), people_count_};
+}
+
+status replay_estimator::estimate(const estimate_args& args, landmark_frame& out) {
+  if (finished_) return status::error("end of recording");
+  if (max_people_ <= 1) {
+    const read_result r = reader_.next(out);
+    if (r == read_result::end) {
+      finished_ = true;
+      out.clear();
+      return status::error("end of recording");
+    }
+    if (r == read_result::error) return status::failure(reader_.error_code(), reader_.error());
+    keep_asked_parts(args, out);
+    return {};
+  }
+  // Several people: the lines sharing the first one's time stamp.
+  people_count_ = 0;
+  if (!has_ahead_) {
+    const read_result r = reader_.next(ahead_);
+    if (r == read_result::end) {
+      finished_ = true;
+      out.clear();
+      return status::error("end of recording");
+    }
+    if (r == read_result::error) return status::failure(reader_.error_code(), reader_.error());
+  }
+  people_[people_count_++] = ahead_;
+  has_ahead_ = false;
+  for (;;) {
+    const read_result r = reader_.next(ahead_);
+    if (r == read_result::end) break;
+    if (r == read_result::error) return status::failure(reader_.error_code(), reader_.error());
+    if (ahead_.t != people_[0].t) {
+      has_ahead_ = true;
+      break;
+    }
+    if (people_count_ < max_people_) people_[people_count_++] = ahead_;
+  }
+  for (int i = 0; i < people_count_; ++i) {
+    if (people_[i].person < 0) people_[i].person = 0;  // a version-1 line: the one person
+    keep_asked_parts(args, people_[i]);
+  }
+  out = people_[0];
   return {};
 }
 
@@ -71,7 +113,7 @@ status create_replay(const estimator_options& options, std::unique_ptr<estimator
   std::unique_ptr<replay_estimator> r;
   if (options.source.empty())
     return status::error("replay backend: give the recording (*.landmarks.jsonl) as the source");
-  status s = replay_estimator::open(options.source, r);
+  status s = replay_estimator::open(options.source, r, options.max_people);
   if (s.ok()) out = std::move(r);
   return s;
 }

@@ -255,6 +255,96 @@ struct drawer {
     for (int i = 0; i < 4; ++i)
       draw_line(cv, px[i], py[i], px[(i + 1) % 4], py[(i + 1) % 4], thickness, o.rect_color);
   }
+
+  // One frame's parts, in overlay_job's order; the face only when `with_face`.
+  void frame(const landmark_frame& f, bool with_face) const {
+    const bool pose = o.draw_pose && f.has(frame_part::pose);
+    const bool left = o.draw_hands && f.has(frame_part::left_hand);
+    const bool right = o.draw_hands && f.has(frame_part::right_hand);
+    if (with_face && o.draw_face && f.has(frame_part::face)) face(f);
+    if (pose) pose_lines(f);
+    if (left) hand_lines(f.left_hand, o.left_color);
+    if (right) hand_lines(f.right_hand, o.right_color);
+    if (o.draw_joints) {
+      if (pose) pose_joints(f);
+      if (left) hand_joints(f.left_hand, o.left_color);
+      if (right) hand_joints(f.right_hand, o.right_color);
+    }
+  }
+
+  // The top centre (pixels) of the points of `f` that frame() draws inside the image; false
+  // when there is none.
+  bool top_of(const landmark_frame& f, double& out_x, double& out_top) const {
+    double x0 = 0.0, x1 = 0.0, y0 = 0.0;
+    bool any = false;
+    const auto add = [&](const landmark& p) {
+      double x, y;
+      if (!to_pixels(p, cv.width, cv.height, x, y) || x < 0.0 || y < 0.0 || x > cv.width ||
+          y > cv.height)
+        return;
+      x0 = any ? std::min(x0, x) : x;
+      x1 = any ? std::max(x1, x) : x;
+      y0 = any ? std::min(y0, y) : y;
+      any = true;
+    };
+    if (o.draw_pose && f.has(frame_part::pose))
+      for (const landmark& p : f.pose)
+        if (pose_level(p) > 0) add(p);
+    if (o.draw_hands && f.has(frame_part::left_hand))
+      for (const landmark& p : f.left_hand) add(p);
+    if (o.draw_hands && f.has(frame_part::right_hand))
+      for (const landmark& p : f.right_hand) add(p);
+    if (o.draw_face && f.has(frame_part::face))
+      for (int i = 0; i < std::clamp(f.face_count, 0, k_face_mesh_iris_count); ++i) add(f.face[i]);
+    out_x = 0.5 * (x0 + x1);
+    out_top = y0;
+    return any;
+  }
+
+  // `id` in decimal digits, seven segments of lines each (thickness + 1 pixels wide),
+  // centred on x with its bottom thickness + 4 pixels above y (kept inside the image), over a
+  // black outline.
+  void label(int id, double x, double y, rgb8_color c) const {
+    char digits[12];
+    int n = 0;
+    unsigned v = id < 0 ? 0u : static_cast<unsigned>(id);
+    do {
+      digits[n++] = static_cast<char>(v % 10);
+      v /= 10;
+    } while (v > 0 && n < 10);
+    const int stroke = thickness + 1;
+    const int h = 9 * thickness + 6;  // digit height
+    const int w = (3 * h + 2) / 5;    // digit width
+    const int gap = stroke + 3;       // between digits
+    const int m = stroke / 2 + 2;     // room for the outline at the image's edges
+    const int total = n * w + (n - 1) * gap;
+    int left = round_to_int(x - 0.5 * total);
+    int top = round_to_int(y) - thickness - 4 - h;
+    left = std::max(m, std::min(left, cv.width - m - total));
+    top = std::max(m, std::min(top, cv.height - m - h));
+    constexpr rgb8_color k_black{0, 0, 0};
+    for (int pass = 0; pass < 2; ++pass) {
+      const int t = pass == 0 ? stroke + 2 : stroke;
+      const int e = pass == 0 ? 1 : 0;  // the outline reaches one pixel past each end
+      const rgb8_color col = pass == 0 ? k_black : c;
+      for (int k = 0; k < n; ++k) {
+        const std::uint8_t seg = overlay_digit_segments(digits[n - 1 - k]);
+        const int xa = left + k * (w + gap), xb = xa + w - 1;
+        const int ya = top, ym = top + (h - 1) / 2, yb = top + h - 1;
+        // Segment i from (x, y) to (x, y): top, top right, bottom right, bottom, bottom left,
+        // top left, middle.
+        const int ends[7][4] = {{xa, ya, xb, ya}, {xb, ya, xb, ym}, {xb, ym, xb, yb},
+                                {xa, yb, xb, yb}, {xa, ym, xa, yb}, {xa, ya, xa, ym},
+                                {xa, ym, xb, ym}};
+        for (int i = 0; i < 7; ++i) {
+          if (!(seg & (1u << i))) continue;
+          const int* q = ends[i];
+          const int dx = q[2] > q[0] ? e : 0, dy = q[3] > q[1] ? e : 0;
+          draw_line(cv, q[0] - dx, q[1] - dy, q[2] + dx, q[3] + dy, t, col);
+        }
+      }
+    }
+  }
 };
 
 }  // namespace
@@ -270,6 +360,7 @@ bool overlay_job::validate() const {
     return false;
   if (image.stride_bytes < image.width * 3) return false;
   if (rect_count > 0 && !rects) return false;
+  if (people_count > 0 && !people) return false;
   if (options.thickness < 0 || options.thickness > k_max_thickness) return false;
   if (options.joint_radius < -1 || options.joint_radius > k_max_thickness) return false;
   return true;
@@ -285,19 +376,24 @@ bool overlay_job::run() const {
                  options.joint_radius >= 0 ? options.joint_radius : t};
   if (options.draw_rects)
     for (std::size_t i = 0; i < rect_count; ++i) d.rect(rects[i]);
-  if (!frame) return true;
-  const landmark_frame& f = *frame;
-  const bool pose = options.draw_pose && f.has(frame_part::pose);
-  const bool left = options.draw_hands && f.has(frame_part::left_hand);
-  const bool right = options.draw_hands && f.has(frame_part::right_hand);
-  if (options.draw_face && f.has(frame_part::face)) d.face(f);
-  if (pose) d.pose_lines(f);
-  if (left) d.hand_lines(f.left_hand, options.left_color);
-  if (right) d.hand_lines(f.right_hand, options.right_color);
-  if (options.draw_joints) {
-    if (pose) d.pose_joints(f);
-    if (left) d.hand_joints(f.left_hand, options.left_color);
-    if (right) d.hand_joints(f.right_hand, options.right_color);
+  if (people == nullptr) {
+    if (frame) d.frame(*frame, true);
+    return true;
+  }
+  constexpr rgb8_color k_black{0, 0, 0};
+  overlay_options outline = options;
+  outline.left_color = outline.right_color = outline.center_color = k_black;
+  const drawer under{d.cv, outline, t + 2, d.radius + 1};
+  for (std::size_t i = 0; i < people_count; ++i) {
+    const landmark_frame& f = people[i];
+    const rgb8_color c = person_color(f.person);
+    overlay_options own = options;
+    own.left_color = own.right_color = own.center_color = own.face_color = c;
+    const drawer over{d.cv, own, t, d.radius};
+    under.frame(f, false);
+    over.frame(f, true);
+    double x, top;
+    if (over.top_of(f, x, top)) over.label(f.person, x, top, c);
   }
   return true;
 }

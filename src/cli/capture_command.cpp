@@ -32,7 +32,8 @@ const char* k_capture_help =
     "is read until it ends, stalls (--stall-seconds) or --seconds have passed; what was\n"
     "captured is written. --people N follows up to N people, each with its own id, hands\n"
     "and face: the file is then version 2, one line per person in view and frame (none\n"
-    "when nobody is), and --overlay draws the lowest id (docs/capture-people.md).\n"
+    "when nobody is), and --overlay draws every person in a colour of its own with its id\n"
+    "above it (docs/capture-people.md).\n"
     "\n"
     "Options:\n";
 
@@ -118,8 +119,9 @@ int run_capture(int argc, char** argv) {
           overlay.open(overlay_path, info.width, info.height, info.fps > 0 ? info.fps : 30.0);
       return st.prefixed("--overlay: ");
     };
-    job.on_frame = [&](const image_view& image, const landmark_frame& frame) {
-      return overlay.write(image, frame);
+    job.on_frame = [&](const image_view& image, const landmark_frame& frame,
+                       const estimator::people_view& people) {
+      return overlay.write(image, frame, people);
     };
     job.on_finish = [&] { return overlay.close(); };
   }

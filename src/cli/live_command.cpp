@@ -11,10 +11,14 @@
 
 #include <chrono>
 #include <cstdio>
+#include <map>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "avatarmap/core/limits.hpp"
 #include "avatarmap/io/pose_file.hpp"
+#include "avatarmap/jobs/people.hpp"
 #include "avatarmap/live/live_capture.hpp"
 #include "avatarmap/live/live_session.hpp"
 #include "avatarmap/media/video_source.hpp"
@@ -41,10 +45,13 @@ const char* k_live_help =
     "dropped and counted. Each result is solved into a proxy pose, filtered and handed to\n"
     "the resampler, and the output runs at --fps from it (slerp between captured frames,\n"
     "short extrapolation past the newest). Prints capture rate, drops and latency (frame\n"
-    "delivered -> pose ready).\n"
+    "delivered -> pose ready). --people N follows up to N people, each solved on its own\n"
+    "and sent to its own outputs: a file per person, the k-th --vmc for the person in\n"
+    "slot k, one viewer avatar per person (docs/capture-people.md).\n"
     "\n"
     "Options:\n"
-    "  -o, --output PATH     write the resampled poses (*.pose.jsonl, atomically)\n"
+    "  -o, --output PATH     write the resampled poses (*.pose.jsonl, atomically); with\n"
+    "                        --people N > 1 one PATH.pID.pose.jsonl per person (its id)\n"
     "  --fps N               output rate (default 60)\n"
     "  --filter live|none    live (default): the causal filter of `solve --filter live`\n"
     "                        (docs/smoothing.md; with the capture's own smoothing of the body\n"
@@ -124,6 +131,13 @@ int run_live_command(int argc, char** argv) {
                  limit_text(k_max_fps).c_str());
     return 2;
   }
+  const bool several = ec.max_people > 1;
+  if (several && out_path == "-") {
+    std::fprintf(stderr,
+                 "avatarmap live: -o -: several people cannot share standard output; give a "
+                 "file (OUT.pose.jsonl: one OUT.pID.pose.jsonl per person)\n");
+    return 2;
+  }
   pose_server_options serve_options = default_viewer_options("live", "--serve");
   if (!serve.empty() && !parse_host_port(serve, serve_options.host, serve_options.port, error)) {
     std::fprintf(stderr, "avatarmap live: --serve: %s\n", error.c_str());
@@ -191,14 +205,31 @@ int run_live_command(int argc, char** argv) {
   // Output thread: the outputs, in order (each pose written, published, sent).
   pose_writer writer;
   const bool writing = !out_path.empty();
+  // Several people: one file per person id (OUT.pID.pose.jsonl), opened when the id first
+  // comes, all committed at the end.
+  std::map<int, std::unique_ptr<pose_writer>> person_writers;
+  pose_file_header out_header;
+  out_header.fps = out_fps;
   status write_status;
   if (writing)
-    lso.outputs.push_back([&](const proxy_pose& p, const live_output_report&) {
-      if (write_status.ok()) write_status = writer.write(p);
+    lso.outputs.push_back([&](const proxy_pose& p, const live_output_report& r) {
+      if (!write_status.ok()) return;
+      if (!several) {
+        write_status = writer.write(p);
+        return;
+      }
+      std::unique_ptr<pose_writer>& w = person_writers[r.person];
+      if (!w) {
+        w = std::make_unique<pose_writer>();
+        write_status = w->open(person_output_path(out_path, r.person), out_header);
+        if (!write_status.ok()) return;
+      }
+      write_status = w->write(p);
     });
   if (!serve.empty())
-    lso.outputs.push_back(
-        [&](const proxy_pose& p, const live_output_report&) { server.publish(p); });
+    lso.outputs.push_back([&](const proxy_pose& p, const live_output_report& r) {
+      server.publish(p, r.person, r.slot);
+    });
   if (vmc.enabled())
     lso.outputs.push_back(
         [&](const proxy_pose& p, const live_output_report& r) { vmc.send(p, r); });
@@ -209,10 +240,8 @@ int run_live_command(int argc, char** argv) {
     return 1;
   }
   // Opened before the first frame is pushed: no output runs before a pose exists.
-  if (writing) {
-    pose_file_header h;
-    h.fps = out_fps;
-    st = writer.open(out_path, h);
+  if (writing && !several) {
+    st = writer.open(out_path, out_header);
     if (!st.ok()) {
       std::fprintf(stderr, "avatarmap live: %s\n", st.message().c_str());
       return 1;
@@ -237,7 +266,9 @@ int run_live_command(int argc, char** argv) {
     std::fprintf(stderr, "%slive: %s\n", progress ? "\n" : "", source.end_reason().c_str());
   if (st.ok()) st = est_status;
   if (st.ok()) st = write_status;
-  if (st.ok() && writing) st = writer.commit();
+  if (st.ok() && writing && !several) st = writer.commit();
+  for (auto& [id, w] : person_writers)
+    if (st.ok()) st = w->commit();
   if (!st.ok()) {
     std::fprintf(stderr, "avatarmap live: %s\n", st.message().c_str());
     return 1;
@@ -256,8 +287,17 @@ int run_live_command(int argc, char** argv) {
                stats.latency_mean_ms, stats.latency_p50_ms, stats.latency_p95_ms,
                stats.latency_max_ms);
   timings.print(stderr);
-  std::fprintf(stderr, "output: %ld poses at %.0f fps%s%s\n", stats.outputs, out_fps,
-               out_path.empty() ? "" : " -> ", out_path.c_str());
+  if (!several || !writing) {
+    std::fprintf(stderr, "output: %ld poses at %.0f fps%s%s\n", stats.outputs, out_fps,
+                 out_path.empty() ? "" : " -> ", out_path.c_str());
+  } else {
+    std::vector<int> ids;
+    for (const auto& [id, w] : person_writers) ids.push_back(id);
+    std::fprintf(stderr, "output: %ld ticks at %.0f fps -> %zu files (%s), people %s\n",
+                 stats.outputs, out_fps, person_writers.size(),
+                 person_output_path(out_path, ids.empty() ? 0 : ids.front()).c_str(),
+                 person_id_list(ids).c_str());
+  }
   vmc.print_summary(stderr);
   return 0;
 }

@@ -10,7 +10,8 @@ status overlay_output::open(const std::string& path, int width, int height, doub
   return writer_.open(path, width, height, fps);
 }
 
-status overlay_output::write(const image_view& image, const landmark_frame& frame) {
+status overlay_output::write(const image_view& image, const landmark_frame& frame,
+                             const estimator::people_view& people) {
   if (image.format != pixel_format::rgb8 || image.data == nullptr)
     return status::error("overlay: frames must be RGB8");
   const size_t row = static_cast<size_t>(image.width) * 3;
@@ -21,7 +22,12 @@ status overlay_output::write(const image_view& image, const landmark_frame& fram
                 row);
   overlay_job job;
   job.image = {pixels_.data(), image.width, image.height, static_cast<int>(row)};
-  job.frame = &frame;
+  if (people.count >= 0) {
+    job.people = people.frames;
+    job.people_count = static_cast<std::size_t>(people.count);
+  } else {
+    job.frame = &frame;
+  }
   if (!job.run()) return status::error("overlay: the frame could not be drawn on");
   return writer_.write(
       {pixels_.data(), image.width, image.height, static_cast<int>(row), pixel_format::rgb8},

@@ -17,8 +17,11 @@ namespace avatarmap::cli {
 class overlay_output {
  public:
   status open(const std::string& path, int width, int height, double fps);
-  /// Draws `frame` on a copy of `image` (RGB8) and writes it at frame.t.
-  status write(const image_view& image, const landmark_frame& frame);
+  /// Draws `frame` on a copy of `image` (RGB8) and writes it at frame.t. With several people
+  /// (people.count >= 0, estimator::last_people()) draws each of them instead, in its own
+  /// colour with its id (overlay_job::people); count -1 draws `frame` as one person.
+  status write(const image_view& image, const landmark_frame& frame,
+               const estimator::people_view& people = {});
   /// Finalises the file (it appears under its name only now).
   status close();
   bool is_open() const { return writer_.is_open(); }

@@ -1,6 +1,7 @@
 #include "avatarmap/live/live_session.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -84,7 +85,39 @@ struct live_session::impl {
   // The worker's scratch.
   landmark_frame frame;
   proxy_pose pose;
+  people_poses people_scratch;  // several people
   std::thread worker;
+
+  // The output thread's scratch (several people: one pose per held person).
+  std::array<live_person, k_max_people> out_people{};
+  std::array<proxy_pose, k_max_people> out_poses;
+
+  bool several() const { return pipeline->max_people() > 1; }
+
+  // The people held now, ascending by id (under out_m).
+  int held_people(live_person* out, int capacity) const {
+    std::array<live_person, k_max_people> all{};
+    int n = 0;
+    if (!several()) {
+      if (has_pose) all[n++] = {0, 0, newest.t};
+    } else {
+      for (int k = 0; k < pipeline->max_people(); ++k)
+        if (pipeline->slot_person(k) >= 0)
+          all[n++] = {pipeline->slot_person(k), k, pipeline->slot_seen(k)};
+      std::sort(all.begin(), all.begin() + n,
+                [](const live_person& a, const live_person& b) { return a.id < b.id; });
+    }
+    for (int i = 0; i < n && i < capacity; ++i) out[i] = all[i];
+    return n;
+  }
+
+  // The stream sampled for `person` (slot 0 with one person; under out_m).
+  bool sample_slot(int slot, double t, proxy_pose& out) const {
+    if (!has_pose) return false;
+    if (!pipeline->stream(slot).sample(t, out)) return false;
+    out.t = t;
+    return true;
+  }
 
   // The output thread and what stops it.
   std::thread output;
@@ -113,11 +146,20 @@ struct live_session::impl {
           ++failed;
           error = st;
         } else {
-          pipeline->solve(frame, pose);
+          bool solved = true;
+          if (several()) {
+            pipeline->solve_people(frame, people_scratch);
+            solved = people_scratch.count > 0;
+            pose = solved ? people_scratch.people[0].pose : newest;
+          } else {
+            pipeline->solve(frame, pose);
+          }
           const clock_type::time_point now = clock_type::now();
           ms = std::chrono::duration<double, std::milli>(now - work.pushed).count();
-          newest = pose;
-          has_pose = true;
+          if (solved) {
+            newest = pose;
+            has_pose = true;
+          }
           ++processed;
           latencies.add(ms);
           newest_at = now;
@@ -135,6 +177,7 @@ struct live_session::impl {
           r.pose = &pose;
           r.timings = pipeline->last_timings();
           r.latency_ms = ms;
+          if (several()) r.people = &people_scratch;
         } else {
           r.error = &st;
         }
@@ -167,22 +210,34 @@ struct live_session::impl {
         std::unique_lock<std::mutex> lock(output_m);
         if (output_cv.wait_until(lock, next, [&] { return output_stop; })) return;
       }
+      int n = 0;
       {
         std::lock_guard<std::mutex> lock(out_m);
         if (!has_pose) continue;
         const double t = std::max(
             last_t + 1e-6,
             newest.t + std::chrono::duration<double>(clock_type::now() - newest_at).count());
-        if (!pipeline->stream().sample(t, p)) continue;
+        if (several()) {
+          const int held = held_people(out_people.data(), k_max_people);
+          for (int i = 0; i < held; ++i)
+            if (sample_slot(out_people[i].slot, t, out_poses[n])) out_people[n++] = out_people[i];
+        } else if (sample_slot(0, t, out_poses[0])) {
+          out_people[0] = {-1, 0, t};
+          n = 1;
+        }
+        if (n == 0) continue;
         last_t = t;
-        p.t = t;
         r.carries_new_frame = fresh;
         r.pushed_at = newest_pushed;
         fresh = false;
         ++outputs;
       }
-      for (const live_output& out : options.outputs)
-        if (out) out(p, r);
+      for (int i = 0; i < n; ++i) {
+        r.person = out_people[i].id;
+        r.slot = out_people[i].slot;
+        for (const live_output& out : options.outputs)
+          if (out) out(out_poses[i], r);
+      }
     }
   }
 };
@@ -271,10 +326,24 @@ status live_session::push(const image_view& image, double t) {
 
 bool live_session::sample(double t, proxy_pose& out) const {
   std::lock_guard<std::mutex> lock(impl_->out_m);
-  if (!impl_->has_pose) return false;
-  if (!impl_->pipeline->stream().sample(t, out)) return false;
-  out.t = t;
-  return true;
+  live_person first;
+  if (impl_->held_people(&first, 1) == 0) return false;
+  return impl_->sample_slot(first.slot, t, out);
+}
+
+bool live_session::sample_person(int id, double t, proxy_pose& out) const {
+  std::lock_guard<std::mutex> lock(impl_->out_m);
+  std::array<live_person, k_max_people> held;
+  const int n = impl_->held_people(held.data(), k_max_people);
+  for (int i = 0; i < n; ++i)
+    if (held[i].id == id || (!impl_->several() && id == 0))
+      return impl_->sample_slot(held[i].slot, t, out);
+  return false;
+}
+
+int live_session::people(live_person* out, int capacity) const {
+  std::lock_guard<std::mutex> lock(impl_->out_m);
+  return impl_->held_people(out, capacity);
 }
 
 bool live_session::latest(proxy_pose& out) const {

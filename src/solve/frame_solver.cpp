@@ -152,6 +152,17 @@ float frame_solver::performer_leg_length() const {
   return thigh > 0.f && shin > 0.f ? thigh + shin : 0.f;
 }
 
+bool frame_solver::ground_origin(glm::vec2& out) const {
+  if (!have_origin_) return false;
+  out = ground_origin_;
+  return true;
+}
+
+void frame_solver::set_ground_origin(const glm::vec2& origin) {
+  ground_origin_ = origin;
+  have_origin_ = true;
+}
+
 float frame_solver::horizontal_fov_degrees() const {
   return 2.f * std::atan(0.5f / focal_per_width_) / k_deg;
 }

@@ -1,9 +1,10 @@
 // The viewer's HTTP + WebSocket server on libwebsockets (include/avatarmap/stream/pose_server.hpp,
 // docs/viewer.md). One lws context with one service thread; publish() hands poses over
-// through a mutex-guarded "newest pose" buffer and lws_cancel_service(), which wakes the service
-// thread, which asks every WebSocket connection for a writeable callback; each connection then
-// sends the newest pose if it has not sent it yet. lws keeps at most the unsent rest of one
-// message per connection, so a slow page skips poses instead of queueing them.
+// through mutex-guarded "newest pose" buffers, one per slot (person), and lws_cancel_service(),
+// which wakes the service thread, which asks every WebSocket connection for a writeable
+// callback; each connection then sends, one message per callback, each slot's newest pose it has
+// not sent yet (the longest waiting first). lws keeps at most the unsent rest of one message per
+// connection, so a slow page skips poses instead of queueing them.
 #include "avatarmap/stream/pose_server.hpp"
 
 #include <arpa/inet.h>
@@ -18,10 +19,13 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <cstring>
+#include <iterator>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <string_view>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -175,6 +179,10 @@ using clock_type = std::chrono::steady_clock;
 constexpr std::size_t k_message_capacity = io_detail::k_pose_line_max;
 // Room write_shortest_float may use past the reserved bytes (pose_text.hpp).
 constexpr std::size_t k_message_slack = io_detail::k_shortest_float_room + 32;
+// Room for the keys publish() adds for a person: ,"person":ID,"slot":K (an int each).
+constexpr std::size_t k_person_keys_room = 48;
+// Bytes of a buffer that holds one message.
+constexpr std::size_t k_message_buffer = k_message_capacity + k_message_slack + k_person_keys_room;
 // A page's messages (its report) are small; longer ones are ignored.
 constexpr std::size_t k_rx_max = 256;
 // Bytes of a body served from memory (the config, the built-in avatar) written per callback.
@@ -200,8 +208,10 @@ struct http_session {
 };
 
 struct ws_session {
-  std::uint64_t sent_seq;  // the newest pose this connection has been handed (0 = none)
-  bool established;        // accepted (counted in open); lws zeroes the session
+  // Per slot, the count (slot_pose::count) of the newest pose this connection has been handed
+  // (0 = none).
+  std::uint64_t sent_count[k_pose_server_slots];
+  bool established;  // accepted (counted in open); lws zeroes the session
   std::size_t rx_len;
   bool rx_overflow;
   char rx[k_rx_max];
@@ -355,16 +365,20 @@ struct server_state {
   std::atomic<bool> stopping{false};
   bool started = false;
 
-  // The newest pose, written by publish() (any thread), read by the service thread.
+  // The newest pose of each slot, written by publish() (any thread), read by the service thread.
+  struct slot_pose {
+    std::vector<char> text = std::vector<char>(k_message_buffer);
+    std::size_t size = 0;     // 0 = none yet
+    std::uint64_t count = 0;  // poses published in this slot
+    std::uint64_t stamp = 0;  // `seq` when the newest was published: the oldest unsent goes first
+  };
   mutable std::mutex m;
   lws_context* context = nullptr;  // under m for publish(); set before the thread starts
-  std::vector<char> latest = std::vector<char>(k_message_capacity + k_message_slack);
-  std::size_t latest_size = 0;
+  std::array<slot_pose, k_pose_server_slots> latest;
   std::uint64_t seq = 0;
 
   // Service thread only.
-  std::vector<unsigned char> send_buffer =
-      std::vector<unsigned char>(LWS_PRE + k_message_capacity + k_message_slack);
+  std::vector<unsigned char> send_buffer = std::vector<unsigned char>(LWS_PRE + k_message_buffer);
   std::vector<unsigned char> http_buffer = std::vector<unsigned char>(LWS_PRE + k_body_chunk);
   machine_names machine;
   clock_type::time_point machine_read_at;
@@ -645,7 +659,7 @@ int ws_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, siz
     }
     case LWS_CALLBACK_ESTABLISHED: {
       server_state& s = *server_of(wsi);
-      session->sent_seq = 0;
+      std::fill(std::begin(session->sent_count), std::end(session->sent_count), 0);
       session->established = true;
       session->rx_len = 0;
       session->rx_overflow = false;
@@ -661,22 +675,34 @@ int ws_callback(lws* wsi, lws_callback_reasons reason, void* user, void* in, siz
     case LWS_CALLBACK_SERVER_WRITEABLE: {
       server_state& s = *server_of(wsi);
       std::size_t n = 0;
-      std::uint64_t seq = 0;
+      std::uint64_t count = 0;
+      int slot = -1;
+      int unsent = 0;  // slots with a pose this connection has not been handed
       {
         std::lock_guard<std::mutex> lock(s.m);
-        if (s.seq == session->sent_seq || s.latest_size == 0) return 0;
-        n = s.latest_size;
-        seq = s.seq;
-        std::memcpy(s.send_buffer.data() + LWS_PRE, s.latest.data(), n);
+        for (int k = 0; k < k_pose_server_slots; ++k) {
+          const server_state::slot_pose& l = s.latest[static_cast<std::size_t>(k)];
+          if (l.size == 0 || l.count == session->sent_count[k]) continue;
+          ++unsent;
+          if (slot < 0 || l.stamp < s.latest[static_cast<std::size_t>(slot)].stamp) slot = k;
+        }
+        if (slot < 0) return 0;
+        const server_state::slot_pose& l = s.latest[static_cast<std::size_t>(slot)];
+        n = l.size;
+        count = l.count;
+        std::memcpy(s.send_buffer.data() + LWS_PRE, l.text.data(), n);
       }
-      if (session->sent_seq != 0 && seq > session->sent_seq + 1)
-        s.skipped += static_cast<long>(seq - session->sent_seq - 1);
-      session->sent_seq = seq;
+      std::uint64_t& sent_count = session->sent_count[slot];
+      if (sent_count != 0 && count > sent_count + 1)
+        s.skipped += static_cast<long>(count - sent_count - 1);
+      sent_count = count;
       // lws sends what the socket takes and keeps the rest, then calls back only when it is
       // out: at most one message waits per connection.
       if (lws_write(wsi, s.send_buffer.data() + LWS_PRE, n, LWS_WRITE_TEXT) < static_cast<int>(n))
         return -1;
       ++s.sent;
+      // Another slot's pose waits: ask again (one message per writeable callback).
+      if (unsent > 1) lws_callback_on_writable(wsi);
       return 0;
     }
     case LWS_CALLBACK_RECEIVE: {
@@ -869,14 +895,39 @@ std::string pose_server::listen_address() const { return impl_->listen_address; 
 bool pose_server::exposed() const { return impl_->port != 0 && !impl_->loopback; }
 std::vector<std::string> pose_server::network_urls() const { return impl_->network_urls; }
 
-void pose_server::publish(const proxy_pose& pose) {
+namespace {
+
+// Puts ,"person":PERSON,"slot":SLOT before the closing '}' of the line text[0, size); returns
+// the new size. `text` has k_person_keys_room bytes past `size`.
+std::size_t add_person_keys(char* text, std::size_t size, int person, int slot) {
+  char* at = text + size - 1;  // the line's closing '}'
+  char* const end = text + size + k_person_keys_room;
+  constexpr std::string_view person_key = ",\"person\":";
+  constexpr std::string_view slot_key = ",\"slot\":";
+  at = std::copy(person_key.begin(), person_key.end(), at);
+  at = std::to_chars(at, end, person).ptr;
+  at = std::copy(slot_key.begin(), slot_key.end(), at);
+  at = std::to_chars(at, end, slot).ptr;
+  *at++ = '}';
+  return static_cast<std::size_t>(at - text);
+}
+
+}  // namespace
+
+void pose_server::publish(const proxy_pose& pose, int person, int slot) {
   impl& s = *impl_;
   ++s.published;
+  if (slot < 0 || slot >= k_pose_server_slots) return;
   std::lock_guard<std::mutex> lock(s.m);
-  io_detail::memory_text text(s.latest.data(), k_message_capacity);
-  if (!io_detail::put_pose_line(text, pose, pose_write_options{}, false)) return;
-  s.latest_size = text.size();
-  ++s.seq;
+  server_state::slot_pose& l = s.latest[static_cast<std::size_t>(slot)];
+  io_detail::memory_text text(l.text.data(), k_message_capacity);
+  if (!io_detail::put_pose_line(text, pose, pose_write_options{}, false)) {
+    l.size = 0;  // the buffer holds a partial line now (never expected: it is sized for any)
+    return;
+  }
+  l.size = person >= 0 ? add_person_keys(l.text.data(), text.size(), person, slot) : text.size();
+  ++l.count;
+  l.stamp = ++s.seq;
   if (s.context) lws_cancel_service(s.context);
 }
 
@@ -913,7 +964,7 @@ std::string pose_server::url() const { return {}; }
 std::string pose_server::listen_address() const { return {}; }
 bool pose_server::exposed() const { return false; }
 std::vector<std::string> pose_server::network_urls() const { return {}; }
-void pose_server::publish(const proxy_pose&) { ++impl_->published; }
+void pose_server::publish(const proxy_pose&, int, int) { ++impl_->published; }
 pose_server_stats pose_server::stats() const {
   pose_server_stats r;
   r.published = impl_->published.load();

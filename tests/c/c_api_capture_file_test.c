@@ -1,9 +1,12 @@
 /* avm_capture_file on real input: tfjs-models' pose_squats.mp4 (65 frames) gives byte for
  * byte the file the CLI's `avatarmap capture VIDEO -o OUT --hands --face` writes (argv[1] is
  * the CLI), with a summary that agrees with the file and progress that ends at the frame
- * count; pose.jpg gives one frame with a body; devices, missing input, bad arguments and an
- * unwritable output fail with a message. Skipped (77) without $AVATARMAP_TEST_DATA,
+ * count; pose.jpg gives one frame with a body; three_people.jpg with max_people 3 gives the
+ * CLI's `--people 3` file byte for byte and the people's counts (ids 0, 1, 2); devices, missing
+ * input, bad arguments (max_people 0 and 9 among them) and an unwritable output fail with a
+ * message. Skipped (77) without $AVATARMAP_TEST_DATA,
  * $AVATARMAP_MODELS or the data. Prints "N passed, N failed". */
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -66,7 +69,7 @@ static long lines_with(const char* text, const char* key) {
 int main(int argc, char** argv) {
   const char* data = getenv("AVATARMAP_TEST_DATA");
   const char* models = getenv("AVATARMAP_MODELS");
-  char video[1024], image[1024], models_dir[1024], command[4096], err[1024];
+  char video[1024], image[1024], people[1024], models_dir[1024], command[4096], err[1024];
   const char* cli_out = "capture_file_cli.landmarks.jsonl";
   const char* c_out = "capture_file_c.landmarks.jsonl";
   avm_estimator_options o;
@@ -81,6 +84,7 @@ int main(int argc, char** argv) {
   }
   snprintf(video, sizeof video, "%s/motion/tfjs-models/pose_squats.mp4", data);
   snprintf(image, sizeof image, "%s/motion/tfjs-models/pose.jpg", data);
+  snprintf(people, sizeof people, "%s/motion/tfjs-models/three_people.jpg", data);
   snprintf(models_dir, sizeof models_dir, "%s/onnx", models);
   if (!file_exists(video) || !file_exists(image)) {
     printf("skipped: %s or pose.jpg missing\n", video);
@@ -141,6 +145,75 @@ int main(int argc, char** argv) {
   CHECK(c_text != NULL && lines_with(c_text, "\"t\":") == 1 &&
         lines_with(c_text, "\"pose\":") == 1);
   free(c_text);
+
+  /* Several people: three_people.jpg with max_people 3 is the CLI's `--people 3` file, with
+   * ids 0, 1, 2; a summary struct of before the people's fields gets none of them. */
+  if (file_exists(people)) {
+    remove(cli_out);
+    snprintf(command, sizeof command,
+             "\"%s\" capture \"%s\" -o %s --people 3 --hands --face --models \"%s\" --quiet",
+             argv[1], people, cli_out, models_dir);
+    CHECK(system(command) == 0);
+    avm_estimator_options_init(&o);
+    o.models_dir = models_dir;
+    o.max_people = 3;
+    memset(&s, 0xff, sizeof s);
+    s.struct_size = sizeof s;
+    CHECK(avm_capture_file(people, c_out, &o, &s, NULL, NULL, err, sizeof err) == AVM_OK);
+    cli_text = slurp(cli_out, &cli_size);
+    c_text = slurp(c_out, &c_size);
+    CHECK(cli_text != NULL && c_text != NULL);
+    if (cli_text != NULL && c_text != NULL) {
+      CHECK(cli_size == c_size && memcmp(cli_text, c_text, (size_t)c_size) == 0);
+      CHECK(lines_with(c_text, "\"version\":2") == 1);
+      CHECK(lines_with(c_text, "\"person\":0,") == 1 && lines_with(c_text, "\"person\":1,") == 1 &&
+            lines_with(c_text, "\"person\":2,") == 1);
+      CHECK(s.frames == 1 && s.people_ids == 3 && s.person_lines == 3 &&
+            s.frames_with_people == 1 && s.body_frames == 3);
+    }
+    free(cli_text);
+    free(c_text);
+    memset(&s, 0x5a, sizeof s);
+    s.struct_size = (uint32_t)offsetof(avm_capture_summary, people_ids);
+    CHECK(avm_capture_file(people, c_out, &o, &s, NULL, NULL, err, sizeof err) == AVM_OK);
+    CHECK(s.frames == 1 && s.body_frames == 3);
+    {
+      int64_t untouched;
+      memset(&untouched, 0x5a, sizeof untouched);
+      CHECK(s.people_ids == untouched && s.frames_with_people == untouched);
+    }
+    /* One person (the default): none of the people's counts. */
+    avm_estimator_options_init(&o);
+    o.models_dir = models_dir;
+    CHECK(o.max_people == 1);
+    s.struct_size = sizeof s;
+    CHECK(avm_capture_file(people, c_out, &o, &s, NULL, NULL, err, sizeof err) == AVM_OK);
+    CHECK(s.people_ids == 0 && s.person_lines == 0 && s.body_frames == 1);
+    /* Out of range: refused, naming the field. */
+    o.max_people = 0;
+    CHECK(avm_capture_file(people, c_out, &o, NULL, NULL, NULL, err, sizeof err) ==
+          AVM_ERROR_INVALID_ARGUMENT);
+    CHECK(contains(err, "avm_estimator_options.max_people"));
+    o.max_people = AVM_MAX_PEOPLE + 1;
+    CHECK(avm_capture_file(people, c_out, &o, NULL, NULL, NULL, err, sizeof err) ==
+          AVM_ERROR_INVALID_ARGUMENT);
+    CHECK(contains(err, "avm_estimator_options.max_people"));
+    /* A caller built before max_people (its struct ends at static_images) gets one person. */
+    avm_estimator_options_init(&o);
+    o.models_dir = models_dir;
+    o.struct_size = (uint32_t)offsetof(avm_estimator_options, max_people);
+    o.max_people = 7; /* past the caller's struct: not read */
+    CHECK(avm_capture_file(people, c_out, &o, NULL, NULL, NULL, err, sizeof err) == AVM_OK);
+    c_text = slurp(c_out, &c_size);
+    CHECK(c_text != NULL && lines_with(c_text, "\"person\"") == 0 &&
+          lines_with(c_text, "\"pose\":") == 1);
+    free(c_text);
+    avm_estimator_options_init(&o);
+    o.models_dir = models_dir;
+    CHECK(avm_capture_file(image, c_out, &o, NULL, NULL, NULL, err, sizeof err) == AVM_OK);
+  } else {
+    printf("three_people.jpg is missing: the several-people checks are skipped\n");
+  }
 
   /* Failures: nothing written over the output. */
   CHECK(avm_capture_file("lavfi:testsrc=size=64x64:rate=5", c_out, &o, NULL, NULL, NULL, err,

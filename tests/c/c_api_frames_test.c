@@ -1,7 +1,11 @@
 /* C API over arrays of frames and poses (avm_frame_block, avm_landmark_reader_*,
  * avm_solve_frames, avm_clip_read / _get_poses / _add_poses, avm_retargeter_apply_poses):
  *   - the reader on a hand-written file (known values, parts missing, 468- and 478-point
- *     faces, NaN fill, NULL arrays skipped, a bad line reported and skipped);
+ *     faces, NaN fill, NULL arrays skipped, a bad line reported and skipped); its person
+ *     column on a hand-written version-2 file, a version-1 file (0) and for a caller whose
+ *     struct ends before the column;
+ *   - avm_solve_frames refuses a block of several person ids, solves a block of one as
+ *     without the column;
  *   - avm_solve_frames on a file's frames gives bit-identical poses to avm_solve_file on the
  *     file (read back with avm_clip_read), for each file filter; on the hand-written file and
  *     on argv[1] (a synthetic recording with hands and face, written by `avatarmap synth`);
@@ -10,6 +14,7 @@
  * Runs in its own build folder (writes and removes a few small files). Prints "N passed, N
  * failed". */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -206,6 +211,152 @@ static void test_reader(void) {
   }
   remove(bad);
   remove(path);
+  free_block(&b);
+}
+
+/* A version-2 file (several people), written here line by line: frame 0 has people 0 and 1,
+ * frame 1 only person 1, frame 2 people 0 and 2 (ascending by id, one t per frame). Line k's
+ * body has the values of `value(k, 0, ...)`. */
+static const int k_people_rows = 5;
+static const int k_people_ids[] = {0, 1, 1, 0, 2};
+static const int k_people_frame[] = {0, 0, 1, 2, 2};
+
+static int write_people_file(const char* path) {
+  FILE* fp = fopen(path, "w");
+  int k;
+  if (fp == NULL) return 0;
+  fprintf(fp,
+          "{\"format\":\"avatarmap.landmarks\",\"version\":2,\"image_size\":[640,480],"
+          "\"fps\":30}\n");
+  for (k = 0; k < k_people_rows; ++k) {
+    fprintf(fp, "{\"t\":%.9g,\"person\":%d", 0.25 + k_people_frame[k] / 32.0, k_people_ids[k]);
+    write_points(fp, "pose", k, 0, 33);
+    fprintf(fp, "}\n");
+  }
+  return fclose(fp) == 0;
+}
+
+/* The person column: a version-2 file's ids row by row; a version-1 file's rows are 0; a caller
+ * whose struct ends before the column (built before it existed) gets none written. */
+static void test_reader_person(void) {
+  const char* people = "frames_test_people.landmarks.jsonl";
+  const char* one = "frames_test_one.landmarks.jsonl";
+  avm_landmark_reader* r = NULL;
+  avm_frame_block b = new_block(8);
+  int32_t ids[8];
+  int64_t got = -1;
+  int k;
+
+  CHECK(write_people_file(people));
+  for (k = 0; k < 8; ++k) ids[k] = -7;
+  b.person = ids;
+  CHECK(avm_landmark_reader_open(people, &r) == AVM_OK);
+  CHECK(avm_landmark_reader_read(r, &b, &got) == AVM_OK && got == k_people_rows);
+  for (k = 0; k < k_people_rows; ++k) {
+    CHECK(ids[k] == k_people_ids[k]);
+    CHECK(b.t[k] == 0.25 + k_people_frame[k] / 32.0);
+    CHECK(row_is(b.pose, 33, k, 0, 33));
+    CHECK(row_is(b.left_hand, 21, k, 2, 0));
+  }
+  CHECK(ids[k_people_rows] == -7); /* no more rows than lines */
+  avm_landmark_reader_destroy(r);
+
+  /* Blocks of two rows: the ids go on across calls. */
+  for (k = 0; k < 8; ++k) ids[k] = -7;
+  CHECK(avm_landmark_reader_open(people, &r) == AVM_OK);
+  b.count = 2;
+  CHECK(avm_landmark_reader_read(r, &b, &got) == AVM_OK && got == 2);
+  CHECK(ids[0] == 0 && ids[1] == 1);
+  CHECK(avm_landmark_reader_read(r, &b, &got) == AVM_OK && got == 2);
+  CHECK(ids[0] == 1 && ids[1] == 0 && row_of(b.pose, 33, 1, 3, 0, 33));
+  CHECK(avm_landmark_reader_read(r, &b, &got) == AVM_OK && got == 1 && ids[0] == 2);
+  b.count = 8;
+  avm_landmark_reader_destroy(r);
+
+  /* A version-1 file: every row is person 0. */
+  CHECK(write_hand_file(one, 0));
+  for (k = 0; k < 8; ++k) ids[k] = -7;
+  CHECK(avm_landmark_reader_open(one, &r) == AVM_OK);
+  CHECK(avm_landmark_reader_read(r, &b, &got) == AVM_OK && got == 4);
+  for (k = 0; k < 4; ++k) CHECK(ids[k] == 0);
+  avm_landmark_reader_destroy(r);
+
+  /* The struct as a caller built before the column knows it: read as before, nothing written
+   * past its end. */
+  for (k = 0; k < 8; ++k) ids[k] = -7;
+  b.struct_size = (uint32_t)offsetof(avm_frame_block, person);
+  CHECK(avm_landmark_reader_open(people, &r) == AVM_OK);
+  CHECK(avm_landmark_reader_read(r, &b, &got) == AVM_OK && got == k_people_rows);
+  CHECK(ids[0] == -7 && ids[1] == -7 && row_is(b.pose, 33, 4, 0, 33));
+  b.struct_size = (uint32_t)offsetof(avm_frame_block, person) - 4;
+  CHECK(avm_landmark_reader_read(r, &b, &got) == AVM_ERROR_INVALID_ARGUMENT);
+  CHECK(contains(avm_landmark_reader_last_error(r), "struct_size"));
+  avm_landmark_reader_destroy(r);
+
+  b.person = NULL;
+  b.struct_size = sizeof b;
+  remove(people);
+  remove(one);
+  free_block(&b);
+}
+
+/* avm_solve_frames and the person column: one id is solved as without the column; several are
+ * refused with a message that says what to do; a struct without the column solves every row. */
+static void test_solve_frames_person(void) {
+  avm_frame_block b = new_block(6);
+  avm_pose plain[6], with_ids[6];
+  int32_t ids[6];
+  char err[512];
+  int k;
+  CHECK(write_people_file("frames_test_solve_people.landmarks.jsonl"));
+  {
+    avm_landmark_reader* r = NULL;
+    int64_t got = 0;
+    CHECK(avm_landmark_reader_open("frames_test_solve_people.landmarks.jsonl", &r) == AVM_OK);
+    CHECK(avm_landmark_reader_read(r, &b, &got) == AVM_OK && got == k_people_rows);
+    avm_landmark_reader_destroy(r);
+  }
+  remove("frames_test_solve_people.landmarks.jsonl");
+  /* Rows 1 and 2 are person 1 (frames 0 and 1): a take of its own. */
+  b.t += 1;
+  b.pose += 33 * PT;
+  b.pose_world += 33 * PT;
+  b.left_hand += 21 * PT;
+  b.left_hand_world += 21 * PT;
+  b.right_hand += 21 * PT;
+  b.right_hand_world += 21 * PT;
+  b.face += 478 * PT;
+  b.count = 2;
+  CHECK(avm_solve_frames(&b, NULL, plain, err, sizeof err) == AVM_OK);
+  ids[0] = ids[1] = 1;
+  b.person = ids;
+  memset(with_ids, 0xff, sizeof with_ids);
+  CHECK(avm_solve_frames(&b, NULL, with_ids, err, sizeof err) == AVM_OK && err[0] == '\0');
+  CHECK(memcmp(plain, with_ids, 2 * sizeof(avm_pose)) == 0);
+  /* Two ids: refused, naming the column and the way out. */
+  ids[1] = 0;
+  CHECK(avm_solve_frames(&b, NULL, with_ids, err, sizeof err) == AVM_ERROR_INVALID_ARGUMENT);
+  CHECK(contains(err, "avm_frame_block.person") && contains(err, "avm_solver_options.person"));
+  /* Three rows, the odd one last. */
+  b.count = 3;
+  ids[1] = 1;
+  ids[2] = 0;
+  CHECK(avm_solve_frames(&b, NULL, with_ids, err, sizeof err) == AVM_ERROR_INVALID_ARGUMENT);
+  /* A caller without the column: the rows are solved (the column is not its own). */
+  b.struct_size = (uint32_t)offsetof(avm_frame_block, person);
+  CHECK(avm_solve_frames(&b, NULL, with_ids, err, sizeof err) == AVM_OK);
+  b.struct_size = sizeof b;
+  b.person = NULL;
+  CHECK(avm_solve_frames(&b, NULL, with_ids, err, sizeof err) == AVM_OK);
+  for (k = 0; k < 3; ++k) CHECK(with_ids[k].t == b.t[k]);
+  b.t -= 1;
+  b.pose -= 33 * PT;
+  b.pose_world -= 33 * PT;
+  b.left_hand -= 21 * PT;
+  b.left_hand_world -= 21 * PT;
+  b.right_hand -= 21 * PT;
+  b.right_hand_world -= 21 * PT;
+  b.face -= 478 * PT;
   free_block(&b);
 }
 
@@ -574,6 +725,7 @@ static void test_reader_endless_line(void) {
 
 int main(int argc, char** argv) {
   test_reader();
+  test_reader_person();
   test_reader_endless_line();
   CHECK(write_hand_file("frames_test_solve.landmarks.jsonl", 0));
   test_solve_frames_matches_file("frames_test_solve.landmarks.jsonl");
@@ -584,6 +736,7 @@ int main(int argc, char** argv) {
     printf("no synthetic recording given (argv[1]): the hand-written file only\n");
   }
   test_solve_frames_errors();
+  test_solve_frames_person();
   test_solve_file_to_clip_errors();
   test_clip_poses();
   test_apply_poses();

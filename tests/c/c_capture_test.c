@@ -14,37 +14,10 @@
 
 #include "avatarmap/avatarmap.h"
 #include "check.h"
+#include "decode_image.h"
 #include "test_util.h"
 
 #define SKIP 77
-
-static void sleep_ms(int ms) {
-  struct timespec ts;
-  ts.tv_sec = ms / 1000;
-  ts.tv_nsec = (long)(ms % 1000) * 1000000L;
-  nanosleep(&ts, NULL);
-}
-
-/* Decodes `path` to packed RGB with the ffmpeg command; NULL when that fails. */
-static unsigned char* decode_rgb(const char* path, int width, int height) {
-  char cmd[2048];
-  unsigned char* px;
-  size_t need = (size_t)width * (size_t)height * 3u, got;
-  FILE* p;
-  snprintf(cmd, sizeof cmd,
-           "ffmpeg -v error -i '%s' -f rawvideo -pix_fmt rgb24 -s %dx%d - 2>/dev/null", path, width,
-           height);
-  p = popen(cmd, "r");
-  if (p == NULL) return NULL;
-  px = (unsigned char*)malloc(need);
-  got = px != NULL ? fread(px, 1, need, p) : 0;
-  pclose(p);
-  if (got != need) {
-    free(px);
-    return NULL;
-  }
-  return px;
-}
 
 /* Reads the 33 [x, y] pixel pairs of "pose-detection::EXPECTED_LANDMARKS" from the JSON file
  * of tfjs-models' expected values; 0 when they are not there. */

@@ -88,8 +88,8 @@ TEST(people_tracker, a_box_on_a_tracked_person_is_that_person) {
   detect(tr, 0.0, {a});
   ASSERT_EQ(tr.active_count(), 1);
   found(tr, 0.0, tr.active(0).slot, a);
-  EXPECT_FALSE(tr.wants_detection(0.1));  // the schedule: every 0.2 s while fewer than 3
-  EXPECT_TRUE(tr.wants_detection(0.2));
+  EXPECT_FALSE(tr.wants_detection(0.05));  // the schedule: every 0.1 s while fewer than 3
+  EXPECT_TRUE(tr.wants_detection(o.redetect_seconds));
   // The detector again: a (moved a little, its region much larger) and a newcomer b.
   person a2{0.32f, 0.5f, 1.5f};
   detect(tr, 0.5, {a2, b});

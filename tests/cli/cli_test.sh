@@ -122,6 +122,46 @@ open("two.landmarks.jsonl", "w").write("\n".join(out) + "\n")' || fail "could no
     cmp -s b.pose.jsonl five.pose.jsonl || fail "convert --person 5 is not b's poses"
     # An old reader's view: the header says version 2, so a version-1 reader refuses it.
     expect_in two.landmarks.jsonl '"version": 2'
+    # live --people 2: one pose file per person. Two people side by side (pose_squats.mp4 beside
+    # its mirror image 1.6 s later), made here with the ffmpeg tool.
+    run 2 live in.mp4 --people 2 -o -
+    expect_in err.txt "several people cannot share standard output"
+    if needs data models && command -v ffmpeg >/dev/null; then
+      clip="$AVATARMAP_TEST_DATA/motion/tfjs-models/pose_squats.mp4"
+      ffmpeg -v error -y -i "$clip" -i "$clip" -filter_complex \
+        "[1:v]trim=start=1.6,setpts=PTS-STARTPTS,hflip[b];[0:v][b]hstack=inputs=2" -t 3 \
+        -c:v libx264 -pix_fmt yuv420p side.mp4 || fail "ffmpeg could not make side.mp4"
+      models="$AVATARMAP_MODELS/onnx"
+      run 0 live side.mp4 --people 2 --models "$models" -o live.pose.jsonl --seconds 3
+      [ -e live.pose.jsonl ] && fail "live of two people wrote live.pose.jsonl"
+      expect_in err.txt "people 0, 1"
+      run 0 live "$clip" --models "$models" -o alone.pose.jsonl --seconds 3
+      # Person 0 (the clip itself) is nearer the clip's own live poses than person 1 (the
+      # mirror image, later) is: each file holds its own person.
+      python3 - live.p0.pose.jsonl live.p1.pose.jsonl alone.pose.jsonl <<'PY' ||
+import json, math, sys
+def load(path):
+    rows = [json.loads(l) for l in open(path) if l.strip()][1:]
+    return [(r["t"], r["bones"]) for r in rows]
+p0, p1, alone = (load(p) for p in sys.argv[1:4])
+assert len(p0) > 60 and len(p1) > 60, (len(p0), len(p1))
+def angle(a, b):
+    d = abs(sum(x * y for x, y in zip(a, b)))
+    return 2 * math.degrees(math.acos(min(1.0, d)))
+def distance(poses):
+    total = n = 0
+    for t, bones in poses:
+        _, ref = min(alone, key=lambda r: abs(r[0] - t))
+        for name in ("leftUpperArm", "rightUpperArm", "leftUpperLeg", "rightUpperLeg"):
+            if name in bones and name in ref:
+                total += angle(bones[name], ref[name]); n += 1
+    return total / max(1, n)
+d0, d1 = distance(p0), distance(p1)
+print("person 0 vs alone %.1f deg, person 1 vs alone %.1f deg" % (d0, d1))
+assert d0 < 15 and d1 > d0 + 20, (d0, d1)  # measured 7.7 and 62.8
+PY
+        fail "live.p0/p1.pose.jsonl do not hold their own people"
+    fi
     ;;
   glb_builtin)
     # A .glb without --avatar carries the built-in avatar, as `avatarmap avatar` writes it:

@@ -92,7 +92,10 @@ def people(scene, t):
         # A is hidden where B's rectangle covers its box.
         lo, hi = apx[av > 0.5].min(0), apx[av > 0.5].max(0)
         cover = max(0.0, min(hi[0], bx + 540) - max(lo[0], bx)) / max(1.0, hi[0] - lo[0])
-        bvis = -270 < bx < 1440 - 270
+        # B is visible while at least half of its body's box (its visible points) is in the
+        # image (its rectangle's black margins do not count).
+        blo, bhi = bpx[bv > 0.5, 0].min(), bpx[bv > 0.5, 0].max()
+        bvis = (min(bhi, 1440.0) - max(blo, 0.0)) / max(1.0, bhi - blo) >= 0.5
         out.append((apx, av, np.hypot(720, 1280), cover < 0.5))
         out.append((bpx, bv, np.hypot(540, 960), bvis))
     return out
@@ -131,6 +134,7 @@ for scene in ("side", "cross"):
             near0 = (d0 < d1).mean()
             if 0.3 < near0 < 0.7:
                 spanning += 1
+                print(f"  spanning at t={t}: person {pid}, {near0:.2f} of its points nearer person 0")
     fps_text = open(f"{work}/{scene}.time").read().strip()
     print(f"{scene}: {len(times)} frames, capture {fps_text} s, skeletons spanning two people {spanning}")
     for k, s in enumerate(stats):

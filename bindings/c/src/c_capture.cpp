@@ -2,6 +2,7 @@
 // poses, the library's capture_pipeline on the caller's thread.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -24,6 +25,9 @@ struct avm_estimator : avatarmap::c_api::error_slot {
   am::landmark_frame frame;  // the last image's landmarks
   am::proxy_pose pose;       // and its pose
   frame_storage storage;     // what avm_frame's pointers point into
+  // Several people (avm_estimator_process_people): every person's pose and landmarks.
+  am::people_poses people;
+  std::array<frame_storage, am::k_max_people> people_storage;
 };
 
 extern "C" {
@@ -97,6 +101,47 @@ AVATARMAP_C_API avm_status avm_estimator_process(avm_estimator* estimator, const
     if (!st.ok()) return fail(estimator, avm_code(st), st.message().c_str());
     if (out_frame != nullptr) to_c_frame(estimator->frame, estimator->storage, *out_frame);
     if (out_pose != nullptr) to_c_pose(estimator->pose, *out_pose);
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_estimator_process_people(avm_estimator* estimator,
+                                                        const avm_image* image, double t,
+                                                        avm_person* out_people, int32_t capacity,
+                                                        int32_t* out_count) {
+  if (estimator == nullptr) return AVM_ERROR_INVALID_ARGUMENT;
+  estimator->last_error.clear();
+  return guard("avm_estimator_process_people", to_handle(estimator), [&]() -> avm_status {
+    const char* who = "avm_estimator_process_people: ";
+    auto bad = [&](const char* what) {
+      char m[k_error_capacity];
+      copy_message(m, sizeof m, who);
+      std::strncat(m, what, sizeof m - std::strlen(m) - 1);
+      return fail(estimator, AVM_ERROR_INVALID_ARGUMENT, m);
+    };
+    if (image == nullptr) return bad("image is NULL");
+    if (out_count == nullptr) return bad("out_count is NULL");
+    if (capacity < 0) return bad("capacity must be >= 0");
+    if (out_people == nullptr && capacity > 0) return bad("out_people is NULL with capacity > 0");
+    if (!std::isfinite(t)) return bad("t must be finite");
+    am::image_view view;
+    char buffer[k_error_capacity];
+    if (const char* why = to_image_view(*image, view, buffer, sizeof buffer))
+      return fail(estimator, AVM_ERROR_INVALID_ARGUMENT, why);
+    am::capture_pipeline& p = *estimator->pipeline;
+    const am::status st = p.estimate(view, t, estimator->frame);
+    if (!st.ok()) return fail(estimator, avm_code(st), st.message().c_str());
+    p.solve_people(estimator->frame, estimator->people);
+    const am::people_poses& people = estimator->people;
+    for (int i = 0; i < people.count && i < capacity; ++i) {
+      const am::person_pose& pp = people.people[i];
+      avm_person& o = out_people[i];
+      o.id = pp.id;
+      o.slot = pp.slot;
+      to_c_frame(*pp.frame, estimator->people_storage[i], o.frame);
+      to_c_pose(pp.pose, o.pose);
+    }
+    *out_count = people.count;
     return AVM_OK;
   });
 }

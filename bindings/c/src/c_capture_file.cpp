@@ -1,5 +1,6 @@
 // avm_capture_file: `avatarmap capture INPUT -o OUT` as a library call, the library's
 // capture_file_job (the CLI's `capture` runs it too) on the calling thread and its decoder's.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -15,6 +16,10 @@ using namespace avatarmap::c_api;
 
 namespace {
 
+// The summary as far as the caller's struct goes: a caller built before the people's fields
+// passes a struct_size that ends at `seconds`.
+constexpr std::size_t k_summary_v1_size = offsetof(avm_capture_summary, people_ids);
+
 void fill_summary(const am::capture_file_summary& s, avm_capture_summary& out) {
   using fp = am::frame_part;
   out.frames = s.frames;
@@ -27,6 +32,11 @@ void fill_summary(const am::capture_file_summary& s, avm_capture_summary& out) {
   out.image_height = s.input.height;
   out.fps = s.input.fps;
   out.seconds = s.seconds;
+  if (out.struct_size >= sizeof(avm_capture_summary)) {
+    out.people_ids = s.people_ids;
+    out.person_lines = s.person_lines;
+    out.frames_with_people = s.frames_with_people;
+  }
 }
 
 }  // namespace
@@ -46,7 +56,7 @@ AVATARMAP_C_API avm_status avm_capture_file(const char* input, const char* out_l
   if (input == nullptr || out_landmarks == nullptr)
     return report(AVM_ERROR_INVALID_ARGUMENT,
                   "avm_capture_file: input and out_landmarks must not be NULL");
-  if (out_summary != nullptr && out_summary->struct_size < sizeof(avm_capture_summary))
+  if (out_summary != nullptr && out_summary->struct_size < k_summary_v1_size)
     return report(AVM_ERROR_INVALID_ARGUMENT,
                   "avm_capture_file: set out_summary->struct_size = sizeof(avm_capture_summary)");
   return guard("avm_capture_file", report, [&]() -> avm_status {

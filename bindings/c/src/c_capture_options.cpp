@@ -13,6 +13,9 @@
 
 namespace avatarmap::c_api {
 
+static_assert(AVM_MAX_PEOPLE == k_max_people,
+              "AVM_MAX_PEOPLE must be estimator.hpp's k_max_people");
+
 namespace {
 // Larger than any plausible future avm_estimator_options: a bigger struct_size is taken as an
 // uninitialised struct rather than a newer caller.
@@ -37,13 +40,13 @@ struct c_field {
 #define AVM_FIELD(f) \
   c_field { #f, offsetof(avm_estimator_options, f) }
 constexpr c_field k_fields[] = {
-    AVM_FIELD(model_complexity),      AVM_FIELD(hands),   AVM_FIELD(face),
-    AVM_FIELD(hand_model_complexity), AVM_FIELD(threads), AVM_FIELD(mirrored),
-    AVM_FIELD(static_images),
+    AVM_FIELD(model_complexity),      AVM_FIELD(hands),      AVM_FIELD(face),
+    AVM_FIELD(hand_model_complexity), AVM_FIELD(threads),    AVM_FIELD(mirrored),
+    AVM_FIELD(static_images),         AVM_FIELD(max_people),
 };
 #undef AVM_FIELD
 // Every field from model_complexity to the end (past it only the struct's padding).
-constexpr std::size_t k_fields_end = offsetof(avm_estimator_options, static_images) + 4;
+constexpr std::size_t k_fields_end = offsetof(avm_estimator_options, max_people) + 4;
 static_assert(offsetof(avm_estimator_options, model_complexity) +
                           sizeof(k_fields) / sizeof(k_fields[0]) * sizeof(std::int32_t) ==
                       k_fields_end &&

@@ -34,8 +34,15 @@ float* row(float* array, int points, std::int64_t i) {
 
 }  // namespace
 
-const char* check_block(const avm_frame_block& block) noexcept {
-  if (block.struct_size < sizeof(avm_frame_block))
+std::int32_t* block_person(const avm_frame_block& block) noexcept {
+  // A caller compiled before the column existed passes the shorter struct: its struct_size
+  // ends at face, and the bytes past it are not its own.
+  if (block.struct_size < offsetof(avm_frame_block, person) + sizeof(block.person)) return nullptr;
+  return block.person;
+}
+
+const char* check_block_to_fill(const avm_frame_block& block) noexcept {
+  if (block.struct_size < offsetof(avm_frame_block, person))
     return "avm_frame_block.struct_size must be sizeof(avm_frame_block)";
   if (block.count < 0) return "avm_frame_block.count must be >= 0";
   if (block.count > 0 && block.t == nullptr)
@@ -43,10 +50,24 @@ const char* check_block(const avm_frame_block& block) noexcept {
   return nullptr;
 }
 
+const char* check_block(const avm_frame_block& block) noexcept {
+  if (const char* bad = check_block_to_fill(block)) return bad;
+  const std::int32_t* person = block_person(block);
+  if (person == nullptr) return nullptr;
+  for (std::int64_t i = 1; i < block.count; ++i)
+    if (person[i] != person[0])
+      return "avm_frame_block.person holds more than one person id: the rows of several "
+             "people cannot be solved as one take; solve each person's rows on their own (a "
+             "block of one id), or solve the file with avm_solve_file and "
+             "avm_solver_options.person";
+  return nullptr;
+}
+
 void block_row_to_frame(const avm_frame_block& block, std::int64_t i,
                         landmark_frame& out) noexcept {
   out.clear();
   out.t = block.t[i];
+  if (const std::int32_t* person = block_person(block)) out.person = person[i];
   for (const block_part& bp : k_parts) {
     const float* array = block.*bp.array;
     if (array == nullptr) continue;
@@ -67,6 +88,7 @@ void frame_to_block_row(const landmark_frame& in, const avm_frame_block& block,
                         std::int64_t i) noexcept {
   constexpr float nan = std::numeric_limits<float>::quiet_NaN();
   block.t[i] = in.t;
+  if (std::int32_t* person = block_person(block)) person[i] = in.person;
   for (const block_part& bp : k_parts) {
     float* dst = block.*bp.array;
     if (dst == nullptr) continue;

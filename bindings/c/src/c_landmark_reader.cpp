@@ -65,7 +65,8 @@ AVATARMAP_C_API avm_status avm_landmark_reader_read(avm_landmark_reader* r,
   if (block == nullptr || out_read == nullptr)
     return fail(r, AVM_ERROR_INVALID_ARGUMENT,
                 "avm_landmark_reader_read: block and out_read must not be NULL");
-  if (const char* bad = check_block(*block)) return fail(r, AVM_ERROR_INVALID_ARGUMENT, bad);
+  if (const char* bad = check_block_to_fill(*block))
+    return fail(r, AVM_ERROR_INVALID_ARGUMENT, bad);
   if (block->t == nullptr)
     return fail(r, AVM_ERROR_INVALID_ARGUMENT, "avm_landmark_reader_read: block->t is NULL");
   return guard("avm_landmark_reader_read", to_handle(r), [&]() -> avm_status {

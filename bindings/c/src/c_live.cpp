@@ -1,5 +1,6 @@
 // The C API's live handle (avm_live_*): the library's live_session — the caller's camera thread
 // pushes images, the session's worker processes the newest, any thread samples the pose.
+#include <array>
 #include <cmath>
 #include <condition_variable>
 #include <memory>
@@ -181,6 +182,37 @@ AVATARMAP_C_API avm_status avm_live_latest(const avm_live* live, avm_pose* out_p
   return guard("avm_live_latest", silently, [&]() -> avm_status {
     am::proxy_pose p;
     if (!live->session->latest(p)) return rest_pose(0.0, out_pose);
+    to_c_pose(p, *out_pose);
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_live_people(const avm_live* live, avm_live_person* out_people,
+                                           int32_t capacity, int32_t* out_count) {
+  if (live == nullptr || out_count == nullptr || capacity < 0 ||
+      (out_people == nullptr && capacity > 0))
+    return AVM_ERROR_INVALID_ARGUMENT;
+  const live_call call(live);
+  if (!call.ok()) return AVM_ERROR_INVALID_ARGUMENT;
+  return guard("avm_live_people", silently, [&]() -> avm_status {
+    std::array<am::live_person, am::k_max_people> held;
+    const int n = live->session->people(held.data(), am::k_max_people);
+    for (int i = 0; i < n && i < capacity; ++i)
+      out_people[i] = {held[i].id, held[i].slot, held[i].seen_t};
+    *out_count = n;
+    return AVM_OK;
+  });
+}
+
+AVATARMAP_C_API avm_status avm_live_sample_person(const avm_live* live, int32_t id, double t,
+                                                  avm_pose* out_pose) {
+  if (live == nullptr || out_pose == nullptr || !std::isfinite(t))
+    return AVM_ERROR_INVALID_ARGUMENT;
+  const live_call call(live);
+  if (!call.ok()) return AVM_ERROR_INVALID_ARGUMENT;
+  return guard("avm_live_sample_person", silently, [&]() -> avm_status {
+    am::proxy_pose p;
+    if (!live->session->sample_person(id, t, p)) return rest_pose(t, out_pose);
     to_c_pose(p, *out_pose);
     return AVM_OK;
   });

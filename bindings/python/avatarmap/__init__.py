@@ -27,8 +27,8 @@ from ._data import (Landmarks, Poses, SOLVER_OPTION_NAMES, convert_file, motion_
                     read_landmarks, read_poses, solve, solve_file, write_animation)
 from ._errors import (AvatarmapError, FileIOError, InternalError, InvalidArgumentError,
                       OutOfMemoryError, ParseError, UnsupportedError)
-from ._handles import (CaptureSummary, Estimator, Live, LiveStats, Retargeter, Solver,
-                       capture_file)
+from ._handles import (CaptureSummary, Estimator, Live, LivePerson, LiveStats, Person,
+                       Retargeter, Solver, capture_file)
 from ._lib import POSE_DTYPE
 
 __all__ = [
@@ -38,7 +38,8 @@ __all__ = [
     "bone_index", "version",
     "Landmarks", "Poses", "read_landmarks", "read_poses", "solve", "solve_file",
     "write_animation", "convert_file", "motion_input_kind",
-    "Solver", "Retargeter", "Estimator", "Live", "LiveStats", "CaptureSummary", "capture_file",
+    "Solver", "Retargeter", "Estimator", "Live", "LiveStats", "Person", "LivePerson",
+    "CaptureSummary", "capture_file",
 ]
 
 __version__ = "0.2.0"

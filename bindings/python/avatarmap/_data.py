@@ -28,6 +28,7 @@ PARTS: Tuple[Tuple[str, int], ...] = (
     ("face", FACE_POINTS))
 
 _ERR_SIZE = 2048
+_MAX_PERSON_ID = 999999  # docs/file-formats.md, version 2
 
 
 def _path(p: PathLike, what: str) -> bytes:
@@ -69,6 +70,13 @@ class Landmarks:
     read_landmarks() returns a part that no frame of the file carries as a read-only NaN
     array of the same shape that takes no memory (``numpy.broadcast_to``); the other arrays
     are writable. ``np.array(lm.face)`` gives a writable copy of such a part.
+
+    ``person`` (N,) int32 is each row's person id (docs/file-formats.md, version 2: a file of
+    several people has one row per person in view and frame, a frame's people in consecutive
+    rows with the same ``t``, ascending by id). read_landmarks() fills it; every row of a
+    version-1 file (one person) is person 0. None (landmarks you build) is one person, 0.
+    ``person_ids()`` lists the ids, ``for_person(id)`` gives one person's rows: solve() takes
+    one person at a time.
     """
 
     t: np.ndarray
@@ -82,9 +90,59 @@ class Landmarks:
     image_width: int = 0
     image_height: int = 0
     fps: float = 0.0
+    person: Optional[np.ndarray] = None
 
     def __len__(self) -> int:
         return int(np.shape(self.t)[0])
+
+    def _person_column(self) -> Optional[np.ndarray]:
+        """``person`` as a (N,) int32 array (None stays None); InvalidArgumentError when it is
+        not one integer id in [0, 999999] per row."""
+        if self.person is None:
+            return None
+        p = np.asarray(self.person)
+        if p.shape != (len(self),) or (p.size and p.dtype.kind not in "iu"):
+            raise InvalidArgumentError("landmarks.person: expected (%d,) integer person ids, "
+                                       "got %s of %s" % (len(self), p.shape, p.dtype), 1)
+        if p.size and (p.min() < 0 or p.max() > _MAX_PERSON_ID):
+            raise InvalidArgumentError("landmarks.person: ids must be in [0, %d], got %d .. %d"
+                                       % (_MAX_PERSON_ID, p.min(), p.max()), 1)
+        return np.ascontiguousarray(p, dtype=np.int32)
+
+    def person_ids(self) -> List[int]:
+        """The distinct person ids of the rows, ascending ([] for no rows; [0] for one
+        person without a ``person`` column)."""
+        p = self._person_column()
+        if p is None:
+            return [0] if len(self) else []
+        return [int(i) for i in np.unique(p)]
+
+    def for_person(self, person: int) -> "Landmarks":
+        """The rows of person ``person`` (an id of person_ids()) as Landmarks of their own, in
+        file order, with the same image size and rate: copies, except that a part none of its
+        rows carries stays a read-only NaN array that takes no memory. Raises
+        InvalidArgumentError naming the ids there are when it has no row."""
+        if isinstance(person, bool) or not isinstance(person, (int, np.integer)):
+            raise InvalidArgumentError("for_person: expected an integer person id, got %r"
+                                       % (person,), 1)
+        p = self._person_column()
+        if p is None:
+            p = np.zeros(len(self), dtype=np.int32)
+        rows = np.flatnonzero(p == person)
+        if not len(rows):
+            raise InvalidArgumentError("for_person: no row of person %d (the ids are %s)"
+                                       % (person, ", ".join(map(str, self.person_ids()))
+                                          or "none: no rows"), 1)
+        n = len(rows)
+        parts = {}
+        for name, points in PARTS:
+            a = getattr(self, name)
+            if isinstance(a, np.ndarray) and _never_seen(a):
+                parts[name] = np.broadcast_to(np.float32(np.nan), (n,) + a.shape[1:])
+            else:
+                parts[name] = np.asarray(a)[rows]
+        return Landmarks(t=np.asarray(self.t)[rows], image_width=self.image_width,
+                         image_height=self.image_height, fps=self.fps, person=p[rows], **parts)
 
     @classmethod
     def empty(cls, n: int, *, image_width: int = 0, image_height: int = 0,
@@ -94,7 +152,8 @@ class Landmarks:
             raise InvalidArgumentError("Landmarks.empty: n must be >= 0, got %d" % n, 1)
         parts = {name: _nan_part(n, points) for name, points in PARTS}
         return cls(t=np.zeros(n, dtype=np.float64), image_width=image_width,
-                   image_height=image_height, fps=fps, **parts)
+                   image_height=image_height, fps=fps, person=np.zeros(n, dtype=np.int32),
+                   **parts)
 
     def seen(self, part: str) -> np.ndarray:
         """(N,) bool: whether `part` ("pose", "left_hand", ...) was seen in each frame."""
@@ -286,6 +345,10 @@ def frame_block(landmarks: Landmarks) -> Tuple[AvmFrameBlock, List[np.ndarray]]:
         if a is not None:
             setattr(block, name, a.ctypes.data)
             keep.append(a)
+    person = landmarks._person_column() if isinstance(landmarks, Landmarks) else None
+    if person is not None:
+        block.person = person.ctypes.data
+        keep.append(person)
     return block, keep
 
 
@@ -483,6 +546,10 @@ def read_landmarks(path: PathLike) -> Landmarks:
     frame carries takes none (a read-only NaN array, numpy.broadcast_to); a regular file's
     size (os.stat) only sizes the first allocation.
 
+    Every line is a row: a file of several people (version 2) gives each row's id in
+    ``person`` (0 for a version-1 file); ``for_person(id)`` takes one person's rows, as
+    solve() needs.
+
     Raises FileIOError (cannot open), ParseError ("FILE:LINE: ..." of the first malformed
     line)."""
     p = _path(path, "read_landmarks")
@@ -500,6 +567,7 @@ def read_landmarks(path: PathLike) -> Landmarks:
         scratch = {name: np.empty((_READ_BLOCK, points, 5), dtype=np.float32)
                    for name, points in PARTS}
         t = _Rows((), np.float64, size, _MIN_FRAME_BYTES, _READ_BLOCK)
+        person = _Rows((), np.int32, size, _MIN_FRAME_BYTES, _READ_BLOCK)
         parts: Dict[str, Optional[_Rows]] = {name: None for name, _ in PARTS}
         block = AvmFrameBlock()
         block.struct_size = ctypes.sizeof(AvmFrameBlock)
@@ -509,6 +577,8 @@ def read_landmarks(path: PathLike) -> Landmarks:
         while True:
             t.reserve(n, n + _READ_BLOCK)
             block.t = t.address(n)
+            person.reserve(n, n + _READ_BLOCK)
+            block.person = person.address(n)
             for name, _ in PARTS:
                 rows = parts[name]
                 if rows is not None:
@@ -530,7 +600,7 @@ def read_landmarks(path: PathLike) -> Landmarks:
                     rows.data[n:n + k] = scratch[name][:k]
                     parts[name] = rows
             n += k
-    out = Landmarks(t=t.finish(n), **{
+    out = Landmarks(t=t.finish(n), person=person.finish(n), **{
         name: rows.finish(n) if rows is not None
         else np.broadcast_to(np.float32(np.nan), (n, points, 5))
         for (name, points), rows in zip(PARTS, parts.values())})
@@ -568,8 +638,11 @@ def solve(landmarks: Landmarks, **options: Any) -> Poses:
 
     ``options`` are avm_solver_options' fields by name (``mirror=True``,
     ``file_filter="live"``, ``rotation_min_cutoff=1.2``, ...); the landmarks' image size is
-    used when ``image_width``/``image_height`` are not given. Raises InvalidArgumentError
-    (shapes, options, a time not finite)."""
+    used when ``image_width``/``image_height`` are not given. The landmarks must be one
+    person's: rows of several ``person`` ids raise InvalidArgumentError (solve
+    ``landmarks.for_person(id)`` for each of ``landmarks.person_ids()``, or a file with
+    ``solve_file(path, person=id)``). Raises InvalidArgumentError (shapes, options, a time
+    not finite, several people)."""
     if not isinstance(landmarks, Landmarks):
         raise InvalidArgumentError("solve: expected avatarmap.Landmarks, got %s"
                                    % type(landmarks).__name__, 1)
@@ -578,7 +651,13 @@ def solve(landmarks: Landmarks, **options: Any) -> Poses:
         options = dict(options, image_width=landmarks.image_width,
                        image_height=landmarks.image_height)
     o = solver_options(options)
-    block, _keep = frame_block(landmarks)
+    block, _keep = frame_block(landmarks)  # checks t and the parts first
+    ids = landmarks.person_ids()
+    if len(ids) > 1:
+        raise InvalidArgumentError(
+            "solve: the landmarks hold %d people (ids %s): solve one at a time, "
+            "solve(landmarks.for_person(id)), or the file with solve_file(path, person=id)"
+            % (len(ids), ", ".join(map(str, ids))), 1)
     rec = np.empty(block.count, dtype=POSE_DTYPE)
     err = ctypes.create_string_buffer(_ERR_SIZE)
     _check(fn("avm_solve_frames")(ctypes.byref(block), o, rec.ctypes.data, err, _ERR_SIZE),

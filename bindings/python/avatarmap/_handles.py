@@ -14,8 +14,8 @@ from ._data import (PARTS, Landmarks, PathLike, Poses, _check, _ERR_SIZE, _Handl
                     _path, solver_options)
 from ._errors import InvalidArgumentError
 from ._lib import (FACE_POINTS, FACE_POINTS_NO_IRIS, POSE_DTYPE, AvmCaptureSummary,
-                   AvmEstimatorOptions, AvmFrame, AvmImage, AvmLandmark, AvmLiveStats, c_value,
-                   fn, set_field, text)
+                   AvmEstimatorOptions, AvmFrame, AvmImage, AvmLandmark, AvmLivePerson,
+                   AvmLiveStats, AvmPerson, c_value, fn, set_field, text)
 
 FrameLike = Union[Landmarks, Mapping[str, Any]]
 
@@ -245,6 +245,25 @@ def _c_image(image: Any) -> Tuple[AvmImage, np.ndarray]:
     return c, a
 
 
+@dataclass
+class Person:
+    """One person of an image (Estimator.process_people): its id (kept while the person is
+    followed, never given to anyone else), its slot (0 .. people-1, its place while its id
+    lives), its Landmarks of one frame and its Poses of one."""
+    id: int
+    slot: int
+    landmarks: Landmarks
+    pose: Poses
+
+
+@dataclass
+class LivePerson:
+    """A person a Live handle holds (Live.people()): id, slot and when it was last seen."""
+    id: int
+    slot: int
+    seen_t: float
+
+
 class Estimator(_Handle):
     """Images -> landmarks -> solved, live-filtered poses (avm_estimator; `avatarmap live`'s
     steps on images you provide). ``models``: the converted models folder (default
@@ -258,10 +277,11 @@ class Estimator(_Handle):
     def __init__(self, models: Optional[PathLike] = None, *, hands: bool = True,
                  face: bool = True, threads: int = 2, model: str = "full",
                  hand_model: str = "full", mirrored: bool = False, static_images: bool = False,
-                 **solver_options_: Any) -> None:
+                 people: int = 1, **solver_options_: Any) -> None:
         super().__init__()
         eo = _estimator_options(models, hands, face, threads, model, hand_model, mirrored,
                                 static_images)
+        set_field(eo, "max_people", people, "people (avm_estimator_options.max_people)")
         so = solver_options(solver_options_)
         _check(fn("avm_estimator_create")(eo, so, ctypes.byref(self._h)),
                fn("avm_last_create_error")())
@@ -281,6 +301,32 @@ class Estimator(_Handle):
             landmarks = _landmarks_of(frame, t)
         landmarks.image_width, landmarks.image_height = c_image.width, c_image.height
         return landmarks, Poses.from_records(rec)
+
+    def process_people(self, image: Any, t: float) -> List[Person]:
+        """Several people (``people`` > 1): every person in one image (capture time t,
+        increasing), each solved and filtered on its own, ascending by id
+        (avm_estimator_process_people). A person's ``slot`` stays its own while its id lives.
+        With people=1: the one person as id 0, slot 0, or [] when no body is seen. Use either
+        this or process() on one Estimator."""
+        c_image, _keep = _c_image(image)
+        t = c_value(ctypes.c_double, t, "process_people: t")
+        people = (AvmPerson * _lib.MAX_PEOPLE)()
+        count = ctypes.c_int32(0)
+        out: List[Person] = []
+        with self._use() as h:
+            st = fn("avm_estimator_process_people")(h, ctypes.byref(c_image), t, people,
+                                                    _lib.MAX_PEOPLE, ctypes.byref(count))
+            if st != _lib.OK:
+                _check(st, fn("avm_estimator_last_error")(h))
+            for p in people[:min(count.value, _lib.MAX_PEOPLE)]:
+                landmarks = _landmarks_of(p.frame, t)
+                landmarks.image_width, landmarks.image_height = c_image.width, c_image.height
+                landmarks.person = np.array([p.id], dtype=np.int32)
+                rec = np.frombuffer(ctypes.string_at(ctypes.addressof(p.pose),
+                                                     ctypes.sizeof(p.pose)),
+                                    dtype=POSE_DTYPE).copy()
+                out.append(Person(p.id, p.slot, landmarks, Poses.from_records(rec)))
+        return out
 
 
 @dataclass
@@ -309,11 +355,12 @@ class Live(_Handle):
     def __init__(self, models: Optional[PathLike] = None, *, hands: bool = True,
                  face: bool = True, threads: int = 2, model: str = "full",
                  hand_model: str = "full", mirrored: bool = False, static_images: bool = False,
-                 **solver_options_: Any) -> None:
+                 people: int = 1, **solver_options_: Any) -> None:
         super().__init__()
         self._push_lock = threading.Lock()
         eo = _estimator_options(models, hands, face, threads, model, hand_model, mirrored,
                                 static_images)
+        set_field(eo, "max_people", people, "people (avm_estimator_options.max_people)")
         so = solver_options(solver_options_)
         _check(fn("avm_live_create")(eo, so, ctypes.byref(self._h)),
                fn("avm_last_create_error")())
@@ -350,6 +397,25 @@ class Live(_Handle):
         """The newest processed pose, None before the first."""
         return self._pose("avm_live_latest")
 
+    def people(self) -> List[LivePerson]:
+        """The people held now (in view, or unseen for under 1 s), ascending by id
+        (avm_live_people). With people=1: one (id 0, slot 0) once an image was processed."""
+        held = (AvmLivePerson * _lib.MAX_PEOPLE)()
+        count = ctypes.c_int32(0)
+        with self._use() as h:
+            st = fn("avm_live_people")(h, held, _lib.MAX_PEOPLE, ctypes.byref(count))
+            if st != _lib.OK:
+                self._error(h, st)
+        return [LivePerson(p.id, p.slot, p.seen_t)
+                for p in held[:min(count.value, _lib.MAX_PEOPLE)]]
+
+    def sample_person(self, person: int, t: float) -> Optional[Poses]:
+        """As sample(), for the person with id ``person`` (people()); None when it is not
+        held."""
+        return self._pose("avm_live_sample_person",
+                          c_value(ctypes.c_int32, person, "sample_person: person"),
+                          c_value(ctypes.c_double, t, "sample_person: t"))
+
     def stats(self) -> LiveStats:
         s = AvmLiveStats()
         with self._use() as h:
@@ -378,17 +444,26 @@ class CaptureSummary:
     image_height: int
     fps: float
     seconds: float
+    people_ids: int = 0  # people=N > 1: distinct ids seen, lines written, frames with people
+    person_lines: int = 0
+    frames_with_people: int = 0
 
 
 def capture_file(input: PathLike, out_landmarks: PathLike, *,
                  models: Optional[PathLike] = None, hands: bool = True, face: bool = True,
                  threads: int = 2, model: str = "full", hand_model: str = "full",
-                 progress: Optional[Callable[[int, int], Any]] = None) -> CaptureSummary:
+                 progress: Optional[Callable[[int, int], Any]] = None,
+                 people: int = 1) -> CaptureSummary:
     """``avatarmap capture INPUT -o OUT``: a video file, an image, a folder of images or a
     printf pattern -> ``*.landmarks.jsonl`` (written atomically). ``threads`` 2 runs two
     lanes, 1 one thread. ``progress(done, total)`` is called about twice a second (total 0:
-    unknown); an exception it raises is re-raised when the capture returns."""
+    unknown); an exception it raises is re-raised when the capture returns. ``people`` (1 ..
+    8, ``capture --people N``) follows up to that many people, each with a stable id: with
+    more than 1 the file is version 2, one line per person in view and frame
+    (read_landmarks() gives each row's ``person``; docs/capture-people.md); the summary's
+    body_frames, ..., face_frames then count lines."""
     eo = _estimator_options(models, hands, face, threads, model, hand_model)
+    set_field(eo, "max_people", people, "people (avm_estimator_options.max_people)")
     summary = AvmCaptureSummary()
     summary.struct_size = ctypes.sizeof(AvmCaptureSummary)
     raised: List[BaseException] = []

@@ -28,6 +28,7 @@ FACE_POINTS_NO_IRIS = 468
 # against the library's tables by tests/python/test_options.py.
 MAX_FPS = 1000.0
 MAX_MODEL_THREADS = 64
+MAX_PEOPLE = 8  # AVM_MAX_PEOPLE: avm_estimator_options.max_people
 
 # avm_status
 OK = 0
@@ -127,7 +128,8 @@ class AvmSolverOptions(ctypes.Structure):
 class AvmFrameBlock(ctypes.Structure):
     _fields_ = [("struct_size", _U32), ("count", _I64), ("t", _P), ("pose", _P),
                 ("pose_world", _P), ("left_hand", _P), ("left_hand_world", _P),
-                ("right_hand", _P), ("right_hand_world", _P), ("face", _P)]
+                ("right_hand", _P), ("right_hand_world", _P), ("face", _P),
+                ("person", _P)]  # int32_t*: one person id per row
 
 
 class AvmImage(ctypes.Structure):
@@ -139,10 +141,19 @@ class AvmEstimatorOptions(ctypes.Structure):
     _fields_ = [("struct_size", _U32), ("models_dir", ctypes.c_char_p),
                 ("model_complexity", _I32), ("hands", _I32), ("face", _I32),
                 ("hand_model_complexity", _I32), ("threads", _I32), ("mirrored", _I32),
-                ("static_images", _I32)]
+                ("static_images", _I32), ("max_people", _I32)]
     _kinds_ = {name: BOOL for name in ("hands", "face", "mirrored", "static_images")}
     _ranges_ = {"model_complexity": (0, 2), "hand_model_complexity": (0, 1),
-                "threads": (1, MAX_MODEL_THREADS)}
+                "threads": (1, MAX_MODEL_THREADS), "max_people": (1, MAX_PEOPLE)}
+
+
+class AvmPerson(ctypes.Structure):
+    # avm_person: one person of an image (several people).
+    _fields_ = [("id", _I32), ("slot", _I32), ("frame", AvmFrame), ("pose", AvmPose)]
+
+
+class AvmLivePerson(ctypes.Structure):
+    _fields_ = [("id", _I32), ("slot", _I32), ("seen_t", _F64)]
 
 
 class AvmLiveStats(ctypes.Structure):
@@ -177,7 +188,8 @@ class AvmCaptureSummary(ctypes.Structure):
                 ("left_hand_frames", _I64), ("right_hand_frames", _I64),
                 ("face_frames", _I64), ("frames_not_decoded", _I64),
                 ("image_width", _I32), ("image_height", _I32), ("fps", _F64),
-                ("seconds", _F64)]
+                ("seconds", _F64), ("people_ids", _I64), ("person_lines", _I64),
+                ("frames_with_people", _I64)]
 
 
 # ---- Python values into C fields and arguments --------------------------------------------
@@ -344,6 +356,9 @@ _SIGNATURES: Dict[str, Tuple[object, List[object]]] = {
     "avm_estimator_process": (_S, [_P, ctypes.POINTER(AvmImage), _F64,
                                    ctypes.POINTER(AvmFrame), _P]),
     "avm_estimator_last_error": (_STR, [_P]),
+    "avm_estimator_process_people": (_S, [_P, ctypes.POINTER(AvmImage), _F64,
+                                          ctypes.POINTER(AvmPerson), _I32,
+                                          ctypes.POINTER(_I32)]),
     "avm_live_create": (_S, [ctypes.POINTER(AvmEstimatorOptions),
                              ctypes.POINTER(AvmSolverOptions), _PP]),
     "avm_live_destroy": (None, [_P]),
@@ -352,6 +367,8 @@ _SIGNATURES: Dict[str, Tuple[object, List[object]]] = {
     "avm_live_latest": (_S, [_P, _P]),
     "avm_live_get_stats": (_S, [_P, ctypes.POINTER(AvmLiveStats)]),
     "avm_live_last_error": (_STR, [_P, _P, _SIZE]),
+    "avm_live_people": (_S, [_P, ctypes.POINTER(AvmLivePerson), _I32, ctypes.POINTER(_I32)]),
+    "avm_live_sample_person": (_S, [_P, _I32, _F64, _P]),
     # issue 12
     "avm_landmark_reader_open": (_S, [_STR, _PP]),
     "avm_landmark_reader_header": (_S, [_P, ctypes.POINTER(_I32), ctypes.POINTER(_I32),

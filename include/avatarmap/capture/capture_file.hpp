@@ -84,8 +84,12 @@ struct capture_file_job {
   /// opened (the CLI opens its overlay here); an error ends the run, its code kept.
   std::function<status(const video_info&)> on_open;
   /// Optional: each frame written, with its decoded image (RGB8; the CLI's overlay draws on
-  /// it); an error ends the run, its code kept.
-  std::function<status(const image_view&, const landmark_frame&)> on_frame;
+  /// it), the frame (with several people: the first person, as estimator::estimate() gives
+  /// it) and every person of it (estimator::last_people(): count -1 with one person, else
+  /// the people in view, ascending by id, each with its person id; valid during the call);
+  /// an error ends the run, its code kept.
+  std::function<status(const image_view&, const landmark_frame&, const estimator::people_view&)>
+      on_frame;
   /// Optional: after the output is committed (the CLI closes its overlay here); an error ends
   /// the run, its code kept (the landmarks are written).
   std::function<status()> on_finish;

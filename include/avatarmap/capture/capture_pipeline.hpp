@@ -10,10 +10,22 @@
 // Thread-safety: one pipeline per thread at a time, except that stream().sample() touches
 // only the resampler, which estimate() never does: a caller may run estimate() on one thread
 // while another samples, if solve() and sample() are under one lock (live_session does so).
+//
+// Several people (options.estimator.max_people > 1; docs/capture-people.md): each person the
+// estimator follows is solved through a pose stream of its own, in a slot 0..max_people-1. A
+// new id takes the lowest free slot (its stream starts afresh); the slot stays the person's
+// while it is in view and for k_person_hold_seconds after it was last seen (the estimator
+// keeps a lost person's id that long to give it back), then it is free. A slot is so one
+// person's for as long as its id lives: the live outputs use it as the person's place (the
+// k-th VMC destination, the viewer's k-th avatar). Every person's hips_position X/Z is
+// measured from one origin, where the first person placed was first seen, so that the people
+// stand apart as in the image (one person alone starts at its own origin, as with one).
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "avatarmap/capture/estimator.hpp"
 #include "avatarmap/core/status.hpp"
@@ -55,6 +67,24 @@ struct capture_pipeline_options {
   status validate() const;
 };
 
+/// How long a person's slot is kept after the person was last seen (seconds of capture time):
+/// the estimator's wait before a lost id is given up (people_tracker_options::keep_lost_seconds).
+inline constexpr double k_person_hold_seconds = 1.0;
+
+/// One person of a frame, solved (several people).
+struct person_pose {
+  int id = -1;    // the person's id (landmark_frame::person)
+  int slot = -1;  // its pose stream, 0..max_people-1 (kept while the id lives)
+  const landmark_frame* frame = nullptr;  // its landmarks; valid until the next estimate()
+  proxy_pose pose;                        // solved and filtered by its own stream (pose.t = t)
+};
+
+/// Every person of a frame, ascending by id.
+struct people_poses {
+  std::array<person_pose, k_max_people> people;
+  int count = 0;
+};
+
 class capture_pipeline {
  public:
   /// Makes the estimator (loads its models) and the solver. Fails with a message that says what
@@ -77,8 +107,23 @@ class capture_pipeline {
   /// The pose stream's step: solves `frame`, filters it into `pose` and hands it to the
   /// resampler. Allocates nothing.
   void solve(const landmark_frame& frame, proxy_pose& pose);
-  /// The pose stream (stream().sample(t): the pose at any capture time).
-  const pose_stream& stream() const { return *stream_; }
+  /// The pose stream (stream().sample(t): the pose at any capture time); with several people,
+  /// slot 0's.
+  const pose_stream& stream() const { return *streams_[0]; }
+
+  /// The most people followed (options.estimator.max_people).
+  int max_people() const { return static_cast<int>(streams_.size()); }
+  /// Several people: solves every person of the last estimate() through its slot's stream into
+  /// `out` (ascending id; count 0 when nobody is in view), giving new ids their slots and
+  /// freeing the slots of people unseen for k_person_hold_seconds. With one person: the frame
+  /// estimate() gave, in slot 0 with id 0 (count 1, or 0 when it has no body). Allocates
+  /// nothing. `frame` is what estimate() wrote.
+  void solve_people(const landmark_frame& frame, people_poses& out);
+  /// Slot `slot`'s stream (0 <= slot < max_people()).
+  const pose_stream& stream(int slot) const { return *streams_[slot]; }
+  /// The id holding slot `slot` (-1: free) and when it was last seen (capture time).
+  int slot_person(int slot) const { return slots_[slot].id; }
+  double slot_seen(int slot) const { return slots_[slot].seen_t; }
 
   /// Where the time of the last process() went in the estimator (nullptr: no stages).
   const estimator_timings* last_timings() const;
@@ -90,7 +135,16 @@ class capture_pipeline {
   capture_pipeline() = default;
   capture_pipeline_options options_;
   std::unique_ptr<estimator> estimator_;
-  std::unique_ptr<pose_stream> stream_;
+  std::vector<std::unique_ptr<pose_stream>> streams_;  // one per slot (one person: one)
+  struct slot_state {
+    int id = -1;  // -1: free
+    double seen_t = 0.0;
+  };
+  std::array<slot_state, k_max_people> slots_{};
+  glm::vec2 shared_origin_{0.f};  // several people: the one ground origin
+  bool have_shared_origin_ = false;
+  // The slot for `id` seen at `t`: its own, else the lowest free one (its stream restarted).
+  int slot_for(int id, double t);
   estimate_args args_;
   int solver_width_ = 0, solver_height_ = 0;  // image size the solver was made for
 };

@@ -151,7 +151,6 @@ inline constexpr option_row<estimator_options> k_estimator_option_table[] = {
         .integer(1, k_max_people)
         .defaults_to(1)
         .cli("--people", "N")
-        .not_in_c()
         .help("follow up to N people, each with an id, its hands and face (a version-2 "
               "landmark file, one line per person and frame); 1 is the single-person capture "
               "(docs/capture-people.md)"),

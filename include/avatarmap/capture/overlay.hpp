@@ -16,6 +16,10 @@
 // options.face_color, rectangles in options.rect_color. Sides follow the landmark indices,
 // not the image: in a mirrored image the left colour is drawn on the person's left all the
 // same.
+//
+// Several people (overlay_job::people): each person in one colour of its own,
+// person_color(its id), its lines and joints over a black outline, and its id written in
+// digits (a seven-segment font of lines) above the top of its points.
 #pragma once
 
 #include <array>
@@ -133,6 +137,25 @@ struct rgb8_color {
   std::uint8_t b = 0;
 };
 
+/// The colours of people when several are drawn (overlay_job::people), by id modulo 8:
+/// eight hues far apart from each other, light and saturated enough to read on dark video;
+/// the black outline drawn under them keeps them readable on light video.
+inline constexpr std::array<rgb8_color, 8> k_person_palette = {{
+    {255, 64, 64},    // red
+    {64, 220, 64},    // green
+    {64, 144, 255},   // blue
+    {255, 200, 0},    // amber
+    {220, 64, 255},   // violet
+    {0, 230, 230},    // cyan
+    {255, 128, 192},  // pink
+    {176, 255, 96},   // lime
+}};
+
+/// The colour of person `id` (>= 0; a negative id gets the first colour).
+constexpr rgb8_color person_color(int id) {
+  return k_person_palette[id < 0 ? 0 : static_cast<std::size_t>(id) % k_person_palette.size()];
+}
+
 /// What happens to pose points whose visibility is below overlay_options::min_visibility
 /// (and to the lines that touch them).
 enum class overlay_low_visibility : std::uint8_t {
@@ -184,6 +207,16 @@ struct rgb8_image_ref {
 /// centre, size as fractions of the image width and height, rotation in radians clockwise
 /// on screen as in image_crop.hpp) onto `image`. Parts missing from `frame` draw nothing.
 /// Order: rectangles, face, pose lines, hand lines, then pose and hand joints.
+///
+/// Several people (`people` set, e.g. estimator::last_people()): `frame` is not drawn; each
+/// of the `people_count` frames is, in its list order (a later one over an earlier one), every
+/// part of it in person_color(frame.person) (the left/right/center/face colours are not
+/// used; low-visibility pose points dim or skip as options say): first a black outline (pose
+/// and hand lines 2 pixels thicker, joints 1 pixel wider in radius), then the face, lines and
+/// joints in the colour, then its id in decimal digits over a black outline, centred above
+/// the top of its drawn points (pose points that are drawn, hand and face points), kept
+/// inside the image. Digits are 9 * thickness + 6 pixels tall, strokes thickness + 1 wide. A
+/// person with no point drawn gets no label.
 /// Owns no buffer, allocates nothing; the caller keeps everything alive during run().
 /// Safe to run concurrently on distinct images.
 struct overlay_job {
@@ -192,11 +225,15 @@ struct overlay_job {
   const normalized_rect* rects = nullptr;  // `rect_count` rectangles, or null
   std::size_t rect_count = 0;
   overlay_options options{};
+  /// Several people: `people_count` frames, one per person (null: draw `frame`).
+  const landmark_frame* people = nullptr;
+  std::size_t people_count = 0;
 
   /// True when image data is set, width and height are in 1..65535, stride_bytes >=
-  /// width * 3, rects is set when rect_count > 0, thickness is in 0..64 and joint_radius in
-  /// -1..64. A non-finite min_visibility or rectangle field is not an error (nothing
-  /// is drawn for such a rectangle; a NaN threshold dims nothing).
+  /// width * 3, rects is set when rect_count > 0, people is set when people_count > 0,
+  /// thickness is in 0..64 and joint_radius in -1..64. A non-finite min_visibility or
+  /// rectangle field is not an error (nothing is drawn for such a rectangle; a NaN threshold
+  /// dims nothing).
   bool validate() const;
   /// Draws; returns false (image untouched) when validate() fails.
   bool run() const;
@@ -204,5 +241,12 @@ struct overlay_job {
 
 /// The automatic line thickness for an image of this size (see overlay_options::thickness).
 int overlay_auto_thickness(int width, int height);
+
+/// Which of the seven segments light digit `d` (0..9) in the people's labels: bit 0 top, 1
+/// top right, 2 bottom right, 3 bottom, 4 bottom left, 5 top left, 6 middle (0 for others).
+constexpr std::uint8_t overlay_digit_segments(int d) {
+  constexpr std::uint8_t k[10] = {0x3F, 0x06, 0x5B, 0x4F, 0x66, 0x6D, 0x7D, 0x07, 0x7F, 0x6F};
+  return d >= 0 && d <= 9 ? k[d] : 0;
+}
 
 }  // namespace avatarmap

@@ -36,7 +36,7 @@ namespace avatarmap {
 
 struct people_tracker_options {
   int max_people = 2;               // 1 .. k_max_people
-  double redetect_seconds = 0.2;    // detector schedule while fewer than max_people tracked
+  double redetect_seconds = 0.1;    // detector schedule while fewer than max_people tracked
   float same_person_offset = 0.5f;  // box to track shoulder centres / torso: the same person
   float merged_offset = 0.2f;       // mean key point distance / torso: one body
   double keep_lost_seconds = 1.0;   // how long a lost person's id waits to be given back

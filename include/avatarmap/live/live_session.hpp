@@ -21,6 +21,11 @@
 // concurrently with each other (the C API's avm_live_destroy waits for the calls in flight);
 // neither may be called from a callback. on_frame runs on the worker thread, the outputs on
 // the output thread, one call at a time each.
+//
+// Several people (pipeline.estimator.max_people > 1): each person has its own pose stream in a
+// slot (capture_pipeline.hpp); the output thread hands every held person's pose to every output
+// at each tick (live_output_report::person and slot say whose), people() lists them and
+// sample_person() samples one. sample() and latest() give the lowest id held.
 #pragma once
 
 #include <chrono>
@@ -47,6 +52,9 @@ struct live_frame_report {
   const estimator_timings* timings = nullptr;  // the estimator's stages (nullptr: none)
   double latency_ms = 0.0;                     // push -> pose in the stream (processed only)
   long dropped_so_far = 0;                     // images dropped before this one was taken
+  /// Several people: every person of the image (frame and pose above are the first's); nullptr
+  /// with one person.
+  const people_poses* people = nullptr;
 };
 
 /// What the output thread tells each output with a pose.
@@ -55,6 +63,18 @@ struct live_output_report {
   /// that image was pushed (an output measures its own push -> delivery latency from it).
   bool carries_new_frame = false;
   std::chrono::steady_clock::time_point pushed_at{};
+  /// Whose pose: the person's id (-1 with one person) and slot (0..max_people-1, the person's
+  /// place for as long as its id lives: the k-th VMC destination, the viewer's k-th avatar; 0
+  /// with one person).
+  int person = -1;
+  int slot = 0;
+};
+
+/// A person a live session holds (several people).
+struct live_person {
+  int id = -1;
+  int slot = -1;
+  double seen_t = 0.0;  // capture time it was last seen
 };
 
 /// An output of the session: called on the output thread with each sampled pose (pose.t is its
@@ -112,6 +132,12 @@ class live_session {
   bool sample(double t, proxy_pose& out) const;
   /// Any thread: the newest processed pose. false before the first.
   bool latest(proxy_pose& out) const;
+  /// Any thread, several people: the people held now (in view, or unseen for under
+  /// k_person_hold_seconds), ascending by id, into out[0 .. min(count, capacity)); returns the
+  /// count. One person: one entry (id 0, slot 0) once a pose was processed.
+  int people(live_person* out, int capacity) const;
+  /// Any thread: as sample(), for the person `id`; false when it is not held.
+  bool sample_person(int id, double t, proxy_pose& out) const;
   live_session_stats stats() const;
   /// The last error the worker met processing an image (ok when none); it keeps going unless
   /// on_frame says otherwise.

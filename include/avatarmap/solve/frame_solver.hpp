@@ -90,6 +90,14 @@ class frame_solver {
   /// restart_take(false) release it.
   void hold_view(bool hold = true);
 
+  /// The root's ground origin: where the person was first seen (X from the camera's axis,
+  /// Y = minus the depth, metres); hips_position X/Z are measured from it. false before.
+  bool ground_origin(glm::vec2& out) const;
+  /// Measures hips_position X/Z from `origin` (a point of ground_origin()'s space) instead of
+  /// where the person is first seen: several people placed from one origin
+  /// (capture_pipeline::solve_people). reset() and restart_take() forget it.
+  void set_ground_origin(const glm::vec2& origin);
+
   const solver_options& options() const { return options_; }
 
   /// The horizontal field of view in use (degrees): options().horizontal_fov_degrees when

@@ -5,11 +5,15 @@
 // loopback it answers only requests that name this machine in their Host header
 // (docs/security.md).
 //
+// Several people: each person's poses are published in the person's slot (0 to
+// k_pose_server_slots - 1, stable while the person stays; live/live_session.hpp), and every
+// page gets each slot's newest pose, tagged with the person's id and slot (docs/viewer.md).
+//
 // Threads: start() runs the server on a thread of its own; publish() may be called from any
-// thread (the live loop's) and never waits for a client: it replaces the newest pose, and each
-// page is sent the newest pose when its connection can take one, so a slow page skips poses
-// instead of queueing them. A page that disconnects, mid-message or not, only ends its own
-// connection.
+// thread (the live loop's) and never waits for a client: it replaces the slot's newest pose, and
+// each page is sent each slot's newest pose when its connection can take one, so a slow page
+// skips poses instead of queueing them. A page that disconnects, mid-message or not, only ends
+// its own connection.
 #pragma once
 
 #include <cstdint>
@@ -30,6 +34,8 @@ namespace avatarmap {
 inline constexpr const char* k_pose_socket_protocol = "avatarmap.pose";
 /// The WebSocket's path.
 inline constexpr const char* k_pose_socket_path = "/pose";
+/// People (slots) a pose server keeps a newest pose for: publish()'s slot is 0 to this - 1.
+inline constexpr int k_pose_server_slots = 8;
 
 struct pose_server_options {
   /// Address to listen on: an IPv4 or IPv6 literal, or "localhost" (= 127.0.0.1). Anything
@@ -91,7 +97,7 @@ struct pose_server_stats {
   int pages_connected = 0;  // WebSocket connections accepted and open now
   long connections = 0;     // WebSocket connections accepted in all
   long refused = 0;         // requests and WebSocket handshakes refused for their Host or Origin
-  long published = 0;       // publish() calls
+  long published = 0;       // publish() calls (a slot out of range counted, never sent)
   long sent = 0;            // pose messages handed to connections, all together
   long skipped = 0;         // poses a connection never got because a newer one came first
   double first_posed_frame_ms = -1;  // the latest page's report: page load -> first posed frame
@@ -129,9 +135,18 @@ class pose_server {
   /// started; link-local IPv6 left out); else empty.
   std::vector<std::string> network_urls() const;
 
-  /// Makes `pose` the newest pose and wakes the server to send it to every page. Any thread,
-  /// before, during or after start(); never blocks on a client, never allocates.
-  void publish(const proxy_pose& pose);
+  /// Makes `pose` the newest pose and wakes the server to send it to every page: one person,
+  /// the same as publish(pose, -1, 0). Any thread, before, during or after start(); never
+  /// blocks on a client, never allocates.
+  void publish(const proxy_pose& pose) { publish(pose, -1, 0); }
+  /// Makes `pose` the newest pose of `slot` (0 to k_pose_server_slots - 1: the person's place,
+  /// live_output_report::slot) and wakes the server to send it to every page; each slot keeps
+  /// its own newest pose, so every person in view reaches every page. The message is the pose's
+  /// line with `"person":PERSON,"slot":SLOT` added as its last keys when `person` >= 0 (the
+  /// person's id); with `person` < 0 (one person) it is the plain line, as publish(pose) sends.
+  /// A slot out of range is ignored (counted in stats().published only). Any thread; never
+  /// blocks on a client, never allocates.
+  void publish(const proxy_pose& pose, int person, int slot);
 
   pose_server_stats stats() const;
 

@@ -251,7 +251,7 @@ status capture_file_job::run(capture_file_summary& s) const {
         s.part_frames[p] += frame.has(static_cast<frame_part>(p));
       w = writer.write(frame);
     }
-    if (w.ok() && on_frame) w = on_frame(d.view, frame);
+    if (w.ok() && on_frame) w = on_frame(d.view, frame, people);
     if (!w.ok()) return w;
     ++s.frames;
     if (s.frames == k_memory_sample_frames) s.resident_kib_after_100 = resident_memory_kib();

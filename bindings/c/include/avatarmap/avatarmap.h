@@ -88,6 +88,8 @@ AVATARMAP_C_API const char* avm_status_string(avm_status status);
 #define AVM_MAX_FPS 1000.0
 /* The most threads avm_estimator_options.threads may ask for. */
 #define AVM_MAX_MODEL_THREADS 64
+/* The most people avm_estimator_options.max_people may ask for. */
+#define AVM_MAX_PEOPLE 8
 
 /* ---- skeleton vocabulary ------------------------------------------------------------- */
 
@@ -803,6 +805,15 @@ typedef struct avm_estimator_options {
   int32_t threads;               /* ONNX Runtime threads, 1 .. AVM_MAX_MODEL_THREADS (default 2) */
   int32_t mirrored;              /* the images are mirrored (a selfie preview); default 0 */
   int32_t static_images;         /* detect on every image (unrelated stills); default 0 */
+  /* -- added after static_images (a struct_size that ends before it gets 1; on 64-bit
+   *    targets it takes what was the struct's tail padding, sizeof unchanged: a caller built
+   *    before it gets 1 there from avm_estimator_options_init()) -- */
+  /* How many people to follow, 1 .. AVM_MAX_PEOPLE (default 1, the single-person capture;
+   * docs/capture-people.md). avm_capture_file() with more than 1 writes a version-2 landmark
+   * file (one line per person in view and frame, each with its "person" id); the estimator
+   * and live handles follow that many: avm_estimator_process_people() and avm_live_people() /
+   * avm_live_sample_person() give every person, the single-person calls the lowest id. */
+  int32_t max_people;
 } avm_estimator_options;
 
 /* Fills the first `size` bytes of *options with the defaults above and sets struct_size =
@@ -853,6 +864,32 @@ AVATARMAP_C_API void avm_estimator_destroy(avm_estimator* estimator);
 AVATARMAP_C_API avm_status avm_estimator_process(avm_estimator* estimator, const avm_image* image,
                                                  double t, avm_frame* out_frame,
                                                  avm_pose* out_pose);
+
+/* One person of an image (several people: docs/capture-people.md). */
+typedef struct avm_person {
+  int32_t id;      /* the person's id: kept while the person is followed (through crossings and
+                      losses of up to 1 s), never given to anyone else */
+  int32_t slot;    /* the person's place, 0 .. max_people-1: its own for as long as its id lives
+                      (a new id takes the lowest free slot; a slot is freed 1 s after its person
+                      was last seen) */
+  avm_frame frame; /* its landmarks; pointers into the estimator's storage, valid until the
+                      next call on it */
+  avm_pose pose;   /* its solved, live-filtered pose (each person has a filter of its own) */
+} avm_person;
+
+/* Several people (avm_estimator_options.max_people > 1): estimates every person of one image
+ * (capture time t, seconds, increasing), each solved and filtered on its own, into
+ * out_people[0 .. min(count, capacity)) ascending by id; *out_count = the people in view (0
+ * when nobody is; may exceed capacity: the rest are not written). With max_people 1: the one
+ * person of avm_estimator_process() (id 0, slot 0), or none when no body is seen. Do not mix
+ * with avm_estimator_process() on one handle (each keeps the people's filters going).
+ * Allocates nothing outside ONNX Runtime. One thread at a time per estimator.
+ * Failures (outputs unchanged): those of avm_estimator_process(); AVM_ERROR_INVALID_ARGUMENT
+ *   also when out_count is NULL, capacity is negative, or out_people is NULL with capacity > 0. */
+AVATARMAP_C_API avm_status avm_estimator_process_people(avm_estimator* estimator,
+                                                        const avm_image* image, double t,
+                                                        avm_person* out_people, int32_t capacity,
+                                                        int32_t* out_count);
 
 /* Message of the last failed call on `estimator` ("" after a success or for NULL); owned by
  * the estimator, valid until the next call on it or its destruction. */
@@ -913,6 +950,27 @@ AVATARMAP_C_API avm_status avm_live_sample(const avm_live* live, double t, avm_p
  * and the rest pose. Failures: AVM_ERROR_INVALID_ARGUMENT when live or out_pose is NULL. */
 AVATARMAP_C_API avm_status avm_live_latest(const avm_live* live, avm_pose* out_pose);
 
+/* A person a live handle holds (several people). */
+typedef struct avm_live_person {
+  int32_t id;    /* as avm_person.id */
+  int32_t slot;  /* as avm_person.slot */
+  double seen_t; /* capture time the person was last seen */
+} avm_live_person;
+
+/* Any thread, any time: the people held now (in view, or unseen for under 1 s), ascending by
+ * id, into out_people[0 .. min(count, capacity)); *out_count = how many (may exceed capacity).
+ * With max_people 1: one entry (id 0, slot 0) once an image was processed.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT when live or out_count is NULL, capacity is negative or
+ * out_people is NULL with capacity > 0. */
+AVATARMAP_C_API avm_status avm_live_people(const avm_live* live, avm_live_person* out_people,
+                                           int32_t capacity, int32_t* out_count);
+
+/* Any thread, any time: as avm_live_sample(), for the person `id` (avm_live_people()). A person
+ * not held (never seen, or gone for over 1 s): AVM_ERROR_END_OF_FILE and the rest pose.
+ * Failures: AVM_ERROR_INVALID_ARGUMENT when live or out_pose is NULL or t is not finite. */
+AVATARMAP_C_API avm_status avm_live_sample_person(const avm_live* live, int32_t id, double t,
+                                                  avm_pose* out_pose);
+
 /* Any thread: the counters and latency so far. AVM_ERROR_INVALID_ARGUMENT when an argument
  * is NULL (or the handle was destroyed, as for every avm_live_* call). */
 AVATARMAP_C_API avm_status avm_live_get_stats(const avm_live* live, avm_live_stats* out_stats);
@@ -943,6 +1001,16 @@ typedef struct avm_frame_block {
   float* right_hand;       /* count x 21 x 5 */
   float* right_hand_world; /* count x 21 x 5 */
   float* face;             /* count x 478 x 5 */
+  /* -- added after face (a caller whose struct_size ends before it has no person column:
+   *    readers write none, avm_solve_frames takes every row as one person) -- */
+  /* count person ids, one per row (NULL: not wanted). avm_landmark_reader_read writes each
+   * line's "person" (docs/file-formats.md, version 2: a frame of several people is several
+   * rows with the same t, ascending by id); every row of a version-1 file is person 0 (the
+   * id avm_solver_options.person picks it by). Ids are 0 .. 999999; -1 is never written.
+   * avm_solve_frames solves one person: it refuses a column holding more than one distinct
+   * value (solve each person's rows on their own, or use avm_solve_file with
+   * avm_solver_options.person). */
+  int32_t* person;
 } avm_frame_block;
 
 /* Reader of a *.landmarks.jsonl file (docs/file-formats.md), a block of frames at a time.
@@ -963,12 +1031,14 @@ AVATARMAP_C_API avm_status avm_landmark_reader_header(const avm_landmark_reader*
                                                       int32_t* image_width, int32_t* image_height,
                                                       double* fps);
 
-/* Reads up to block->count frames into rows 0, 1, ... of the block's arrays (NULL arrays are
- * skipped; parts a frame lacks, and rows 468..477 of a 468-point face, are filled with NaN).
- * *out_read = the number of frames read; 0 with AVM_OK at the end of the file. Allocates
- * nothing per frame.
+/* Reads up to block->count lines into rows 0, 1, ... of the block's arrays (NULL arrays are
+ * skipped; parts a line lacks, and rows 468..477 of a 468-point face, are filled with NaN).
+ * A line is a row: in a file of several people (version 2) one frame's people are
+ * consecutive rows with the same t, told apart by block->person (0 for every row of a
+ * version-1 file). *out_read = the number of rows read; 0 with AVM_OK at the end of the
+ * file. Allocates nothing per frame.
  * Failures: AVM_ERROR_INVALID_ARGUMENT (r, block, block->t or out_read NULL, struct_size
- *   below sizeof(avm_frame_block), count negative); AVM_ERROR_PARSE: a malformed line,
+ *   below offsetof(avm_frame_block, person), count negative); AVM_ERROR_PARSE: a malformed line,
  *   "FILE:LINE: ..." in avm_landmark_reader_last_error(); *out_read then counts the good
  *   frames read before it, and the next call goes on after the bad line;
  *   AVM_ERROR_IO (a read error), AVM_ERROR_INTERNAL. */
@@ -989,9 +1059,13 @@ AVATARMAP_C_API void avm_landmark_reader_destroy(avm_landmark_reader* r);
  * options->image_width/height (0: unknown, square pixels assumed). The block's arrays are
  * only read during the call. Allocates nothing per frame (the offline filter's window once
  * per call). `options` NULL means the defaults. err as avm_solve_file().
+ * The block is one person: a person column (frames->person) holding more than one distinct
+ * id is refused (solve each person's rows on their own, or a file with avm_solve_file() and
+ * avm_solver_options.person); options->person is not used.
  * Failures: AVM_ERROR_INVALID_ARGUMENT (frames or out_poses NULL with count > 0, frames->t
- *   NULL, struct_size below sizeof(avm_frame_block), count negative, a time not finite, bad
- *   options: the message names the frame or field), AVM_ERROR_OUT_OF_MEMORY,
+ *   NULL, struct_size below offsetof(avm_frame_block, person), count negative, a time not
+ *   finite, several person ids, bad options: the message names the frame or field),
+ *   AVM_ERROR_OUT_OF_MEMORY,
  *   AVM_ERROR_INTERNAL. Thread-safe (separate outputs). */
 AVATARMAP_C_API avm_status avm_solve_frames(const avm_frame_block* frames,
                                             const avm_solver_options* options, avm_pose* out_poses,
@@ -1141,15 +1215,22 @@ AVATARMAP_C_API avm_status avm_retargeter_apply_poses(avm_retargeter* r, const a
 /* ---- capture of a whole file ----------------------------------------------------------- */
 
 /* What avm_capture_file() did (also filled, as far as it got, when it fails). Set
- * struct_size = sizeof(avm_capture_summary) before the call (a smaller one is refused). */
+ * struct_size = sizeof(avm_capture_summary) before the call (one that ends before `seconds` is
+ * refused; the fields past the caller's struct_size are not written). */
 typedef struct avm_capture_summary {
   uint32_t struct_size;
   int64_t frames;                                                        /* frames written */
-  int64_t body_frames, left_hand_frames, right_hand_frames, face_frames; /* frames with each */
+  int64_t body_frames, left_hand_frames, right_hand_frames, face_frames; /* frames with each
+                                          (max_people > 1: lines, one per person and frame) */
   int64_t frames_not_decoded; /* broken frames skipped with a warning */
   int32_t image_width, image_height;
   double fps;     /* the input's nominal rate; 0 unknown */
   double seconds; /* wall-clock time of the run, start-up included */
+  /* -- added after seconds (a caller whose struct_size ends before them gets none) -- */
+  /* Several people (avm_estimator_options.max_people > 1; all 0 with one): the distinct
+   * person ids seen, the lines written (one per person in view and frame), and the frames
+   * with at least one person in view. */
+  int64_t people_ids, person_lines, frames_with_people;
 } avm_capture_summary;
 
 /* Called about twice a second during avm_capture_file() on its calling thread, and once at

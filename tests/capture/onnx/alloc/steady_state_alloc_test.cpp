@@ -138,5 +138,41 @@ TEST(steady_state, capture_pipeline_allocates_nothing_outside_onnx_runtime) {
   EXPECT_EQ(g_outside.load(), 0);
 }
 
+// Several people through capture_pipeline (the C API's avm_estimator_process_people and the
+// live session): each person's stream in its slot allocates nothing per frame either.
+TEST(steady_state, capture_pipeline_people_allocate_nothing_outside_onnx_runtime) {
+  const std::string models = test::models_dir();
+  if (models.empty()) GTEST_SKIP() << "AVATARMAP_MODELS is not set (folder of converted models)";
+  if (test::test_data_dir().empty()) GTEST_SKIP() << test::k_no_test_data;
+  test::loaded_image img;
+  ASSERT_TRUE(test::load_image(test::test_data_path("motion/tfjs-models/three_people.jpg"), img));
+  capture_pipeline_options o;
+  o.estimator.source = models;
+  o.estimator.threads = 1;
+  o.estimator.hands = o.estimator.face = true;
+  o.estimator.max_people = 3;
+  o.estimator.static_images = true;  // the same three people, slots kept, every frame
+  std::unique_ptr<capture_pipeline> p;
+  const status s = capture_pipeline::create(o, p);
+  ASSERT_TRUE(s.ok()) << s.message();
+  landmark_frame f;
+  people_poses people;
+  g_outside = 0;
+  int least = k_max_people;
+  for (int i = 0; i < 30; ++i) {
+    if (i == 10) g_counting = true;
+    ASSERT_TRUE(p->estimate(img.view(), i / 30.0, f).ok());
+    p->solve_people(f, people);
+    if (i >= 10) least = std::min(least, people.count);
+  }
+  g_counting = false;
+  EXPECT_EQ(least, 3);
+  std::printf(
+      "[figures] capture_pipeline, 3 people: allocations outside ONNX Runtime in 20 frames: "
+      "%ld\n",
+      g_outside.load());
+  EXPECT_EQ(g_outside.load(), 0);
+}
+
 }  // namespace
 }  // namespace avatarmap
