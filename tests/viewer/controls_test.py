@@ -131,9 +131,13 @@ def js(browser, expression):
 
 
 def seek(browser, t):
+    before = (browser.state() or {}).get("frames", 0)
     js(browser, f"(() => {{ const s = document.getElementById('timeline'); s.value = '{t}';"
                 "s.dispatchEvent(new Event('input', {bubbles: true})); })()")
     time.sleep(0.15)
+    # Two frames drawn after the seek, however slow the machine (a loaded CI machine once read
+    # the eyes before the page had drawn the new time).
+    browser.wait_for(lambda st: st.get("frames", 0) >= before + 2, 10, f"two frames after seek {t}")
 
 
 def click(browser, element_id):
