@@ -66,28 +66,28 @@ estimator::people_view replay_estimator::last_people() const {
 
 status replay_estimator::estimate(const estimate_args& args, landmark_frame& out) {
   if (finished_) return status::error("end of recording");
-  if (max_people_ <= 1) {
-    const read_result r = reader_.next(out);
+  // The next line into `f`: false at the end of the recording or on an error (`st` set).
+  status st;
+  auto first_line = [&](landmark_frame& f) {
+    const read_result r = reader_.next(f);
+    if (r == read_result::frame) return true;
     if (r == read_result::end) {
       finished_ = true;
       out.clear();
-      return status::error("end of recording");
+      st = status::error("end of recording");
+    } else {
+      st = status::failure(reader_.error_code(), reader_.error());
     }
-    if (r == read_result::error) return status::failure(reader_.error_code(), reader_.error());
+    return false;
+  };
+  if (max_people_ <= 1) {
+    if (!first_line(out)) return st;
     keep_asked_parts(args, out);
     return {};
   }
   // Several people: the lines sharing the first one's time stamp.
   people_count_ = 0;
-  if (!has_ahead_) {
-    const read_result r = reader_.next(ahead_);
-    if (r == read_result::end) {
-      finished_ = true;
-      out.clear();
-      return status::error("end of recording");
-    }
-    if (r == read_result::error) return status::failure(reader_.error_code(), reader_.error());
-  }
+  if (!has_ahead_ && !first_line(ahead_)) return st;
   people_[people_count_++] = ahead_;
   has_ahead_ = false;
   for (;;) {
@@ -100,10 +100,8 @@ status replay_estimator::estimate(const estimate_args& args, landmark_frame& out
     }
     if (people_count_ < max_people_) people_[people_count_++] = ahead_;
   }
-  for (int i = 0; i < people_count_; ++i) {
-    if (people_[i].person < 0) people_[i].person = 0;  // a version-1 line: the one person
-    keep_asked_parts(args, people_[i]);
-  }
+  // (A version-1 line is person 0: the reader gives it so.)
+  for (int i = 0; i < people_count_; ++i) keep_asked_parts(args, people_[i]);
   out = people_[0];
   return {};
 }

@@ -336,8 +336,7 @@ bool live_session::sample_person(int id, double t, proxy_pose& out) const {
   std::array<live_person, k_max_people> held;
   const int n = impl_->held_people(held.data(), k_max_people);
   for (int i = 0; i < n; ++i)
-    if (held[i].id == id || (!impl_->several() && id == 0))
-      return impl_->sample_slot(held[i].slot, t, out);
+    if (held[i].id == id) return impl_->sample_slot(held[i].slot, t, out);
   return false;
 }
 

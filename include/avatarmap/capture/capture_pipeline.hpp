@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "avatarmap/capture/estimator.hpp"
+#include "avatarmap/capture/people_tracker.hpp"
 #include "avatarmap/core/status.hpp"
 #include "avatarmap/landmarks/landmark_frame.hpp"
 #include "avatarmap/skeleton/proxy_pose.hpp"
@@ -68,8 +69,8 @@ struct capture_pipeline_options {
 };
 
 /// How long a person's slot is kept after the person was last seen (seconds of capture time):
-/// the estimator's wait before a lost id is given up (people_tracker_options::keep_lost_seconds).
-inline constexpr double k_person_hold_seconds = 1.0;
+/// the estimator's wait before a lost id is given up (people_tracker.hpp).
+inline constexpr double k_person_hold_seconds = k_keep_lost_seconds;
 
 /// One person of a frame, solved (several people).
 struct person_pose {

@@ -34,14 +34,20 @@
 
 namespace avatarmap {
 
+/// How long a lost person's id waits to be given back (seconds): the default of
+/// people_tracker_options::keep_lost_seconds, and how long capture_pipeline keeps the person's
+/// slot (k_person_hold_seconds).
+inline constexpr double k_keep_lost_seconds = 1.0;
+
 struct people_tracker_options {
   int max_people = 2;               // 1 .. k_max_people
   double redetect_seconds = 0.1;    // detector schedule while fewer than max_people tracked
   float same_person_offset = 0.5f;  // box to track shoulder centres / torso: the same person
   float merged_offset = 0.2f;       // mean key point distance / torso: one body
-  double keep_lost_seconds = 1.0;   // how long a lost person's id waits to be given back
-  float reid_max_offset = 0.5f;     // centre distance / size allowed to take an id back
-  float reid_max_scale = 1.5f;      // size ratio allowed to take an id back
+  double keep_lost_seconds =
+      k_keep_lost_seconds;       // how long a lost person's id waits to be given back
+  float reid_max_offset = 0.5f;  // centre distance / size allowed to take an id back
+  float reid_max_scale = 1.5f;   // size ratio allowed to take an id back
 };
 
 class people_tracker {
