@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "avatarmap/capture/image_crop.hpp"
+#include "avatarmap/capture/low_light.hpp"
 
 namespace avatarmap {
 namespace {
@@ -89,6 +90,24 @@ void bm_memcpy_tensor(benchmark::State& state) {
   state.SetBytesProcessed(state.iterations() * static_cast<int64_t>(src.size() * sizeof(float)));
 }
 
+// The low-light lift on a 256 x 256 crop (low_light.hpp): a well-exposed crop is only measured
+// (the histogram: every input pays this), a dim one is also stretched. Each iteration restores
+// the crop first (a memcpy, as bm_memcpy_tensor).
+void run_lift(benchmark::State& state, float scale) {
+  crop_options o;
+  o.output_width = o.output_height = 256;
+  std::vector<float> src(crop_output_size(o)), t(src.size());
+  std::mt19937 rng(7);
+  for (float& v : src) v = scale * static_cast<float>(rng() % 256) / 255.f;
+  for (auto _ : state) {
+    std::memcpy(t.data(), src.data(), t.size() * sizeof(float));
+    benchmark::DoNotOptimize(lift_low_light(t.data(), o, crop_transform{}));
+    benchmark::ClobberMemory();
+  }
+}
+void bm_lift_well_exposed(benchmark::State& state) { run_lift(state, 1.0f); }
+void bm_lift_dim(benchmark::State& state) { run_lift(state, 0.1f); }
+
 BENCHMARK(bm_crop_rgb_rotated);
 BENCHMARK(bm_crop_rgb_rotated_zero_border);
 BENCHMARK(bm_crop_rgb_rotated_gl);
@@ -96,6 +115,8 @@ BENCHMARK(bm_crop_rgb_rotated_gl_zero_border);
 BENCHMARK(bm_crop_rgb_upright);
 BENCHMARK(bm_crop_bgra_rotated);
 BENCHMARK(bm_memcpy_tensor);
+BENCHMARK(bm_lift_well_exposed);
+BENCHMARK(bm_lift_dim);
 
 }  // namespace
 }  // namespace avatarmap

@@ -19,6 +19,12 @@ constexpr double k_jump_fade_seconds = 0.3;
 constexpr float k_steady_move = 0.15f;
 // The jump rule applies between tracks started at least this long ago.
 constexpr double k_settled_seconds = 0.3;
+// A track slid onto another person: its shoulder centre moved at least k_slide_min_move torso
+// lengths at k_slide_speed torso lengths per second or faster (a person's shoulders do not:
+// about 3 m/s), and at least half of that move brought it nearer another track's shoulder
+// centre.
+constexpr float k_slide_min_move = 0.5f;
+constexpr float k_slide_speed = 6.0f;
 // A region's side in pixels (regions are squares in pixels; the larger side otherwise).
 float side_px(const normalized_rect& r, int w, int h) {
   return std::max(r.width * static_cast<float>(w), r.height * static_cast<float>(h));
@@ -184,6 +190,18 @@ void people_tracker::on_found(int slot, double t, const normalized_rect& used,
   const float fade = since > 0.0 ? static_cast<float>(std::exp(-since / k_jump_fade_seconds)) : 0.f;
   b.jump = (had ? fade * b.jump : 0.f) + move;
   b.t = t;
+  // Slid onto another person (its own hidden: the model follows the body in front)?
+  b.slid = false;
+  if (move >= k_slide_min_move && since > 0.0 && move / since >= k_slide_speed) {
+    const float sx1 = 0.5f * (b.xy[2] + b.xy[4]), sy1 = 0.5f * (b.xy[3] + b.xy[5]);
+    for (int i = 0; i < active_count_ && !b.slid; ++i) {
+      const body_points& o = body_[tracks_[i].slot];
+      if (tracks_[i].slot == slot || !(o.torso > 0.f)) continue;
+      const float ox = 0.5f * (o.xy[2] + o.xy[4]), oy = 0.5f * (o.xy[3] + o.xy[5]);
+      const float nearer = std::hypot(sx0 - ox, sy0 - oy) - std::hypot(sx1 - ox, sy1 - oy);
+      b.slid = nearer >= 0.5f * move * b.torso;
+    }
+  }
   if (!had || move < k_steady_move) steady_[slot] = m;
 }
 
@@ -216,6 +234,19 @@ void people_tracker::on_lost(int slot, double t) {
 
 int people_tracker::resolve_merges(double t, int* out_slots) {
   int n = 0;
+  // Tracks that slid onto another person this frame end first (as lost, waiting with the
+  // motion of their last steady frame: the person may come back from behind).
+  for (int i = 0; i < active_count_;) {
+    body_points& b = body_[tracks_[i].slot];
+    if (!(b.slid && b.t == t)) {
+      ++i;
+      continue;
+    }
+    b.slid = false;
+    out_slots[n++] = tracks_[i].slot;
+    remove(i, t, true, true);
+    lost_since_detection_ = true;
+  }
   for (int i = 0; i < active_count_; ++i) {
     for (int j = i + 1; j < active_count_;) {
       const body_points& a = body_[tracks_[i].slot];

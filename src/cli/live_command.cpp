@@ -230,6 +230,8 @@ int run_live_command(int argc, char** argv) {
     lso.outputs.push_back([&](const proxy_pose& p, const live_output_report& r) {
       server.publish(p, r.person, r.slot);
     });
+  if (!serve.empty())
+    lso.on_person_gone.push_back([&](int id, int slot) { server.clear(id, slot); });
   if (vmc.enabled())
     lso.outputs.push_back(
         [&](const proxy_pose& p, const live_output_report& r) { vmc.send(p, r); });

@@ -91,6 +91,9 @@ struct live_session::impl {
   // The output thread's scratch (several people: one pose per held person).
   std::array<live_person, k_max_people> out_people{};
   std::array<proxy_pose, k_max_people> out_poses;
+  // Per slot, the person the outputs were last handed (-1: none), and those gone this tick.
+  std::array<int, k_max_people> handed{};
+  std::array<live_person, k_max_people> gone{};
 
   bool several() const { return pipeline->max_people() > 1; }
 
@@ -104,11 +107,28 @@ struct live_session::impl {
       for (int k = 0; k < pipeline->max_people(); ++k)
         if (pipeline->slot_person(k) >= 0)
           all[n++] = {pipeline->slot_person(k), k, pipeline->slot_seen(k)};
-      std::sort(all.begin(), all.begin() + n,
-                [](const live_person& a, const live_person& b) { return a.id < b.id; });
+      // Insertion by id (at most k_max_people).
+      for (int i = 1; i < n; ++i)
+        for (int j = i; j > 0 && all[j].id < all[j - 1].id; --j) std::swap(all[j], all[j - 1]);
     }
     for (int i = 0; i < n && i < capacity; ++i) out[i] = all[i];
     return n;
+  }
+
+  // The people handed to the outputs last time whose slot now holds nobody or someone else,
+  // into gone[]; handed[] becomes out_people[0 .. n)'s (output thread, under out_m).
+  int people_gone(int n) {
+    std::array<int, k_max_people> now{};
+    now.fill(-1);
+    for (int i = 0; i < n; ++i)
+      now[static_cast<std::size_t>(out_people[i].slot)] = out_people[i].id;
+    int count = 0;
+    for (std::size_t k = 0; k < handed.size(); ++k) {
+      if (handed[k] >= 0 && handed[k] != now[k])
+        gone[static_cast<std::size_t>(count++)] = {handed[k], static_cast<int>(k), 0.0};
+      handed[k] = now[k];
+    }
+    return count;
   }
 
   // The stream sampled for `person` (slot 0 with one person; under out_m).
@@ -200,8 +220,8 @@ struct live_session::impl {
         std::chrono::duration<double>(1.0 / options.output_fps));
     auto next = clock_type::now();
     double last_t = -INFINITY;  // output times always increase (processing time varies)
-    proxy_pose p;
     live_output_report r;
+    handed.fill(-1);
     for (;;) {
       next += period;
       {
@@ -210,7 +230,7 @@ struct live_session::impl {
         std::unique_lock<std::mutex> lock(output_m);
         if (output_cv.wait_until(lock, next, [&] { return output_stop; })) return;
       }
-      int n = 0;
+      int n = 0, n_gone = 0;
       {
         std::lock_guard<std::mutex> lock(out_m);
         if (!has_pose) continue;
@@ -221,17 +241,23 @@ struct live_session::impl {
           const int held = held_people(out_people.data(), k_max_people);
           for (int i = 0; i < held; ++i)
             if (sample_slot(out_people[i].slot, t, out_poses[n])) out_people[n++] = out_people[i];
+          n_gone = people_gone(n);
         } else if (sample_slot(0, t, out_poses[0])) {
           out_people[0] = {-1, 0, t};
           n = 1;
         }
-        if (n == 0) continue;
-        last_t = t;
-        r.carries_new_frame = fresh;
-        r.pushed_at = newest_pushed;
-        fresh = false;
-        ++outputs;
+        if (n == 0 && n_gone == 0) continue;
+        if (n > 0) {
+          last_t = t;
+          r.carries_new_frame = fresh;
+          r.pushed_at = newest_pushed;
+          fresh = false;
+          ++outputs;
+        }
       }
+      for (int i = 0; i < n_gone; ++i)
+        for (const auto& g : options.on_person_gone)
+          if (g) g(gone[i].id, gone[i].slot);
       for (int i = 0; i < n; ++i) {
         r.person = out_people[i].id;
         r.slot = out_people[i].slot;

@@ -931,6 +931,27 @@ void pose_server::publish(const proxy_pose& pose, int person, int slot) {
   if (s.context) lws_cancel_service(s.context);
 }
 
+void pose_server::clear(int person, int slot) {
+  impl& s = *impl_;
+  if (slot < 0 || slot >= k_pose_server_slots) return;
+  std::lock_guard<std::mutex> lock(s.m);
+  server_state::slot_pose& l = s.latest[static_cast<std::size_t>(slot)];
+  constexpr std::string_view gone_key = ",\"gone\":true}";
+  char* at = l.text.data();
+  *at++ = '{';
+  constexpr std::string_view person_key = "\"person\":";
+  at = std::copy(person_key.begin(), person_key.end(), at);
+  at = std::to_chars(at, l.text.data() + l.text.size(), person).ptr;
+  constexpr std::string_view slot_key = ",\"slot\":";
+  at = std::copy(slot_key.begin(), slot_key.end(), at);
+  at = std::to_chars(at, l.text.data() + l.text.size(), slot).ptr;
+  at = std::copy(gone_key.begin(), gone_key.end(), at);
+  l.size = static_cast<std::size_t>(at - l.text.data());
+  ++l.count;
+  l.stamp = ++s.seq;
+  if (s.context) lws_cancel_service(s.context);
+}
+
 pose_server_stats pose_server::stats() const {
   const impl& s = *impl_;
   pose_server_stats r;
@@ -965,6 +986,8 @@ std::string pose_server::listen_address() const { return {}; }
 bool pose_server::exposed() const { return false; }
 std::vector<std::string> pose_server::network_urls() const { return {}; }
 void pose_server::publish(const proxy_pose&, int, int) { ++impl_->published; }
+void pose_server::clear(int, int) {}
+
 pose_server_stats pose_server::stats() const {
   pose_server_stats r;
   r.published = impl_->published.load();

@@ -246,5 +246,59 @@ TEST(live_session_people, outputs_and_samples_every_held_person_with_its_id_and_
   EXPECT_GT(outputs_of[1], 0);
 }
 
+// A person who leaves is reported gone once, with its slot, after its last output and before
+// the next person takes that slot (the viewer's server forgets its pose then).
+TEST(live_session_people, a_person_who_left_is_reported_gone_before_the_slot_is_reused) {
+  test::temp_dir dir("live_people_gone");
+  const recordings rec = write_recordings(dir);
+  live_session_options o;
+  o.pipeline = replay_options(rec.together, 3);
+  o.output_fps = 200.0;
+  std::mutex m;
+  struct event {
+    bool gone;
+    int person, slot;
+  };
+  std::vector<event> events;
+  o.outputs.push_back([&](const proxy_pose&, const live_output_report& r) {
+    std::lock_guard<std::mutex> lock(m);
+    events.push_back({false, r.person, r.slot});
+  });
+  o.on_person_gone.push_back([&](int person, int slot) {
+    std::lock_guard<std::mutex> lock(m);
+    events.push_back({true, person, slot});
+  });
+  std::unique_ptr<live_session> s;
+  ASSERT_TRUE(live_session::create(o, s).ok());
+  std::vector<std::uint8_t> px(4 * 4 * 3, 128);
+  const image_view img{px.data(), 4, 4, 12, pixel_format::rgb8};
+  for (int i = 0; i < k_frames; ++i) {
+    ASSERT_TRUE(s->push(img, i / k_fps).ok());
+    settle(*s);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));  // output ticks between frames
+  }
+  s->stop();
+  std::lock_guard<std::mutex> lock(m);
+  int gone_at = -1, last_of_1 = -1, first_of_2 = -1;
+  for (int i = 0; i < static_cast<int>(events.size()); ++i) {
+    const event& e = events[static_cast<std::size_t>(i)];
+    if (e.gone) {
+      EXPECT_EQ(gone_at, -1) << "a second gone report: person " << e.person;
+      EXPECT_EQ(e.person, 1);
+      EXPECT_EQ(e.slot, 1);
+      gone_at = i;
+    } else if (e.person == 1) {
+      last_of_1 = i;
+    } else if (e.person == 2 && first_of_2 < 0) {
+      first_of_2 = i;
+      EXPECT_EQ(e.slot, 1) << "person 2 takes the freed slot";
+    }
+  }
+  ASSERT_GE(gone_at, 0) << "person 1 was never reported gone";
+  ASSERT_GE(first_of_2, 0);
+  EXPECT_LT(last_of_1, gone_at);
+  EXPECT_LT(gone_at, first_of_2);
+}
+
 }  // namespace
 }  // namespace avatarmap

@@ -151,6 +151,41 @@ TEST(pose_server_people, a_slow_page_gets_each_slots_newest_pose) {
   EXPECT_LT(got, k_poses / 10) << "the slow page was sent a queue of old poses";
 }
 
+TEST(pose_server_people, a_person_gone_is_told_to_open_pages_and_never_shown_to_new_ones) {
+  people_fixture f;
+  pose_server server;
+  ASSERT_TRUE(server.start(f.options()).ok());
+  ws_client page;
+  ASSERT_TRUE(page.open(server.port(), k_protocol_header));
+  server.publish(pose_at(0.5, 1), 7, 0);
+  server.publish(pose_at(0.5, 2), 3, 1);
+  read_back m;
+  ASSERT_TRUE(read_message(page, m));
+  ASSERT_TRUE(read_message(page, m));
+  server.clear(3, 1);
+  server.clear(3, k_pose_server_slots);  // out of range: ignored
+  std::string text;
+  ASSERT_TRUE(page.read(text));
+  const nlohmann::json gone = nlohmann::json::parse(text, nullptr, false);
+  ASSERT_FALSE(gone.is_discarded()) << text;
+  EXPECT_EQ(gone, nlohmann::json::parse(R"({"person":3,"slot":1,"gone":true})"));
+
+  // A page that connects now gets slot 0's pose and slot 1's notice, not person 3's old pose.
+  ws_client later;
+  ASSERT_TRUE(later.open(server.port(), k_protocol_header));
+  std::string first, second;
+  ASSERT_TRUE(later.read(first));
+  ASSERT_TRUE(later.read(second));
+  EXPECT_EQ(nlohmann::json::parse(first).at("person"), 7);
+  EXPECT_EQ(second, text);
+
+  // The slot's next person is sent as usual.
+  server.publish(pose_at(0.9, 4), 9, 1);
+  ASSERT_TRUE(read_message(page, m));
+  EXPECT_EQ(m.json.at("person"), 9);
+  EXPECT_EQ(m.pose.t, 0.9);
+}
+
 TEST(pose_server_people, publish_to_a_slot_allocates_nothing) {
   people_fixture f;
   pose_server server;

@@ -11,7 +11,8 @@ slot)) and checked against the poses sent: lines without "slot" drive the one av
 before, which stays shown when they stop; two slots get two avatars, each with its own person's
 arm rotation; without a root translation they stand 1 m apart by slot, with one they stand
 where their hips say (slot 1 left of slot 0 when its hips are); a slot whose poses stop is
-hidden after 1.5 s and shown again when they resume, slot 0's (the page's own avatar) too. Exit 77 (skipped) without chromium, the
+hidden after 1.5 s and shown again when they resume, slot 0's (the page's own avatar) too; a
+"gone" notice hides a slot's avatar at once. Exit 77 (skipped) without chromium, the
 test data or the viewer's modules."""
 
 import base64
@@ -209,6 +210,15 @@ def main():
         seen = wait_people(browser, lambda p: not p[0]["visible"], 10, "slot 0 hidden")
         check(seen[1]["visible"] and browser.state()["people"] == 1,
               "slot 0's person left: its avatar is hidden, slot 1's stays")
+        # The server's notice that slot 1's person has gone (pose_server::clear): hidden at
+        # once, not after 1.5 s.
+        gone = json.dumps({"person": 9, "slot": 1, "gone": True}, separators=(",", ":"))
+        source.set_lines([gone])
+        t0 = time.time()
+        wait_people(browser, lambda p: not p[1]["visible"], 10, "slot 1 hidden by its notice")
+        took = time.time() - t0
+        check(took < 1.0, f"a gone notice hides the avatar at once ({took:.2f} s, not 1.5 s)")
+        check(browser.state()["people"] == 0, "nobody is shown after both left")
         check(not browser.exceptions, f"no page exceptions ({browser.exceptions[-3:]})")
     except TimeoutError as e:
         check(False, str(e))

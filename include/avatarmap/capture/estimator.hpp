@@ -78,6 +78,9 @@ struct estimator_options {
   /// estimate() then gives the first person (the lowest id) and last_people() every person
   /// (docs/capture-people.md). Runs on one lane.
   int max_people = 1;
+  /// onnx: lift dim, low-contrast model inputs (a dark room, a washed-out picture) before the
+  /// models see them; well-exposed inputs are untouched (low_light.hpp, docs/capture.md).
+  bool low_light = true;
 };
 
 /// The estimator's options as every front end takes them (the CLI's capture, live and animate
@@ -154,6 +157,13 @@ inline constexpr option_row<estimator_options> k_estimator_option_table[] = {
         .help("follow up to N people, each with an id, its hands and face (a version-2 "
               "landmark file, one line per person and frame); 1 is the single-person capture "
               "(docs/capture-people.md)"),
+    option_row<estimator_options>("low_light", AVATARMAP_OPTION_FIELD(estimator_options, low_light))
+        .boolean()
+        .defaults_to(1)
+        .cli("--low-light", nullptr, "--no-low-light")
+        .not_in_c()
+        .help("stretch the levels of a dim, low-contrast picture before the models see it "
+              "(well-exposed pictures are untouched; docs/capture.md \"Low light\")"),
     option_row<estimator_options>("spin", AVATARMAP_OPTION_FIELD(estimator_options, spin))
         .boolean()
         .cli("--spin")

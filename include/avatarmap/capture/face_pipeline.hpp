@@ -154,6 +154,9 @@ struct face_pipeline_options {
   /// How the crops sample the image (image_crop.hpp): `gl`, MediaPipe's OpenGL converter (its
   /// GPU and web graphs, which made the goldens: docs/capture.md), or `opencv`, its CPU one.
   crop_sampling sampling = crop_sampling::gl;
+  /// Lift dim, low-contrast model inputs before the models see them (low_light.hpp); inputs
+  /// whose luma range is wide enough are untouched.
+  bool low_light = true;
   /// Scale of the pose-derived search region (Holistic: 3), in (0, 100].
   float pose_region_scale = 3.0f;
   /// While tracking with a body, move the tracked region by the body's head motion since the

@@ -160,6 +160,9 @@ struct hand_pipeline_options {
   /// How the crops sample the image (image_crop.hpp): `gl`, MediaPipe's OpenGL converter (its
   /// GPU and web graphs, which made the goldens: docs/capture.md), or `opencv`, its CPU one.
   crop_sampling sampling = crop_sampling::gl;
+  /// Lift dim, low-contrast model inputs before the models see them (low_light.hpp); inputs
+  /// whose luma range is wide enough are untouched.
+  bool low_light = true;
 };
 
 /// Time spent in the last process() call, milliseconds (0 for a stage that did not run).

@@ -20,6 +20,11 @@
 // - Two tracks whose nose, shoulders and hips lie on average within merged_offset of the
 //   smaller torso length of each other follow one body: the lower id (the person known
 //   longer) keeps it, the other is ended as lost (its id may come back).
+// - A track whose shoulder centre moves half a torso length or more in one frame, at 6 torso
+//   lengths a second or faster (faster than shoulders move), and at least half of that toward
+//   another track's shoulder centre has slid onto that person: its own person is hidden and
+//   the model follows the body in front. It is ended as lost on that frame, before its
+//   skeleton is given out (its id may come back).
 //
 // Spaces: regions in normalised image coordinates (image_crop.hpp); sizes and motion are
 // measured in pixels of the image size given with each call; times in seconds.
@@ -85,7 +90,9 @@ class people_tracker {
                 const landmark* pose, int image_width, int image_height);
   /// The track in slot `slot` lost its person at `t`: its id waits keep_lost_seconds.
   void on_lost(int slot, double t);
-  /// Ends one of every two tracks that follow one body (merged_offset; as lost): between two
+  /// Ends every track that slid onto another person on its last frame (the rule above; as
+  /// lost, waiting with its motion from its last steady frame), then one of every two tracks
+  /// that follow one body (merged_offset; as lost): between two
   /// tracks started at least 0.3 s ago the one that jumped onto it (its recent moves, in torso
   /// lengths and fading with a time constant of k_jump_fade_seconds, exceed the other's by
   /// k_merge_jump_margin: a track whose person is hidden slides onto the one in front), else the
@@ -115,6 +122,7 @@ class people_tracker {
     std::array<float, 10> xy{};
     float torso = 0.f;
     float jump = 0.f;    // the shoulder centre's recent moves, torso lengths, fading
+    bool slid = false;   // on its last frame it slid onto another person (resolve_merges)
     double t = 0.0;      // when found last
     double start = 0.0;  // when the track started
   };

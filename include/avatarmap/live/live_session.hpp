@@ -97,6 +97,11 @@ struct live_session_options {
   /// output in order. 0: no output thread (callers sample()). At most k_max_fps.
   double output_fps = 0.0;
   std::vector<live_output> outputs;
+  /// Several people, output thread: called once for a person the outputs were handed when it
+  /// is no longer held (unseen for k_person_hold_seconds: its slot is freed), with its id and
+  /// former slot, before the next poses go out (the viewer's server forgets the slot's pose).
+  /// Same rules as an output.
+  std::vector<std::function<void(int person, int slot)>> on_person_gone;
 };
 
 struct live_session_stats {

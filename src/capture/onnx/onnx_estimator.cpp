@@ -509,6 +509,7 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
   po.complexity = static_cast<pose_model_complexity>(options.model_complexity);
   po.precision = options.precision;
   po.static_images = options.static_images;
+  po.low_light = options.low_light;
   std::unique_ptr<pose_pipeline> pose;
   status s = pose_pipeline::create(po, pose);
   if (!s.ok()) return s;
@@ -523,6 +524,7 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
     ho.mirrored_input = options.mirrored_input;
     ho.allow_spinning = po.allow_spinning;
     ho.static_images = options.static_images;
+    ho.low_light = options.low_light;
     // Several people: a hand only from its person's wrists, never a palm found anywhere.
     if (several) ho.roi_source = hand_roi_source::pose;
     s = hand_pipeline::create(ho, hands);
@@ -536,6 +538,7 @@ status create_onnx_estimator(const estimator_options& options, std::unique_ptr<e
     fo.intra_op_threads = threads;
     fo.allow_spinning = po.allow_spinning;
     fo.static_images = options.static_images;
+    fo.low_light = options.low_light;
     // Several people: a face only in its person's face region, never the image's best face.
     if (several) fo.roi_source = face_roi_source::pose;
     if (options.face_model < 0 || options.face_model > 1)

@@ -160,15 +160,19 @@ std::string bound_model::load_in_order(const std::string& path, const Ort::Sessi
 }
 
 bool bound_model::crop_input(const image_view& image, const normalized_rect& roi,
-                             const crop_options& options, crop_transform* transform) {
+                             const crop_options& options, crop_transform* transform,
+                             const low_light_options* lift) {
+  crop_transform local;
   image_crop_job job;
   job.image = image;
   job.roi = roi;
   job.options = options;
   job.output = input.data();
   job.output_size = input.size();
-  job.out_transform = transform;
-  return job.run();
+  job.out_transform = transform != nullptr ? transform : &local;
+  if (!job.run()) return false;
+  if (lift != nullptr) lift_low_light(input.data(), options, *job.out_transform, *lift);
+  return true;
 }
 
 namespace {

@@ -15,6 +15,7 @@
 
 #include "avatarmap/capture/estimator.hpp"
 #include "avatarmap/capture/image_crop.hpp"
+#include "avatarmap/capture/low_light.hpp"
 #include "model_cache.hpp"
 
 namespace avatarmap {
@@ -93,10 +94,10 @@ struct bound_model {
                             const std::vector<int64_t>& counts);
 
   /// Crops `roi` of `image` into `input` (MediaPipe's ImageToTensor, image_crop.hpp); the
-  /// transform back to the image goes to `transform` when non-null. False when the image
-  /// cannot be cropped.
+  /// transform back to the image goes to `transform` when non-null. With `lift`, a dim,
+  /// low-contrast crop is then lifted (low_light.hpp). False when the image cannot be cropped.
   bool crop_input(const image_view& image, const normalized_rect& roi, const crop_options& options,
-                  crop_transform* transform);
+                  crop_transform* transform, const low_light_options* lift = nullptr);
 
   /// Runs the session on `input` into `outputs`. Throws Ort::Exception.
   void run();
