@@ -48,8 +48,14 @@ void people_tracker::reset() {
 bool people_tracker::wants_detection(double t) const {
   if (active_count_ == 0 || !detected_once_) return true;
   if (active_count_ >= options_.max_people) return false;
-  return lost_since_detection_ || !(t >= last_detection_t_) ||
-         t - last_detection_t_ >= options_.redetect_seconds;
+  if (lost_since_detection_ || !(t >= last_detection_t_) ||
+      t - last_detection_t_ >= options_.redetect_seconds)
+    return true;
+  // A person lost a moment ago may come out from behind someone: look on every frame while
+  // its id waits.
+  for (const motion& m : lost_)
+    if (m.id >= 0 && t - m.t <= options_.keep_lost_seconds) return true;
+  return false;
 }
 
 int people_tracker::index_of_slot(int slot) const {

@@ -241,6 +241,30 @@ TEST(people_tracker, a_fast_move_away_from_everybody_is_no_slide) {
   EXPECT_EQ(tr.active_count(), 2);
 }
 
+// While a lost id waits, the detector looks on every frame (the person may come out from
+// behind someone), not every redetect_seconds; once the id is given up it goes back to its
+// schedule.
+TEST(people_tracker, the_detector_looks_on_every_frame_while_a_lost_id_waits) {
+  people_tracker tr;  // max 2
+  person a{0.3f, 0.5f}, b{0.7f, 0.5f};
+  detect(tr, 0.0, {a, b});
+  const int sa = slot_of(tr, 0), sb = slot_of(tr, 1);
+  for (int k = 0; k <= 5; ++k) {
+    found(tr, 0.1 * k, sa, a);
+    found(tr, 0.1 * k, sb, b);
+  }
+  EXPECT_FALSE(tr.wants_detection(0.55));  // two of two tracked: never
+  tr.on_lost(sa, 0.6);                     // a was last seen at 0.5 s
+  EXPECT_TRUE(tr.wants_detection(0.6));
+  detect(tr, 0.6, {b});
+  EXPECT_TRUE(tr.wants_detection(0.62));
+  detect(tr, 1.45, {b});
+  EXPECT_TRUE(tr.wants_detection(1.47));  // 0.97 s since a was seen
+  detect(tr, 1.55, {b});
+  EXPECT_FALSE(tr.wants_detection(1.57));  // given up: the 0.1 s schedule again
+  EXPECT_TRUE(tr.wants_detection(1.66));
+}
+
 TEST(people_tracker, reset_starts_ids_again) {
   people_tracker tr;
   detect(tr, 0.0, {person{0.5f, 0.5f}});

@@ -5,8 +5,9 @@
 //
 // The rule (docs/capture-people.md):
 // - The detector runs when nobody is tracked, on the frame after a track was lost, and every
-//   redetect_seconds while fewer than max_people are tracked (with max_people tracked it does
-//   not run: the cost grows with the people in view, not with max_people).
+//   redetect_seconds while fewer than max_people are tracked, on every frame while a lost id
+//   waits (a person hidden a moment ago comes out from behind someone); with max_people
+//   tracked it does not run (the cost grows with the people in view, not with max_people).
 // - A detector box is a tracked person when its shoulder centre (the detector's keypoint 2)
 //   lies within same_person_offset of that person's torso length (shoulder centre to hip
 //   centre, pixels) from the person's shoulder centre (the mean of landmarks 11 and 12): the
