@@ -73,10 +73,10 @@ const cli_flag k_convert_flags[] = {
     {"--quiet", nullptr, nullptr, "no summary"},
 };
 // The solve-file table's flags convert takes for a landmark input (its --fps is the output's).
-#define AVATARMAP_CONVERT_SOLVE_FLAGS                                         \
-  {                                                                           \
-    "--smoothing", "--min-cutoff", "--beta", "--threads", "--skip-bad-lines", \
-        "--no-foot-contacts", "--no-root-follow", "--person"                  \
+#define AVATARMAP_CONVERT_SOLVE_FLAGS                                           \
+  {                                                                             \
+    "--smoothing", "--min-cutoff", "--beta", "--threads", "--skip-bad-lines",   \
+        "--no-foot-contacts", "--no-root-follow", "--person", "--origin-person" \
   }
 
 void append_position(std::string& s, const std::string& name, glm::dvec3 p, bool first) {

@@ -93,7 +93,9 @@ for la, lb in zip(a[1:], b[1:]):
     for pid, line in ((0, la), (5, lb)):
         d = json.loads(line); d["person"] = pid; out.append(json.dumps(d))
 open("two.landmarks.jsonl", "w").write("\n".join(out) + "\n")' || fail "could not write the two-person file"
-    # Each person to its own output, the same poses as solving that person's recording alone.
+    # Each person to its own output: the poses of solving that person's recording alone, the
+    # root measured from where the first person (0) was first seen: person 5's hips X/Z are b's
+    # alone moved by one constant, everything else is b's.
     run 0 solve two.landmarks.jsonl -o take.pose.jsonl
     expect_in err.txt "person 0 -> take.p0.pose.jsonl"
     expect_in err.txt "person 5 -> take.p5.pose.jsonl"
@@ -101,10 +103,27 @@ open("two.landmarks.jsonl", "w").write("\n".join(out) + "\n")' || fail "could no
     run 0 solve a.landmarks.jsonl -o a.pose.jsonl
     run 0 solve b.landmarks.jsonl -o b.pose.jsonl
     cmp -s a.pose.jsonl take.p0.pose.jsonl || fail "person 0's poses differ from a's alone"
-    cmp -s b.pose.jsonl take.p5.pose.jsonl || fail "person 5's poses differ from b's alone"
-    # One person asked for: one output under the name given.
+    python3 - b.pose.jsonl take.p5.pose.jsonl <<'PY' || fail "person 5 is not b moved by a constant"
+import json, sys
+alone, moved = ([json.loads(l) for l in open(p) if l.strip()][1:] for p in sys.argv[1:3])
+assert len(alone) == len(moved) > 10
+shift = [moved[0]["hips_position"][k] - alone[0]["hips_position"][k] for k in (0, 2)]
+assert abs(shift[0]) + abs(shift[1]) > 0.05, shift  # synth's two people stand apart
+for a, m in zip(alone, moved):
+    for k, d in ((0, shift[0]), (2, shift[1])):
+        assert abs(m["hips_position"][k] - a["hips_position"][k] - d) < 1e-4
+    assert m["hips_position"][1] == a["hips_position"][1]
+    assert m["bones"] == a["bones"] and m["t"] == a["t"]
+PY
+    # One person asked for: one output under the name given, from the same origin; with its
+    # own id as the origin person it is b alone.
     run 0 solve two.landmarks.jsonl -o five.pose.jsonl --person 5
-    cmp -s b.pose.jsonl five.pose.jsonl || fail "--person 5 is not b's poses"
+    cmp -s take.p5.pose.jsonl five.pose.jsonl || fail "--person 5 is not take.p5's poses"
+    run 0 solve two.landmarks.jsonl -o own.pose.jsonl --person 5 --origin-person 5
+    cmp -s b.pose.jsonl own.pose.jsonl || fail "--origin-person 5 is not b's poses alone"
+    run 1 solve two.landmarks.jsonl -o x.pose.jsonl --person 5 --origin-person 3
+    expect_in err.txt "no origin person 3 (its people: 0, 5)"
+    [ -e x.pose.jsonl ] && fail "a refused origin person wrote x.pose.jsonl"
     run 2 solve two.landmarks.jsonl -o x.pose.jsonl --person 3
     expect_in err.txt "no person 3 (its people: 0, 5)"
     run 2 solve two.landmarks.jsonl -o -
@@ -119,7 +138,7 @@ open("two.landmarks.jsonl", "w").write("\n".join(out) + "\n")' || fail "could no
     [ -s take.p0.glb ] && [ -s take.p5.glb ] || fail "convert did not write take.p0.glb and take.p5.glb"
     [ -e take.glb ] && fail "convert of two people wrote take.glb"
     run 0 convert two.landmarks.jsonl -o five.pose.jsonl --person 5 --quiet
-    cmp -s b.pose.jsonl five.pose.jsonl || fail "convert --person 5 is not b's poses"
+    cmp -s take.p5.pose.jsonl five.pose.jsonl || fail "convert --person 5 is not solve's"
     # An old reader's view: the header says version 2, so a version-1 reader refuses it.
     expect_in two.landmarks.jsonl '"version": 2'
     # live --people 2: one pose file per person. Two people side by side (pose_squats.mp4 beside
@@ -161,6 +180,22 @@ print("person 0 vs alone %.1f deg, person 1 vs alone %.1f deg" % (d0, d1))
 assert d0 < 15 and d1 > d0 + 20, (d0, d1)  # measured 7.7 and 62.8
 PY
         fail "live.p0/p1.pose.jsonl do not hold their own people"
+      # The same video captured to a file and solved: the two people stand apart as in the
+      # video, the right one (person 1) about as far right of the left one as live puts it.
+      run 0 capture side.mp4 --people 2 --models "$models" -o side.landmarks.jsonl --quiet
+      run 0 solve side.landmarks.jsonl -o side.pose.jsonl
+      python3 - side.p0.pose.jsonl side.p1.pose.jsonl live.p0.pose.jsonl live.p1.pose.jsonl <<'PY' ||
+import json, sys
+def mean_x(path):
+    rows = [json.loads(l) for l in open(path) if l.strip()][1:]
+    return sum(r["hips_position"][0] for r in rows) / len(rows)
+f0, f1, l0, l1 = (mean_x(p) for p in sys.argv[1:5])
+gap_file, gap_live = f1 - f0, l1 - l0
+print("person 1 right of person 0: %.2f m (files), %.2f m (live)" % (gap_file, gap_live))
+# Two people 720 px apart at one depth, each about 1100 px tall: 1 to 2.5 m apart.
+assert 0.8 < gap_file < 3.0 and abs(gap_file - gap_live) < 0.5, (gap_file, gap_live)
+PY
+        fail "the solved files do not stand the two people apart as live does"
     fi
     ;;
   glb_builtin)

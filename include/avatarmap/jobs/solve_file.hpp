@@ -80,6 +80,10 @@ struct solve_file_summary {
   /// them, those whose spine and arms were not followed either, and how many had each doubt
   /// (solve/body_plausibility.hpp, bit index order). A warning says it when any was held.
   body_hold_stats body_hold{};
+  /// The point of the solver's ground space the root was measured from (where the person, or
+  /// origin_person, was first seen); has_ground_origin false when no frame had a body.
+  bool has_ground_origin = false;
+  float ground_origin[2] = {0.f, 0.f};
 };
 
 /// The job. Fill the inputs, call run(). Thread-safety: a job may be run from any thread; the
@@ -101,6 +105,14 @@ struct solve_file_job : pose_stream_filters {
   /// file's only person (a file of several people is then refused: jobs/people.hpp plans one
   /// run per person). Not used with `source`.
   int person = -1;
+  /// Of a file of several people: measure the root (hips_position X/Z) from where person
+  /// `origin_person` was first seen (that person's own solve of this file gives the point)
+  /// instead of where `person` was, so that people stand apart as in the video, as live places
+  /// them. -1: the file's lowest id when the file (a regular, version-2 one) holds several
+  /// people, else `person` itself. Costs a solve of that person first (when it is not
+  /// `person`). Give `person` itself to measure from its own first place. Not used with
+  /// `source`.
+  int origin_person = -1;
   /// *.pose.jsonl to write ("-" = standard output), atomically: on failure an existing file is
   /// left as it was. Ignored when `sink` is set.
   std::string output;
@@ -234,6 +246,14 @@ inline constexpr option_row<solve_file_job> k_solve_file_option_table[] = {
         .cli("--person", "ID")
         .help("of a file of several people, solve only person ID (default: each person to its "
               "own output, the id before the extension: take.p0.glb, take.p1.glb)"),
+    option_row<solve_file_job>("origin_person",
+                               AVATARMAP_OPTION_FIELD(solve_file_job, origin_person))
+        .integer(-1, k_max_person_id)
+        .cli("--origin-person", "ID")
+        .not_in_c()
+        .help("of a file of several people, measure every root from where person ID was first "
+              "seen, so that people stand apart as in the video; -1: the file's lowest id, as "
+              "live does; a person's own id: its own first place"),
     option_row<solve_file_job>("output_fps", AVATARMAP_OPTION_FIELD(solve_file_job, output_fps))
         .number(0, k_max_fps, true)
         .or_zero()

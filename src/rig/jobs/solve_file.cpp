@@ -120,6 +120,11 @@ status solve_file_job::validate() const {
   if (person < -1 || person > k_max_person_id)
     return status::error("solve_file_job.person must be -1 (the file's only person) or in [0, " +
                          std::to_string(k_max_person_id) + "]");
+  if (origin_person < -1 || origin_person > k_max_person_id)
+    return status::error(
+        "solve_file_job.origin_person must be -1 (the person's own first place) "
+        "or in [0, " +
+        std::to_string(k_max_person_id) + "]");
   if (!(std::isfinite(image_width) && std::isfinite(image_height) && image_width >= 0.f &&
         image_height >= 0.f) ||
       (image_width > 0.f) != (image_height > 0.f))
@@ -165,6 +170,37 @@ status solve_file_job::run(solve_file_summary& s) const {
       if (ids.size() == 1) only = ids[0];
     }
     reader.set_person(only);
+  }
+  // Several people standing apart: the origin person's own solve says where it was first seen.
+  // -1: a file of several people's first (lowest) id.
+  bool shared_origin = false;
+  glm::vec2 origin(0.f);
+  int origin_id = origin_person;
+  if (!source && origin_id != only) {
+    std::error_code ec;
+    std::vector<int> ids{0};  // a version-1 file: person 0
+    if (reader.header().version >= 2 && std::filesystem::is_regular_file(input, ec))
+      if (st = people_in_file(input, ids); !st.ok()) return st;
+    if (origin_id == -1 && reader.header().version >= 2 && ids.size() > 1)
+      origin_id = *std::min_element(ids.begin(), ids.end());
+    if (origin_id >= 0 && std::find(ids.begin(), ids.end(), origin_id) == ids.end())
+      return status::invalid_argument(input + ": no origin person " + std::to_string(origin_id) +
+                                      " (its people: " + person_id_list(ids) + ")");
+  }
+  if (origin_id >= 0 && origin_id != only && !source) {
+    solve_file_job first = *this;
+    first.person = origin_id;
+    first.origin_person = origin_id;
+    first.sink = [](const proxy_pose&) { return status{}; };
+    first.progress = nullptr;
+    first.warning = nullptr;
+    first.write_confidence = false;
+    solve_file_summary fs;
+    if (status st = first.run(fs); !st.ok())
+      return status::failure(
+          st.code(), "the origin person " + std::to_string(origin_id) + ": " + st.message());
+    shared_origin = fs.has_ground_origin;
+    origin = {fs.ground_origin[0], fs.ground_origin[1]};
   }
   s.input_opened = true;
   // Frames from a source have no header: its defaults (no image size, no fps).
@@ -212,6 +248,20 @@ status solve_file_job::run(solve_file_summary& s) const {
   // exactly: no warm-up.
   state->warming = filter_mode == pose_filter_mode::offline;
   pose_stream& stream = state->stream;
+  // Where the root is measured from (set again after the warm-up's restarts, which forget it),
+  // and which point that was (the first one the solver had after the warm-up).
+  auto use_origin = [&] {
+    if (shared_origin) stream_solver(stream).set_ground_origin(origin);
+  };
+  auto note_origin = [&] {
+    if (s.has_ground_origin || state->warming || state->holding_face) return;
+    glm::vec2 o;
+    if (!stream.solver().ground_origin(o)) return;
+    s.has_ground_origin = true;
+    s.ground_origin[0] = o.x;
+    s.ground_origin[1] = o.y;
+  };
+  use_origin();
   // Whatever the filter, a regular file's face is calibrated over all its frames (with the
   // offline filter after the warm-up, else before the first frame); a source's, a pipe's or
   // standard input's (read once) over the first k_warm_up_frames (the warm-up's with the
@@ -243,6 +293,7 @@ status solve_file_job::run(solve_file_summary& s) const {
     for (const landmark_frame& f : ws.warm) ws.stream.learn_camera(f);
     ws.stream.restart_take();
     ws.stream.hold_view();
+    use_origin();
     if (face && read_twice)
       calibrate_face_over_file(input, only, stream_solver(ws.stream));
     else if (face)
@@ -320,6 +371,7 @@ status solve_file_job::run(solve_file_summary& s) const {
       } else {
         pushed = stream.push(frame, emit);
       }
+      note_origin();
       src.release();
       if (!pushed.ok()) return pushed;
       if (progress && (s.frames & 255) == 0) {
@@ -351,6 +403,7 @@ status solve_file_job::run(solve_file_summary& s) const {
     const status held = end_holding_face();
     if (st.ok()) st = held;
   }
+  note_origin();
   if (st.ok()) st = stream.finish(emit);  // the poses the offline filter still holds
   s.poses_written = stream.stats().emitted;
   if (!st.ok()) return st;

@@ -1,10 +1,12 @@
 // Several people in one landmark file (jobs/people.hpp, docs/file-formats.md "Version 2"): the
 // output names, the runs planned for a file, and the solve job reading one person's lines: a
-// person's poses out of a file of two are bit for bit those of a file of that person alone.
+// person's poses out of a file of two are bit for bit those of a file of that person alone, the
+// root measured from where the file's first person was first seen.
 #include "avatarmap/jobs/people.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -81,6 +83,8 @@ TEST(people, output_names_carry_the_person_before_the_extension) {
   EXPECT_EQ(person_output_path(".pose.jsonl", 2), ".pose.p2.jsonl");
 }
 
+// Each person of a file of two is solved as alone, its root measured from where the file's
+// first person was first seen: the two stand apart as the synthetic scene placed them.
 TEST(people, a_persons_poses_from_a_file_of_two_are_those_of_that_person_alone) {
   test::temp_dir dir{"people"};
   const std::vector<landmark_frame> a = person_frames(3, -0.5f), b = person_frames(4, 0.6f);
@@ -96,13 +100,27 @@ TEST(people, a_persons_poses_from_a_file_of_two_are_those_of_that_person_alone) 
   const std::vector<proxy_pose> got_a = solve(two, 0), got_b = solve(two, 7);
   ASSERT_EQ(got_a.size(), 40u);
   ASSERT_EQ(got_b.size(), 40u);
+  const glm::vec3 shift = got_b[0].hips_position - want_b[0].hips_position;
   for (std::size_t i = 0; i < 40; ++i) {
     EXPECT_EQ(got_a[i].rotations, want_a[i].rotations) << i;
     EXPECT_EQ(got_a[i].hips_position, want_a[i].hips_position) << i;
     EXPECT_EQ(got_a[i].blendshapes, want_a[i].blendshapes) << i;
     EXPECT_EQ(got_b[i].rotations, want_b[i].rotations) << i;
-    EXPECT_EQ(got_b[i].hips_position, want_b[i].hips_position) << i;
+    // b's root: b alone's, moved on the ground by one constant.
+    EXPECT_NEAR(got_b[i].hips_position.x - want_b[i].hips_position.x, shift.x, 1e-5f) << i;
+    EXPECT_EQ(got_b[i].hips_position.y, want_b[i].hips_position.y) << i;
+    EXPECT_NEAR(got_b[i].hips_position.z - want_b[i].hips_position.z, shift.z, 1e-5f) << i;
   }
+  // The constant is where b first stood from where a did, as the scene placed them: hips 0.6 m
+  // and -0.5 m to the side, plus each one's own motion at its first frame.
+  synth_options so;
+  const float truth_x =
+      (0.6f + demo_motion_pose(4.0, landmark_synth(so).skeleton()).hips_position.x) -
+      (-0.5f + demo_motion_pose(3.0, landmark_synth(so).skeleton()).hips_position.x);
+  std::printf("b stands %.3f m beside a (the scene: %.3f m); %.3f m apart in depth\n", shift.x,
+              truth_x, shift.z);
+  EXPECT_NEAR(shift.x, truth_x, 0.05f);
+  EXPECT_LT(std::abs(shift.z), 0.3f);
   // The two people are not the same poses (the test would pass on one person's lines twice).
   EXPECT_NE(got_a[20].rotations, got_b[20].rotations);
 
