@@ -122,8 +122,8 @@ status solve_file_job::validate() const {
                          std::to_string(k_max_person_id) + "]");
   if (origin_person < -1 || origin_person > k_max_person_id)
     return status::error(
-        "solve_file_job.origin_person must be -1 (the person's own first place) "
-        "or in [0, " +
+        "solve_file_job.origin_person must be -1 (a file of several people's lowest id) or in "
+        "[0, " +
         std::to_string(k_max_person_id) + "]");
   if (!(std::isfinite(image_width) && std::isfinite(image_height) && image_width >= 0.f &&
         image_height >= 0.f) ||
@@ -178,8 +178,13 @@ status solve_file_job::run(solve_file_summary& s) const {
   int origin_id = origin_person;
   if (!source && origin_id != only) {
     std::error_code ec;
+    const bool regular = std::filesystem::is_regular_file(input, ec);
+    if (!regular && origin_id >= 0)
+      return status::invalid_argument(input +
+                                      ": origin_person reads the file twice: give a file, "
+                                      "not a pipe or standard input");
     std::vector<int> ids{0};  // a version-1 file: person 0
-    if (reader.header().version >= 2 && std::filesystem::is_regular_file(input, ec))
+    if (reader.header().version >= 2 && regular)
       if (st = people_in_file(input, ids); !st.ok()) return st;
     if (origin_id == -1 && reader.header().version >= 2 && ids.size() > 1)
       origin_id = *std::min_element(ids.begin(), ids.end());
