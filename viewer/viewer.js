@@ -16,7 +16,7 @@
 // origin as the others (the first pose's hips); one without stands 1 m to the right per slot.
 // Once a pose has carried a "slot", an avatar whose slot got no pose for 1.5 s is hidden until
 // its slot gets one again (slot 0's too, unless it plays an animation); one person's is never.
-// A message {"person":ID,"slot":K,"gone":true} (the person left the slot) hides it at once.
+// A message {"gone":true,"person":ID,"slot":K} (the person left the slot) hides it at once.
 //
 // For tests and tools: window.avatarmapViewer.state() says what the page shows,
 // boneRotation(name, slot = 0) / rawBoneRotation(name, slot = 0) the normalised / raw local
@@ -838,9 +838,9 @@ async function loadBody(slot) {
 function poseSlot(slot, now) {
   const text = newestMessages[slot];
   if (text === null) return false;
-  // The person left the slot (the server's {"person":ID,"slot":K,"gone":true}): its avatar
+  // The person left the slot (the server's {"gone":true,"person":ID,"slot":K}): its avatar
   // hides now rather than after HIDE_AFTER_MS.
-  if (text.endsWith('"gone":true}')) {
+  if (text.startsWith('{"gone":true')) {
     newestMessages[slot] = null;
     if (bodies[slot]) bodies[slot].lastSeen = -Infinity;
     return false;

@@ -212,7 +212,7 @@ def main():
               "slot 0's person left: its avatar is hidden, slot 1's stays")
         # The server's notice that slot 1's person has gone (pose_server::clear): hidden at
         # once, not after 1.5 s.
-        gone = json.dumps({"person": 9, "slot": 1, "gone": True}, separators=(",", ":"))
+        gone = json.dumps({"gone": True, "person": 9, "slot": 1}, separators=(",", ":"))
         source.set_lines([gone])
         t0 = time.time()
         wait_people(browser, lambda p: not p[1]["visible"], 10, "slot 1 hidden by its notice")

@@ -27,6 +27,9 @@ struct low_light_options {
   float max_gain = 8.0f;      // at most this stretch (noise grows with it)
 };
 
+/// The options every pipeline lifts with (estimator_options::low_light on).
+inline constexpr low_light_options k_low_light{};
+
 /// Lifts the crop `tensor` (W x H x 3 floats in [options.range_min, options.range_max], as
 /// image_crop_job writes it; `transform` its geometry, for the letterbox bands) in place as the
 /// header says. Returns the gain applied (1: untouched).

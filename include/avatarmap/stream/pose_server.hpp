@@ -148,7 +148,7 @@ class pose_server {
   /// blocks on a client, never allocates.
   void publish(const proxy_pose& pose, int person, int slot);
   /// The person `person` has left `slot` (live_session_options::on_person_gone): the slot's
-  /// newest message becomes `{"person":PERSON,"slot":SLOT,"gone":true}`, sent to every page
+  /// newest message becomes `{"gone":true,"person":PERSON,"slot":SLOT}`, sent to every page
   /// in place of the person's last pose (the viewer hides that avatar at once; a page that
   /// connects later gets it too, not the stale pose). A slot out of range is ignored. Any
   /// thread; never blocks on a client, never allocates.

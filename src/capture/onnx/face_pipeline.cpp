@@ -34,9 +34,8 @@ constexpr int k_attention_flag_output = 6;
 
 struct face_pipeline::impl {
   face_pipeline_options options;
-  const low_light_options lift{};  // with options.low_light: dim crops lifted (low_light.hpp)
-  bound_model detector;            // outputs: boxes [896 x 16], scores [896]
-  bound_model mesh;  // outputs: landmarks [468 x 3], face flag [1]; or the attention ones
+  bound_model detector;  // outputs: boxes [896 x 16], scores [896]
+  bound_model mesh;      // outputs: landmarks [468 x 3], face flag [1]; or the attention ones
   face_mesh_model model = face_mesh_model::attention;
   int points = k_face_mesh_iris_count;
   std::string note;
@@ -92,8 +91,7 @@ struct face_pipeline::impl {
     ran_detector = true;
     search_region = region;
     crop_transform tr;
-    if (!detector.crop_input(image, region, detector_crop, &tr,
-                             options.low_light ? &lift : nullptr)) {
+    if (!detector.crop_input(image, region, detector_crop, &tr)) {
       // A degenerate body region (e.g. all face points on one spot) is not an error.
       if (keypoint_roi) return false;
       error = "face detector: the image could not be cropped";
@@ -119,7 +117,7 @@ struct face_pipeline::impl {
   bool landmarks(const image_view& image, const normalized_rect& r, landmark_frame& out) {
     const auto t0 = std::chrono::steady_clock::now();
     crop_transform tr;
-    if (!mesh.crop_input(image, r, mesh_crop, &tr, options.low_light ? &lift : nullptr)) {
+    if (!mesh.crop_input(image, r, mesh_crop, &tr)) {
       error = "face mesh: the region could not be cropped";
       return false;
     }
@@ -249,6 +247,7 @@ status face_pipeline::create(const face_pipeline_options& options,
   m->mesh_crop.keep_aspect_ratio = false;
   m->mesh_crop.border = crop_border::replicate;
   m->detector_crop.sampling = m->mesh_crop.sampling = options.sampling;
+  if (options.low_light) m->detector.lift = m->mesh.lift = &k_low_light;
   out.reset(new face_pipeline(std::move(m)));
   return {};
 }

@@ -78,9 +78,8 @@ struct hand_pipeline::impl {
   }
 
   hand_pipeline_options options;
-  const low_light_options lift{};  // with options.low_light: dim crops lifted (low_light.hpp)
-  bound_model palm;                // outputs: boxes [2016 x 18], scores [2016]
-  bound_model hand_model;          // outputs by position: landmarks, presence, handedness, world
+  bound_model palm;        // outputs: boxes [2016 x 18], scores [2016]
+  bound_model hand_model;  // outputs by position: landmarks, presence, handedness, world
   std::vector<ssd_anchor> anchors;
   detection_decode_options decode;
   std::vector<detection> decoded;
@@ -125,8 +124,7 @@ struct hand_pipeline::impl {
     ran_palm = true;
     crop_transform tr;
     // The whole image, letterboxed.
-    if (!palm.crop_input(image, normalized_rect{}, palm_crop, &tr,
-                         options.low_light ? &lift : nullptr)) {
+    if (!palm.crop_input(image, normalized_rect{}, palm_crop, &tr)) {
       error = "hand_pipeline: palm detector: the image could not be cropped";
       return -1;
     }
@@ -167,7 +165,7 @@ struct hand_pipeline::impl {
     const auto t0 = std::chrono::steady_clock::now();
     ++timings.landmark_runs;
     crop_transform tr;
-    if (!hand_model.crop_input(image, r, landmark_crop, &tr, options.low_light ? &lift : nullptr)) {
+    if (!hand_model.crop_input(image, r, landmark_crop, &tr)) {
       error = "hand_pipeline: hand landmarks: the region could not be cropped";
       return false;
     }
@@ -444,6 +442,7 @@ status hand_pipeline::create(const hand_pipeline_options& options,
   m->landmark_crop.range_max = 1.f;
   m->landmark_crop.border = crop_border::replicate;
   m->palm_crop.sampling = m->landmark_crop.sampling = options.sampling;
+  if (options.low_light) m->palm.lift = m->hand_model.lift = &k_low_light;
   out.reset(new hand_pipeline(std::move(m)));
   return {};
 }

@@ -160,8 +160,7 @@ std::string bound_model::load_in_order(const std::string& path, const Ort::Sessi
 }
 
 bool bound_model::crop_input(const image_view& image, const normalized_rect& roi,
-                             const crop_options& options, crop_transform* transform,
-                             const low_light_options* lift) {
+                             const crop_options& options, crop_transform* transform) {
   crop_transform local;
   image_crop_job job;
   job.image = image;

@@ -93,11 +93,14 @@ struct bound_model {
                             const std::vector<int64_t>& input_shape,
                             const std::vector<int64_t>& counts);
 
-  /// Crops `roi` of `image` into `input` (MediaPipe's ImageToTensor, image_crop.hpp); the
-  /// transform back to the image goes to `transform` when non-null. With `lift`, a dim,
-  /// low-contrast crop is then lifted (low_light.hpp). False when the image cannot be cropped.
+  /// When set, crop_input() lifts a dim, low-contrast crop with these options (low_light.hpp).
+  const low_light_options* lift = nullptr;
+
+  /// Crops `roi` of `image` into `input` (MediaPipe's ImageToTensor, image_crop.hpp), lifted
+  /// when `lift` is set; the transform back to the image goes to `transform` when non-null.
+  /// False when the image cannot be cropped.
   bool crop_input(const image_view& image, const normalized_rect& roi, const crop_options& options,
-                  crop_transform* transform, const low_light_options* lift = nullptr);
+                  crop_transform* transform);
 
   /// Runs the session on `input` into `outputs`. Throws Ort::Exception.
   void run();

@@ -71,9 +71,8 @@ void refine_from_heatmap(const float* heatmap, int channel, float& x, float& y) 
 struct pose_pipeline::impl {
   bool has_heatmap = false;
   pose_pipeline_options options;
-  const low_light_options lift{};  // with options.low_light: dim crops lifted (low_light.hpp)
-  bound_model detector;            // outputs: boxes [2254 x 12], scores [2254]
-  bound_model landmark;            // outputs: landmarks [195], presence [1], world [117]
+  bound_model detector;  // outputs: boxes [2254 x 12], scores [2254]
+  bound_model landmark;  // outputs: landmarks [195], presence [1], world [117]
   std::vector<ssd_anchor> anchors;
   detection_decode_options decode;
   std::vector<detection> decoded;
@@ -111,8 +110,7 @@ struct pose_pipeline::impl {
     const auto t0 = std::chrono::steady_clock::now();
     crop_transform tr;
     // The whole image, letterboxed.
-    if (!detector.crop_input(image, normalized_rect{}, detector_crop, &tr,
-                             options.low_light ? &lift : nullptr)) {
+    if (!detector.crop_input(image, normalized_rect{}, detector_crop, &tr)) {
       error = "pose detector: the image could not be cropped";
       return false;
     }
@@ -143,8 +141,7 @@ struct pose_pipeline::impl {
                  float* out_anchors) {
     const auto t0 = std::chrono::steady_clock::now();
     crop_transform tr;
-    if (!detector.crop_input(image, normalized_rect{}, detector_crop, &tr,
-                             options.low_light ? &lift : nullptr)) {
+    if (!detector.crop_input(image, normalized_rect{}, detector_crop, &tr)) {
       error = "pose detector: the image could not be cropped";
       return -1;
     }
@@ -189,7 +186,7 @@ struct pose_pipeline::impl {
                  landmark_frame& out) {
     const auto t0 = std::chrono::steady_clock::now();
     crop_transform tr;
-    if (!landmark.crop_input(image, r, landmark_crop, &tr, options.low_light ? &lift : nullptr)) {
+    if (!landmark.crop_input(image, r, landmark_crop, &tr)) {
       error = "pose landmarks: the region could not be cropped";
       return false;
     }
@@ -326,6 +323,7 @@ status pose_pipeline::create(const pose_pipeline_options& options,
   m->landmark_crop.range_max = 1.f;
   m->landmark_crop.border = crop_border::replicate;
   m->detector_crop.sampling = m->landmark_crop.sampling = options.sampling;
+  if (options.low_light) m->detector.lift = m->landmark.lift = &k_low_light;
   out.reset(new pose_pipeline(std::move(m)));
   return {};
 }

@@ -151,6 +151,7 @@ status solve_file_job::run(solve_file_summary& s) const {
   // The person solved: `person`, else the file's only one (a version-1 file's lines are all
   // person 0; a version-2 file of several people needs `person`, jobs/people.hpp).
   int only = person;
+  std::vector<int> ids;  // the file's people, once scanned (a version-2 regular file)
   if (!source) {
     st = reader.open(input);
     if (!st.ok()) return st;  // io (cannot be opened) or parse (a bad header)
@@ -159,7 +160,6 @@ status solve_file_job::run(solve_file_summary& s) const {
       if (input == "-" || !std::filesystem::is_regular_file(input, ec))
         return status::invalid_argument(
             input + ": several people's landmarks (version 2) read once: choose one (person)");
-      std::vector<int> ids;
       if (st = people_in_file(input, ids); !st.ok()) return st;
       if (ids.size() > 1) {
         return status::invalid_argument(input + " has " + std::to_string(ids.size()) + " people (" +
@@ -183,8 +183,9 @@ status solve_file_job::run(solve_file_summary& s) const {
       return status::invalid_argument(input +
                                       ": origin_person reads the file twice: give a file, "
                                       "not a pipe or standard input");
-    std::vector<int> ids{0};  // a version-1 file: person 0
-    if (reader.header().version >= 2 && regular)
+    if (reader.header().version < 2)
+      ids = {0};  // a version-1 file: person 0
+    else if (ids.empty() && regular)
       if (st = people_in_file(input, ids); !st.ok()) return st;
     if (origin_id == -1 && reader.header().version >= 2 && ids.size() > 1)
       origin_id = *std::min_element(ids.begin(), ids.end());
@@ -192,7 +193,7 @@ status solve_file_job::run(solve_file_summary& s) const {
       return status::invalid_argument(input + ": no origin person " + std::to_string(origin_id) +
                                       " (its people: " + person_id_list(ids) + ")");
   }
-  if (origin_id >= 0 && origin_id != only && !source) {
+  if (!source && origin_id >= 0 && origin_id != only) {
     solve_file_job first = *this;
     first.person = origin_id;
     first.origin_person = origin_id;
